@@ -1,0 +1,207 @@
+#include "engine/input_log.hpp"
+
+#include <charconv>
+#include <fstream>
+#include <sstream>
+
+namespace fire {
+
+std::string format_double(double v) {
+  char buf[64];
+  auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+namespace {
+
+std::vector<std::string_view> split_fields(std::string_view line) {
+  std::vector<std::string_view> out;
+  size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
+    size_t j = i;
+    while (j < line.size() && line[j] != ' ' && line[j] != '\t' && line[j] != '\r') ++j;
+    if (j > i) out.push_back(line.substr(i, j - i));
+    i = j;
+  }
+  return out;
+}
+
+bool parse_double(std::string_view s, double& out) {
+  auto r = std::from_chars(s.data(), s.data() + s.size(), out);
+  return r.ec == std::errc() && r.ptr == s.data() + s.size();
+}
+
+bool parse_int64(std::string_view s, int64_t& out) {
+  auto r = std::from_chars(s.data(), s.data() + s.size(), out);
+  return r.ec == std::errc() && r.ptr == s.data() + s.size();
+}
+
+int hex_digit(char c) {
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  return -1;
+}
+
+bool parse_hex(std::string_view s, std::vector<uint8_t>& out) {
+  if (s.size() % 2 != 0) return false;
+  out.clear();
+  for (size_t i = 0; i < s.size(); i += 2) {
+    int hi = hex_digit(s[i]), lo = hex_digit(s[i + 1]);
+    if (hi < 0 || lo < 0) return false;
+    out.push_back(static_cast<uint8_t>(hi * 16 + lo));
+  }
+  return true;
+}
+
+bool parse_point(const std::vector<std::string_view>& f, size_t first, Vec3& p) {
+  if (f.size() != first + 3) return false;
+  for (int k = 0; k < 3; ++k)
+    if (!parse_double(f[first + k], p[k])) return false;
+  return true;
+}
+
+}  // namespace
+
+Result<InputLog> parse_input_log(std::string_view text, const std::string& source) {
+  auto fail = [&](uint32_t line, const std::string& why) {
+    return Result<InputLog>::failure(source + ":" + std::to_string(line) + ": " + why);
+  };
+  if (text.empty()) return Result<InputLog>::failure(source + ": empty input log (expected the header '" + std::string(kInputLogHeader) + "')");
+  InputLog log;
+  size_t pos = 0;
+  uint32_t line_no = 0;
+  int64_t last_t = INT64_MIN;
+  while (pos < text.size()) {
+    size_t end = text.find('\n', pos);
+    ++line_no;
+    if (end == std::string_view::npos)
+      return fail(line_no, "truncated input log: the last line has no end of line (was the writer cut off?)");
+    std::string_view line = text.substr(pos, end - pos);
+    pos = end + 1;
+    if (line_no == 1) {
+      if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+      if (line.substr(0, 9) == "FIRE-LOG ") {
+        if (line != kInputLogHeader)
+          return fail(1, "unknown input log version '" + std::string(line.substr(9)) + "' (this build reads version 1)");
+        continue;
+      }
+      return fail(1, "not a FIRE input log (the first line must be '" + std::string(kInputLogHeader) + "')");
+    }
+    auto f = split_fields(line);
+    if (f.empty() || f[0][0] == '#') continue;
+    InputEvent e;
+    e.line = line_no;
+    if (f.size() < 2) return fail(line_no, "expected '<t_us> <kind> ...'");
+    if (!parse_int64(f[0], e.t_us)) return fail(line_no, "bad timestamp '" + std::string(f[0]) + "'");
+    if (e.t_us < last_t) return fail(line_no, "timestamp goes back in time (" + std::to_string(e.t_us) + " after " + std::to_string(last_t) + ")");
+    last_t = e.t_us;
+    std::string_view kind = f[1];
+    if (kind == "pen") {
+      e.kind = EventKind::Pen;
+      if (!parse_point(f, 2, e.p)) return fail(line_no, "pen needs three numbers x y z");
+    } else if (kind == "down" || kind == "up") {
+      e.kind = kind == "down" ? EventKind::Down : EventKind::Up;
+      if (f.size() != 2) return fail(line_no, std::string(kind) + " takes no fields");
+    } else if (kind == "cmd") {
+      e.kind = EventKind::Command;
+      if (f.size() < 3) return fail(line_no, "cmd needs a command: undo, redo, close or delete x y z");
+      std::string_view c = f[2];
+      if (c == "undo" || c == "redo" || c == "close") {
+        e.command = c == "undo" ? CommandKind::Undo : c == "redo" ? CommandKind::Redo : CommandKind::Close;
+        if (f.size() != 3) return fail(line_no, "cmd " + std::string(c) + " takes no fields");
+      } else if (c == "delete") {
+        e.command = CommandKind::Delete;
+        if (!parse_point(f, 3, e.p)) return fail(line_no, "cmd delete needs three numbers x y z");
+      } else {
+        return fail(line_no, "unknown command '" + std::string(c) + "'");
+      }
+    } else if (kind == "hid") {
+      e.kind = EventKind::Hid;
+      int64_t device = 0;
+      if (f.size() != 4 || !parse_int64(f[2], device) || device < 0 || device > 255)
+        return fail(line_no, "hid needs '<device> <hex bytes>'");
+      e.device = static_cast<int>(device);
+      if (!parse_hex(f[3], e.bytes)) {
+        e.hid_ok = false;
+        e.bytes.clear();
+        ++log.rejected_hid_lines;
+      }
+    } else if (kind == "truth") {
+      e.kind = EventKind::Truth;
+      if (f.size() < 3) return fail(line_no, "truth needs a name");
+      e.name = std::string(f[2]);
+      for (size_t k = 3; k < f.size(); ++k) {
+        double v;
+        if (!parse_double(f[k], v)) return fail(line_no, "truth value '" + std::string(f[k]) + "' is not a number");
+        e.values.push_back(v);
+      }
+    } else if (kind == "meta") {
+      e.kind = EventKind::Meta;
+      if (f.size() < 3) return fail(line_no, "meta needs a key");
+      e.name = std::string(f[2]);
+      size_t at = line.find(f[2]) + f[2].size();
+      while (at < line.size() && line[at] == ' ') ++at;
+      e.text = std::string(line.substr(at));
+    } else {
+      return fail(line_no, "unknown event kind '" + std::string(kind) + "'");
+    }
+    log.events.push_back(std::move(e));
+  }
+  if (line_no == 0) return Result<InputLog>::failure(source + ": empty input log");
+  return log;
+}
+
+Result<InputLog> read_input_log(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Result<InputLog>::failure(path + ": cannot open input log");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parse_input_log(ss.str(), path);
+}
+
+std::string format_event(const InputEvent& e) {
+  std::string s = std::to_string(e.t_us) + ' ';
+  auto point = [&](const Vec3& p) {
+    return format_double(p.x()) + ' ' + format_double(p.y()) + ' ' + format_double(p.z());
+  };
+  switch (e.kind) {
+    case EventKind::Pen: s += "pen " + point(e.p); break;
+    case EventKind::Down: s += "down"; break;
+    case EventKind::Up: s += "up"; break;
+    case EventKind::Command:
+      switch (e.command) {
+        case CommandKind::Undo: s += "cmd undo"; break;
+        case CommandKind::Redo: s += "cmd redo"; break;
+        case CommandKind::Close: s += "cmd close"; break;
+        case CommandKind::Delete: s += "cmd delete " + point(e.p); break;
+      }
+      break;
+    case EventKind::Hid: {
+      static const char* digits = "0123456789abcdef";
+      s += "hid " + std::to_string(e.device) + ' ';
+      for (uint8_t b : e.bytes) {
+        s += digits[b >> 4];
+        s += digits[b & 15];
+      }
+      break;
+    }
+    case EventKind::Truth:
+      s += "truth " + e.name;
+      for (double v : e.values) s += ' ' + format_double(v);
+      break;
+    case EventKind::Meta: s += "meta " + e.name + (e.text.empty() ? "" : " " + e.text); break;
+  }
+  s += '\n';
+  return s;
+}
+
+std::string format_input_log(const std::vector<InputEvent>& events) {
+  std::string s(kInputLogHeader);
+  s += '\n';
+  for (const auto& e : events) s += format_event(e);
+  return s;
+}
+
+}  // namespace fire

@@ -1,0 +1,49 @@
+#pragma once
+// The input log (format in engine/INPUT_LOG.md): everything that enters the engine, timestamped.
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "engine/common.hpp"
+
+namespace fire {
+
+enum class EventKind : uint8_t { Pen, Down, Up, Command, Hid, Truth, Meta };
+enum class CommandKind : uint8_t { Undo, Redo, Close, Delete };
+
+struct InputEvent {
+  int64_t t_us = 0;
+  EventKind kind = EventKind::Pen;
+  Vec3 p = Vec3::Zero();              // Pen sample; Delete command's pick point
+  CommandKind command = CommandKind::Undo;
+  int device = 0;                     // Hid
+  bool hid_ok = true;                 // Hid: false when the hex was garbled (bytes then empty)
+  std::vector<uint8_t> bytes;         // Hid: the report, report id first
+  std::string name;                   // Truth name, Meta key
+  std::vector<double> values;         // Truth numbers
+  std::string text;                   // Meta value
+  uint32_t line = 0;                  // 1-based line in the file it came from (0 if built in memory)
+};
+
+struct InputLog {
+  std::vector<InputEvent> events;
+  size_t rejected_hid_lines = 0;      // garbled hid payloads, kept as events with hid_ok = false
+};
+
+inline constexpr std::string_view kInputLogHeader = "FIRE-LOG 1";
+
+// Parses a whole log held in memory; `source` names it in error messages.
+Result<InputLog> parse_input_log(std::string_view text, const std::string& source);
+// Reads and parses a file; errors name the file, the line and the problem.
+Result<InputLog> read_input_log(const std::string& path);
+
+// One line of the format, ending in '\n'.
+std::string format_event(const InputEvent& e);
+// The header line followed by every event.
+std::string format_input_log(const std::vector<InputEvent>& events);
+
+// Shortest text that reads back as the same double.
+std::string format_double(double v);
+
+}  // namespace fire

@@ -1,0 +1,435 @@
+#include "engine/mesh.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+namespace fire {
+
+namespace {
+
+constexpr std::array<uint32_t, 2> kNoPair{kNone, kNone};
+
+void mark(std::vector<uint8_t>& dirty, uint32_t i) {
+  if (dirty.size() <= i) dirty.resize(i + 1, 1);
+  dirty[i] = 1;
+}
+
+}  // namespace
+
+// Visits every journaled column with the dirty tags of the pool it belongs to (nullptr for shared arrays).
+template <class F>
+void Mesh::for_each_column(F&& f) {
+  f(vertices.position, &vertices.dirty);
+  f(vertices.first_edge, &vertices.dirty);
+  f(vertices.generation, &vertices.dirty);
+  f(vertices.flags, &vertices.dirty);
+  f(vertices.free_list, nullptr);
+  f(edges.vertex, &edges.dirty);
+  f(edges.face, &edges.dirty);
+  f(edges.next, &edges.dirty);
+  f(edges.point_offset, &edges.dirty);
+  f(edges.point_count, &edges.dirty);
+  f(edges.generation, &edges.dirty);
+  f(edges.flags, &edges.dirty);
+  f(edges.free_list, nullptr);
+  f(faces.edge_offset, &faces.dirty);
+  f(faces.edge_count, &faces.dirty);
+  f(faces.generation, &faces.dirty);
+  f(faces.flags, &faces.dirty);
+  f(faces.free_list, nullptr);
+  f(points, nullptr);
+  f(face_edges, nullptr);
+}
+
+template <class F>
+void Mesh::for_each_column(F&& f) const {
+  const_cast<Mesh*>(this)->for_each_column([&](auto& column, std::vector<uint8_t>*) { f(std::as_const(column)); });
+}
+
+size_t Mesh::vertex_count() const {
+  return static_cast<size_t>(std::count_if(vertices.flags.values().begin(), vertices.flags.values().end(),
+                                           [](uint8_t f) { return f & kAlive; }));
+}
+size_t Mesh::edge_count() const {
+  return static_cast<size_t>(std::count_if(edges.flags.values().begin(), edges.flags.values().end(),
+                                           [](uint8_t f) { return f & kAlive; }));
+}
+size_t Mesh::face_count() const {
+  return static_cast<size_t>(std::count_if(faces.flags.values().begin(), faces.flags.values().end(),
+                                           [](uint8_t f) { return f & kAlive; }));
+}
+size_t Mesh::live_point_count() const {
+  size_t n = 0;
+  for (uint32_t e = 0; e < edge_slots(); ++e)
+    if (edge_alive(e)) n += edges.point_count[e];
+  return n;
+}
+
+std::vector<uint32_t> Mesh::vertex_edges(uint32_t v) const {
+  std::vector<uint32_t> out;
+  for (uint32_t e = vertices.first_edge[v]; e != kNone;) {
+    out.push_back(e);
+    e = edges.next[e][edges.vertex[e][0] == v ? 0 : 1];
+  }
+  return out;
+}
+
+uint32_t Mesh::valence(uint32_t v) const {
+  uint32_t n = 0;
+  for (uint32_t e = vertices.first_edge[v]; e != kNone; e = edges.next[e][edges.vertex[e][0] == v ? 0 : 1]) ++n;
+  return n;
+}
+
+uint32_t Mesh::loop_position(uint32_t f, uint32_t e) const {
+  auto loop = face_loop(f);
+  for (uint32_t k = 0; k < loop.size(); ++k)
+    if (edge_of(loop[k]) == e) return k;
+  return kNone;
+}
+
+uint32_t Mesh::allocate(Column<uint32_t>& free_list, Column<uint32_t>& generation, Column<uint8_t>& flags,
+                        std::vector<uint8_t>& dirty) {
+  uint32_t slot;
+  if (!free_list.empty()) {
+    slot = free_list[free_list.size() - 1];
+    free_list.pop_back();
+    flags.set(slot, kAlive);
+  } else {
+    slot = static_cast<uint32_t>(flags.size());
+    generation.push_back(0);
+    flags.push_back(kAlive);
+  }
+  mark(dirty, slot);
+  return slot;
+}
+
+void Mesh::release(uint32_t slot, Column<uint32_t>& free_list, Column<uint32_t>& generation, Column<uint8_t>& flags,
+                   std::vector<uint8_t>& dirty) {
+  flags.set(slot, 0);
+  generation.set(slot, generation[slot] + 1);
+  free_list.push_back(slot);
+  mark(dirty, slot);
+}
+
+uint32_t Mesh::add_vertex(const Vec3& p, uint8_t extra_flags) {
+  bool fresh = vertices.free_list.empty();
+  uint32_t v = allocate(vertices.free_list, vertices.generation, vertices.flags, vertices.dirty);
+  if (fresh) {
+    vertices.position.push_back(p);
+    vertices.first_edge.push_back(kNone);
+  } else {
+    vertices.position.set(v, p);
+    vertices.first_edge.set(v, kNone);
+  }
+  vertices.flags.set(v, static_cast<uint8_t>(kAlive | extra_flags));
+  return v;
+}
+
+void Mesh::link_edge(uint32_t e) {
+  auto next = edges.next[e];
+  for (int s = 0; s < 2; ++s) {
+    uint32_t v = edges.vertex[e][s];
+    next[s] = vertices.first_edge[v];
+    vertices.first_edge.set(v, e);
+    mark(vertices.dirty, v);
+  }
+  edges.next.set(e, next);
+}
+
+void Mesh::unlink_edge(uint32_t e) {
+  for (int s = 0; s < 2; ++s) {
+    uint32_t v = edges.vertex[e][s];
+    mark(vertices.dirty, v);
+    uint32_t after = edges.next[e][s];
+    if (vertices.first_edge[v] == e) {
+      vertices.first_edge.set(v, after);
+      continue;
+    }
+    for (uint32_t x = vertices.first_edge[v]; x != kNone;) {
+      int xs = edges.vertex[x][0] == v ? 0 : 1;
+      if (edges.next[x][xs] == e) {
+        auto n = edges.next[x];
+        n[xs] = after;
+        edges.next.set(x, n);
+        break;
+      }
+      x = edges.next[x][xs];
+    }
+  }
+}
+
+uint32_t Mesh::add_edge(uint32_t v0, uint32_t v1, std::span<const Vec3> polyline) {
+  bool fresh = edges.free_list.empty();
+  uint32_t e = allocate(edges.free_list, edges.generation, edges.flags, edges.dirty);
+  uint32_t offset = static_cast<uint32_t>(points.size());
+  for (size_t i = 0; i < polyline.size(); ++i) {
+    if (i == 0) points.push_back(vertices.position[v0]);
+    else if (i + 1 == polyline.size()) points.push_back(vertices.position[v1]);
+    else points.push_back(polyline[i]);
+  }
+  uint32_t count = static_cast<uint32_t>(polyline.size());
+  if (fresh) {
+    edges.vertex.push_back({v0, v1});
+    edges.face.push_back(kNoPair);
+    edges.next.push_back(kNoPair);
+    edges.point_offset.push_back(offset);
+    edges.point_count.push_back(count);
+  } else {
+    edges.vertex.set(e, {v0, v1});
+    edges.face.set(e, kNoPair);
+    edges.next.set(e, kNoPair);
+    edges.point_offset.set(e, offset);
+    edges.point_count.set(e, count);
+  }
+  link_edge(e);
+  return e;
+}
+
+uint32_t Mesh::add_face(std::span<const uint32_t> loop) {
+  if (loop.empty()) return kNone;
+  for (size_t k = 0; k < loop.size(); ++k) {
+    uint32_t oe = loop[k];
+    if (!edge_alive(edge_of(oe)) || edges.face[edge_of(oe)][is_reversed(oe)] != kNone) return kNone;
+    if (head(oe) != tail(loop[(k + 1) % loop.size()])) return kNone;
+    for (size_t q = 0; q < k; ++q)
+      if (edge_of(loop[q]) == edge_of(oe)) return kNone;
+  }
+  bool fresh = faces.free_list.empty();
+  uint32_t f = allocate(faces.free_list, faces.generation, faces.flags, faces.dirty);
+  uint32_t offset = static_cast<uint32_t>(face_edges.size());
+  for (uint32_t oe : loop) {
+    face_edges.push_back(oe);
+    auto fs = edges.face[edge_of(oe)];
+    fs[is_reversed(oe)] = f;
+    edges.face.set(edge_of(oe), fs);
+    mark(edges.dirty, edge_of(oe));
+  }
+  if (fresh) {
+    faces.edge_offset.push_back(offset);
+    faces.edge_count.push_back(static_cast<uint32_t>(loop.size()));
+  } else {
+    faces.edge_offset.set(f, offset);
+    faces.edge_count.set(f, static_cast<uint32_t>(loop.size()));
+  }
+  return f;
+}
+
+bool Mesh::set_face_loop(uint32_t f, std::span<const uint32_t> loop) {
+  if (loop.empty()) return false;
+  for (size_t k = 0; k < loop.size(); ++k) {
+    uint32_t oe = loop[k], e = edge_of(oe);
+    uint32_t side = edges.face[e][is_reversed(oe)];
+    if (!edge_alive(e) || (side != kNone && side != f)) return false;
+    if (head(oe) != tail(loop[(k + 1) % loop.size()])) return false;
+    for (size_t q = 0; q < k; ++q)
+      if (edge_of(loop[q]) == e) return false;
+  }
+  for (uint32_t oe : face_loop(f)) {
+    auto fs = edges.face[edge_of(oe)];
+    fs[is_reversed(oe)] = kNone;
+    edges.face.set(edge_of(oe), fs);
+    mark(edges.dirty, edge_of(oe));
+  }
+  faces.edge_offset.set(f, static_cast<uint32_t>(face_edges.size()));
+  faces.edge_count.set(f, static_cast<uint32_t>(loop.size()));
+  for (uint32_t oe : loop) {
+    face_edges.push_back(oe);
+    auto fs = edges.face[edge_of(oe)];
+    fs[is_reversed(oe)] = f;
+    edges.face.set(edge_of(oe), fs);
+    mark(edges.dirty, edge_of(oe));
+  }
+  mark(faces.dirty, f);
+  return true;
+}
+
+void Mesh::remove_face(uint32_t f) {
+  for (uint32_t oe : face_loop(f)) {
+    auto fs = edges.face[edge_of(oe)];
+    fs[is_reversed(oe)] = kNone;
+    edges.face.set(edge_of(oe), fs);
+    mark(edges.dirty, edge_of(oe));
+  }
+  release(f, faces.free_list, faces.generation, faces.flags, faces.dirty);
+}
+
+void Mesh::remove_edge(uint32_t e) {
+  unlink_edge(e);
+  release(e, edges.free_list, edges.generation, edges.flags, edges.dirty);
+}
+
+void Mesh::remove_vertex(uint32_t v) {
+  release(v, vertices.free_list, vertices.generation, vertices.flags, vertices.dirty);
+}
+
+void Mesh::set_edge_flag(uint32_t e, uint8_t flag, bool on) {
+  uint8_t f = edges.flags[e];
+  edges.flags.set(e, static_cast<uint8_t>(on ? (f | flag) : (f & ~flag)));
+  mark(edges.dirty, e);
+}
+
+void Mesh::move_vertex(uint32_t v, const Vec3& p) {
+  vertices.position.set(v, p);
+  mark(vertices.dirty, v);
+  for (uint32_t e : vertex_edges(v)) {
+    uint32_t at = edges.vertex[e][0] == v ? edges.point_offset[e] : edges.point_offset[e] + edges.point_count[e] - 1;
+    points.set(at, p);
+    mark(edges.dirty, e);
+  }
+}
+
+MeshMark Mesh::begin_transaction() {
+  MeshMark m;
+  for_each_column([&](auto& column, std::vector<uint8_t>*) { m.columns.push_back(column.begin()); });
+  return m;
+}
+
+void Mesh::end_transaction() {
+  for_each_column([](auto& column, std::vector<uint8_t>*) { column.end(); });
+}
+
+void Mesh::rollback(const MeshMark& m) {
+  size_t k = 0;
+  for_each_column([&](auto& column, std::vector<uint8_t>* dirty) {
+    column.end();
+    column.rollback(m.columns[k++]);
+    (void)dirty;
+  });
+  // Everything that survived the rollback may have changed: tag it all for consumers to re-read.
+  vertices.dirty.assign(vertex_slots(), 1);
+  edges.dirty.assign(edge_slots(), 1);
+  faces.dirty.assign(face_slots(), 1);
+}
+
+void Mesh::forget_history() {
+  for_each_column([](auto& column, std::vector<uint8_t>*) { column.forget_journal(); });
+}
+
+CompactionMap Mesh::compact() {
+  CompactionMap map;
+  auto build = [](const Column<uint8_t>& flags, std::vector<uint32_t>& m) {
+    m.assign(flags.size(), kNone);
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < flags.size(); ++i)
+      if (flags[i] & kAlive) m[i] = n++;
+    return n;
+  };
+  uint32_t nv = build(vertices.flags, map.vertex);
+  uint32_t ne = build(edges.flags, map.edge);
+  uint32_t nf = build(faces.flags, map.face);
+
+  auto gather = [](const auto& column, const std::vector<uint32_t>& m, uint32_t n) {
+    using T = std::decay_t<decltype(column[0])>;
+    std::vector<T> out(n);
+    for (uint32_t i = 0; i < m.size(); ++i)
+      if (m[i] != kNone) out[m[i]] = column[i];
+    return out;
+  };
+  auto remap = [](uint32_t x, const std::vector<uint32_t>& m) { return x == kNone ? kNone : m[x]; };
+
+  Mesh c;
+  c.vertices.position.assign(gather(vertices.position, map.vertex, nv));
+  // Compaction invalidates every handle (callers remap with the returned map), so generations restart.
+  c.vertices.generation.assign(std::vector<uint32_t>(nv, 0));
+  c.vertices.flags.assign(gather(vertices.flags, map.vertex, nv));
+  c.vertices.first_edge.assign(std::vector<uint32_t>(nv, kNone));
+  c.edges.generation.assign(std::vector<uint32_t>(ne, 0));
+  c.edges.flags.assign(gather(edges.flags, map.edge, ne));
+  c.faces.generation.assign(std::vector<uint32_t>(nf, 0));
+  c.faces.flags.assign(gather(faces.flags, map.face, nf));
+
+  std::vector<std::array<uint32_t, 2>> ev(ne), ef(ne), en(ne, kNoPair);
+  std::vector<uint32_t> po(ne), pc(ne);
+  std::vector<Vec3> pts;
+  pts.reserve(live_point_count());
+  for (uint32_t e = 0; e < edge_slots(); ++e) {
+    uint32_t n = map.edge[e];
+    if (n == kNone) continue;
+    ev[n] = {map.vertex[edges.vertex[e][0]], map.vertex[edges.vertex[e][1]]};
+    ef[n] = {remap(edges.face[e][0], map.face), remap(edges.face[e][1], map.face)};
+    po[n] = static_cast<uint32_t>(pts.size());
+    pc[n] = edges.point_count[e];
+    auto line = polyline(e);
+    pts.insert(pts.end(), line.begin(), line.end());
+  }
+  // Rebuild the vertex-edge lists as adding the edges in order would, so a compacted mesh equals the same
+  // network loaded from a file.
+  std::vector<uint32_t> first(nv, kNone);
+  for (uint32_t e = 0; e < ne; ++e)
+    for (int s = 0; s < 2; ++s) {
+      en[e][s] = first[ev[e][s]];
+      first[ev[e][s]] = e;
+    }
+  c.vertices.first_edge.assign(std::move(first));
+  c.edges.vertex.assign(std::move(ev));
+  c.edges.face.assign(std::move(ef));
+  c.edges.next.assign(std::move(en));
+  c.edges.point_offset.assign(std::move(po));
+  c.edges.point_count.assign(std::move(pc));
+  c.points.assign(std::move(pts));
+
+  std::vector<uint32_t> fo(nf), fc(nf), fe;
+  for (uint32_t f = 0; f < face_slots(); ++f) {
+    uint32_t n = map.face[f];
+    if (n == kNone) continue;
+    fo[n] = static_cast<uint32_t>(fe.size());
+    fc[n] = faces.edge_count[f];
+    for (uint32_t oe : face_loop(f)) fe.push_back(make_oriented(map.edge[edge_of(oe)], is_reversed(oe)));
+  }
+  c.faces.edge_offset.assign(std::move(fo));
+  c.faces.edge_count.assign(std::move(fc));
+  c.face_edges.assign(std::move(fe));
+  c.vertices.dirty.assign(nv, 1);
+  c.edges.dirty.assign(ne, 1);
+  c.faces.dirty.assign(nf, 1);
+  *this = std::move(c);
+  return map;
+}
+
+uint64_t Mesh::hash() const {
+  uint64_t h = 0xcbf29ce484222325ull;
+  auto mix = [&](const void* data, size_t n) {
+    auto* b = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < n; ++i) {
+      h ^= b[i];
+      h *= 0x100000001b3ull;
+    }
+  };
+  for_each_column([&](const auto& column) {
+    uint64_t n = column.size();
+    mix(&n, sizeof n);
+    if (n) mix(column.values().data(), n * sizeof(column[0]));
+  });
+  return h;
+}
+
+bool Mesh::same_pools(const Mesh& other) const {
+  std::vector<std::pair<const void*, size_t>> mine, theirs;
+  for_each_column([&](const auto& c) { mine.emplace_back(c.values().data(), c.size() * sizeof(c[0])); });
+  other.for_each_column([&](const auto& c) { theirs.emplace_back(c.values().data(), c.size() * sizeof(c[0])); });
+  for (size_t k = 0; k < mine.size(); ++k) {
+    if (mine[k].second != theirs[k].second) return false;
+    if (mine[k].second && std::memcmp(mine[k].first, theirs[k].first, mine[k].second) != 0) return false;
+  }
+  return true;
+}
+
+void Mesh::clear_dirty() {
+  std::fill(vertices.dirty.begin(), vertices.dirty.end(), 0);
+  std::fill(edges.dirty.begin(), edges.dirty.end(), 0);
+  std::fill(faces.dirty.begin(), faces.dirty.end(), 0);
+}
+
+size_t Mesh::pool_bytes() const {
+  size_t n = 0;
+  for_each_column([&](const auto& c) { n += c.bytes(); });
+  return n;
+}
+
+size_t Mesh::journal_bytes() const {
+  size_t n = 0;
+  for_each_column([&](const auto& c) { n += c.journal_bytes(); });
+  return n;
+}
+
+}  // namespace fire

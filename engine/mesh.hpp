@@ -1,0 +1,189 @@
+#pragma once
+// The polyline mesh M = (V, E, F, P) of thesis chapter 5, held in structure-of-arrays pools.
+//
+// - Points: every polyline sample of every edge, in one contiguous column. An edge owns the range
+//   [point_offset, point_offset + point_count); its first and last points equal its two vertices.
+// - Faces refer to their edges through one flat column of oriented edges (edge << 1 | reversed),
+//   with a per-face offset and count, in loop order.
+// - E -> 2V; E -> <=2F with face[0] the face that walks the edge from vertex[0] to vertex[1] and face[1]
+//   the one that walks it backwards; V -> E as an intrusive list (first_edge, then next[] per edge end).
+// - Dead elements are tombstones (flag kAlive cleared, generation bumped) on a free list; compact()
+//   squeezes them out and returns old-to-new maps.
+// Every column is journaled: mutations made inside a transaction can be rolled back bit for bit.
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "engine/column.hpp"
+#include "engine/common.hpp"
+
+namespace fire {
+
+inline constexpr uint32_t kNone = 0xFFFFFFFFu;
+
+// A typed reference that outlives a frame: the slot index plus the generation the slot had.
+template <class Tag>
+struct Handle {
+  uint32_t index = kNone;
+  uint32_t generation = 0;
+  bool valid() const { return index != kNone; }
+  friend bool operator==(const Handle&, const Handle&) = default;
+};
+using VertexId = Handle<struct VertexTag>;
+using EdgeId = Handle<struct EdgeTag>;
+using FaceId = Handle<struct FaceTag>;
+
+// An edge as it appears in a face loop.
+inline uint32_t make_oriented(uint32_t edge, bool reversed) { return edge << 1 | (reversed ? 1u : 0u); }
+inline uint32_t edge_of(uint32_t oriented) { return oriented >> 1; }
+inline bool is_reversed(uint32_t oriented) { return oriented & 1u; }
+
+enum ElementFlag : uint8_t {
+  kAlive = 1,
+  kSplitVertex = 2,  // vertex made by splitting an edge: joined again when no curve needs it
+  kSharpEdge = 4,    // crease for subdivision
+};
+
+struct VertexPool {
+  Column<Vec3> position;
+  Column<uint32_t> first_edge;
+  Column<uint32_t> generation;
+  Column<uint8_t> flags;
+  Column<uint32_t> free_list;
+  std::vector<uint8_t> dirty;  // not journaled: undo marks what it restores as dirty
+};
+
+struct EdgePool {
+  Column<std::array<uint32_t, 2>> vertex;
+  Column<std::array<uint32_t, 2>> face;
+  Column<std::array<uint32_t, 2>> next;  // next[s]: next edge in the list of vertex[s]
+  Column<uint32_t> point_offset;
+  Column<uint32_t> point_count;
+  Column<uint32_t> generation;
+  Column<uint8_t> flags;
+  Column<uint32_t> free_list;
+  std::vector<uint8_t> dirty;
+};
+
+struct FacePool {
+  Column<uint32_t> edge_offset;
+  Column<uint32_t> edge_count;
+  Column<uint32_t> generation;
+  Column<uint8_t> flags;
+  Column<uint32_t> free_list;
+  std::vector<uint8_t> dirty;
+};
+
+struct MeshMark;
+
+// Old-to-new slot maps produced by compaction (kNone for removed slots).
+struct CompactionMap {
+  std::vector<uint32_t> vertex, edge, face;
+};
+
+class Mesh {
+ public:
+  VertexPool vertices;
+  EdgePool edges;
+  FacePool faces;
+  Column<Vec3> points;
+  Column<uint32_t> face_edges;
+
+  // ---- reading
+  size_t vertex_slots() const { return vertices.flags.size(); }
+  size_t edge_slots() const { return edges.flags.size(); }
+  size_t face_slots() const { return faces.flags.size(); }
+  bool vertex_alive(uint32_t v) const { return v < vertex_slots() && (vertices.flags[v] & kAlive); }
+  bool edge_alive(uint32_t e) const { return e < edge_slots() && (edges.flags[e] & kAlive); }
+  bool face_alive(uint32_t f) const { return f < face_slots() && (faces.flags[f] & kAlive); }
+  size_t vertex_count() const;
+  size_t edge_count() const;
+  size_t face_count() const;
+  size_t live_point_count() const;  // points owned by live edges (shared ends counted per edge)
+
+  VertexId vertex_id(uint32_t v) const { return {v, vertices.generation[v]}; }
+  EdgeId edge_id(uint32_t e) const { return {e, edges.generation[e]}; }
+  FaceId face_id(uint32_t f) const { return {f, faces.generation[f]}; }
+  bool valid(VertexId h) const { return vertex_alive(h.index) && vertices.generation[h.index] == h.generation; }
+  bool valid(EdgeId h) const { return edge_alive(h.index) && edges.generation[h.index] == h.generation; }
+  bool valid(FaceId h) const { return face_alive(h.index) && faces.generation[h.index] == h.generation; }
+
+  std::span<const Vec3> polyline(uint32_t e) const {
+    return points.span(edges.point_offset[e], edges.point_count[e]);
+  }
+  std::span<const uint32_t> face_loop(uint32_t f) const {
+    return face_edges.span(faces.edge_offset[f], faces.edge_count[f]);
+  }
+  // The vertex an oriented edge starts from / arrives at when its face walks it.
+  uint32_t tail(uint32_t oriented) const { return edges.vertex[edge_of(oriented)][is_reversed(oriented) ? 1 : 0]; }
+  uint32_t head(uint32_t oriented) const { return edges.vertex[edge_of(oriented)][is_reversed(oriented) ? 0 : 1]; }
+  // Edges incident to v (unordered).
+  std::vector<uint32_t> vertex_edges(uint32_t v) const;
+  uint32_t valence(uint32_t v) const;
+  // The other face of an edge, or kNone.
+  uint32_t other_face(uint32_t e, uint32_t f) const {
+    const auto& fs = edges.face[e];
+    return fs[0] == f ? fs[1] : fs[0];
+  }
+  bool is_border_edge(uint32_t e) const { return edges.face[e][0] == kNone || edges.face[e][1] == kNone; }
+  // Index of edge e in f's loop, or kNone.
+  uint32_t loop_position(uint32_t f, uint32_t e) const;
+
+  // ---- primitive mutations (journaled inside a transaction, dirty-tagged always)
+  uint32_t add_vertex(const Vec3& p, uint8_t extra_flags = 0);
+  // The polyline must have at least 2 points; its ends are set to the vertices' positions exactly.
+  uint32_t add_edge(uint32_t v0, uint32_t v1, std::span<const Vec3> polyline);
+  // `loop` is a closed walk of oriented edges. Fails (returns kNone, changes nothing) when an edge's side
+  // is already taken by another face or the walk is not closed.
+  uint32_t add_face(std::span<const uint32_t> loop);
+  // Gives face f a new loop, keeping its slot and handle (used when an edge of f is split or joined).
+  // Returns false and changes nothing when the loop is not closed or an edge side is taken by another face.
+  bool set_face_loop(uint32_t f, std::span<const uint32_t> loop);
+  void remove_face(uint32_t f);
+  void remove_edge(uint32_t e);    // the edge must have no faces
+  void remove_vertex(uint32_t v);  // the vertex must have no edges
+  void set_edge_flag(uint32_t e, uint8_t flag, bool on);
+  // Moves a vertex and the matching end of every incident polyline.
+  void move_vertex(uint32_t v, const Vec3& p);
+
+  // ---- transactions
+  MeshMark begin_transaction();
+  void end_transaction();
+  // Restores the pools to `mark` (the most recent transaction not rolled back yet).
+  void rollback(const MeshMark& mark);
+  void forget_history();
+
+  // ---- sync point
+  CompactionMap compact();
+
+  // ---- comparison, hashing, dirty tags
+  // FNV-1a 64 over every pool column (sizes and bytes); dirty tags and journals excluded.
+  uint64_t hash() const;
+  bool same_pools(const Mesh& other) const;
+  void clear_dirty();
+  size_t pool_bytes() const;     // bytes held by the pools' arrays
+  size_t journal_bytes() const;  // bytes held by the undo journals
+
+  // ---- invariants (thesis 5.1 plus pool consistency); empty string when valid
+  std::string validate() const;
+
+ private:
+  template <class F>
+  void for_each_column(F&& f);
+  template <class F>
+  void for_each_column(F&& f) const;
+  uint32_t allocate(Column<uint32_t>& free_list, Column<uint32_t>& generation, Column<uint8_t>& flags,
+                    std::vector<uint8_t>& dirty);
+  void release(uint32_t slot, Column<uint32_t>& free_list, Column<uint32_t>& generation, Column<uint8_t>& flags,
+               std::vector<uint8_t>& dirty);
+  void link_edge(uint32_t e);
+  void unlink_edge(uint32_t e);
+};
+
+struct MeshMark {
+  std::vector<ColumnMark> columns;
+};
+
+}  // namespace fire

@@ -1,0 +1,176 @@
+#include "systems/sketch/sketch.hpp"
+
+#include <limits>
+
+namespace fire {
+
+namespace {
+
+struct Nearest {
+  CurveEnd end;
+  double distance = std::numeric_limits<double>::infinity();
+};
+
+// Nearest polyline point on face f's boundary; on ties the earlier point wins, so vertices (point 0) win.
+Nearest nearest_on_face(const Mesh& m, uint32_t f, const Vec3& p) {
+  Nearest best;
+  for (uint32_t oe : m.face_loop(f)) {
+    uint32_t e = edge_of(oe);
+    auto line = m.polyline(e);
+    for (uint32_t k = 0; k < line.size(); ++k) {
+      double d = (line[k] - p).norm();
+      if (d < best.distance) best = {{e, k}, d};
+    }
+  }
+  return best;
+}
+
+bool border_open(const Mesh& m) { return m.edge_count() > 0 && m.face_count() == 0; }
+
+// The open border's first and last vertices (the first is the start of the first edge drawn).
+std::pair<uint32_t, uint32_t> border_ends(const Mesh& m) {
+  uint32_t first = kNone, last = kNone;
+  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+    if (!m.edge_alive(e)) continue;
+    if (m.valence(m.edges.vertex[e][0]) == 1) first = m.edges.vertex[e][0];
+    if (m.valence(m.edges.vertex[e][1]) == 1) last = m.edges.vertex[e][1];
+  }
+  return {first, last};
+}
+
+}  // namespace
+
+Snap snap_to_face(const Mesh& m, const Vec3& start, const Vec3& end, double limit) {
+  Snap best;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (uint32_t f = 0; f < m.face_slots(); ++f) {
+    if (!m.face_alive(f)) continue;
+    Nearest a = nearest_on_face(m, f, start), b = nearest_on_face(m, f, end);
+    if (a.distance > limit || b.distance > limit) continue;
+    double cost = a.distance + b.distance;
+    if (cost < best_cost) {
+      best_cost = cost;
+      best = {f, a.end, b.end, a.distance, b.distance};
+    }
+  }
+  return best;
+}
+
+uint32_t pick_edge(const Mesh& m, const Vec3& p, double limit) {
+  uint32_t best = kNone;
+  double best_d = limit;
+  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+    if (!m.edge_alive(e)) continue;
+    for (const Vec3& q : m.polyline(e)) {
+      double d = (q - p).norm();
+      if (d <= best_d && (best == kNone || d < best_d)) {
+        best_d = d;
+        best = e;
+      }
+    }
+  }
+  return best;
+}
+
+void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh, const SketchSettings& settings,
+                   SketchState& state, std::vector<EditRequest>& requests, std::vector<Rejection>& rejections) {
+  requests.clear();
+  // At most one request per frame, so every request is placed on the mesh as the previous one left it;
+  // events after it wait in `pending` for the next frame.
+  std::vector<InputEvent> events = std::move(state.pending);
+  state.pending.clear();
+  events.insert(events.end(), frame_events.begin(), frame_events.end());
+  for (size_t i = 0; i < events.size(); ++i) {
+    if (!requests.empty()) {
+      state.pending.assign(events.begin() + i, events.end());
+      return;
+    }
+    const InputEvent& ev = events[i];
+    auto reject = [&](std::string why) { rejections.push_back({ev.t_us, ev.line, std::move(why)}); };
+    switch (ev.kind) {
+      case EventKind::Down:
+        if (state.pen_down) reject("pen down while already down: the unfinished stroke is dropped");
+        state.pen_down = true;
+        state.stroke.clear();
+        break;
+      case EventKind::Pen:
+        if (state.pen_down) state.stroke.push_back(ev.p);
+        break;
+      case EventKind::Up: {
+        if (!state.pen_down) {
+          reject("pen up without pen down");
+          break;
+        }
+        state.pen_down = false;
+        EditRequest r{RequestKind::Edit, {}, ev.t_us, ev.line};
+        r.command.points = std::move(state.stroke);
+        state.stroke.clear();
+        bool finite = r.command.points.size() >= 2;
+        for (const Vec3& p : r.command.points) finite = finite && is_finite(p);
+        if (!finite) {
+          // Let the edit say why (too few points, NaN): one place words the rule.
+          r.command.kind = mesh.edge_count() == 0 ? EditKind::StartBorder : EditKind::AppendBorder;
+          requests.push_back(std::move(r));
+          break;
+        }
+        if (mesh.edge_count() == 0) {
+          r.command.kind = EditKind::StartBorder;
+        } else if (border_open(mesh)) {
+          auto [first, last] = border_ends(mesh);
+          (void)last;
+          double gap = (r.command.points.back() - mesh.vertices.position[first]).norm();
+          r.command.kind = gap <= settings.snap_distance ? EditKind::CloseBorder : EditKind::AppendBorder;
+          r.command.snap_distance = settings.snap_distance;
+        } else {
+          Snap s = snap_to_face(mesh, r.command.points.front(), r.command.points.back(), settings.snap_distance);
+          if (s.face == kNone) {
+            reject("the stroke does not start and end on the boundary of one face (no face has both ends within " +
+                   std::to_string(settings.snap_distance) + ")");
+            break;
+          }
+          r.command.kind = EditKind::SplitFace;
+          r.command.face = s.face;
+          r.command.start = s.start;
+          r.command.end = s.end;
+        }
+        requests.push_back(std::move(r));
+        break;
+      }
+      case EventKind::Command: {
+        EditRequest r{RequestKind::Edit, {}, ev.t_us, ev.line};
+        if (ev.command == CommandKind::Undo) r.kind = RequestKind::Undo;
+        else if (ev.command == CommandKind::Redo) r.kind = RequestKind::Redo;
+        else if (ev.command == CommandKind::Close) {
+          if (!border_open(mesh)) {
+            reject("close: there is no open border polygon");
+            break;
+          }
+          auto [first, last] = border_ends(mesh);
+          const Vec3 a = mesh.vertices.position[last], b = mesh.vertices.position[first];
+          for (uint32_t k = 0; k < settings.close_samples; ++k) {
+            double s = double(k) / double(settings.close_samples - 1);
+            r.command.points.push_back(a + s * (b - a));
+          }
+          r.command.kind = EditKind::CloseBorder;
+          r.command.snap_distance = settings.snap_distance;
+        } else {
+          uint32_t e = pick_edge(mesh, ev.p, settings.snap_distance);
+          if (e == kNone) {
+            reject("delete: no curve within " + std::to_string(settings.snap_distance) + " of the picked point");
+            break;
+          }
+          r.command.kind = EditKind::DeleteCurve;
+          r.command.edge = e;
+        }
+        requests.push_back(std::move(r));
+        break;
+      }
+      case EventKind::Hid:
+      case EventKind::Truth:
+      case EventKind::Meta:
+        break;  // device reports are the triangulate system's; truth and meta are not for replay
+    }
+  }
+}
+
+}  // namespace fire

@@ -1,0 +1,43 @@
+#pragma once
+// The sketch system: turns pen strokes and user commands into edit requests (thesis 5.4 and 5.5).
+// A stroke is the pen samples between `down` and `up`. Its ends are snapped to the nearest polyline
+// point of a face that holds both ends (exhaustive search, thesis 5.5.1); strokes that cannot be
+// placed are rejected with a reason, and nothing already drawn changes.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "engine/input_log.hpp"
+#include "engine/mesh.hpp"
+#include "engine/edit_command.hpp"
+
+namespace fire {
+
+struct SketchSettings {
+  double snap_distance = 0.01;  // how far a stroke end may be from the polyline it snaps to (model units)
+  uint32_t close_samples = 16;  // points on the straight edge made by `cmd close`
+};
+
+struct SketchState {
+  bool pen_down = false;
+  std::vector<Vec3> stroke;
+  std::vector<InputEvent> pending;  // events after this frame's request, handled next frame
+};
+
+// Where a stroke end lands: the face, and the polyline point on that face's boundary.
+struct Snap {
+  uint32_t face = kNone;
+  CurveEnd start, end;
+  double start_distance = 0, end_distance = 0;
+};
+
+// The face whose boundary passes closest to both points (sum of distances), each within `limit`.
+Snap snap_to_face(const Mesh& mesh, const Vec3& start, const Vec3& end, double limit);
+// The live edge with a polyline point nearest to p within `limit`, or kNone.
+uint32_t pick_edge(const Mesh& mesh, const Vec3& p, double limit);
+
+// Emits at most one request per frame (see `pending`).
+void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh, const SketchSettings& settings,
+                   SketchState& state, std::vector<EditRequest>& requests, std::vector<Rejection>& rejections);
+
+}  // namespace fire

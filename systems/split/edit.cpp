@@ -1,0 +1,297 @@
+#include "systems/split/edit.hpp"
+
+#include <algorithm>
+
+namespace fire {
+
+namespace {
+
+std::string str(uint32_t x) { return std::to_string(x); }
+
+EditOutcome check_points(const std::vector<Vec3>& points) {
+  if (points.size() < 2) return EditOutcome::reject("a curve needs at least 2 points, got " + str(uint32_t(points.size())));
+  for (size_t i = 0; i < points.size(); ++i)
+    if (!is_finite(points[i])) return EditOutcome::reject("curve point " + str(uint32_t(i)) + " is not finite (NaN or infinity)");
+  return EditOutcome::success();
+}
+
+bool has_faces(const Mesh& m) { return m.face_count() > 0; }
+
+// The open border chain, in drawing order: its first and last vertices and its edges.
+struct BorderChain {
+  uint32_t first = kNone, last = kNone;
+  std::vector<uint32_t> edges;
+};
+
+BorderChain open_border(const Mesh& m) {
+  BorderChain chain;
+  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e) && m.valence(m.edges.vertex[e][0]) == 1) chain.first = m.edges.vertex[e][0];
+  if (chain.first == kNone) return chain;
+  uint32_t v = chain.first, came = kNone;
+  for (;;) {
+    uint32_t next = kNone;
+    for (uint32_t e : m.vertex_edges(v))
+      if (e != came && m.edges.vertex[e][0] == v) next = e;
+    if (next == kNone) break;
+    chain.edges.push_back(next);
+    came = next;
+    v = m.edges.vertex[next][1];
+  }
+  chain.last = v;
+  return chain;
+}
+
+EditOutcome start_border(Mesh& m, const EditCommand& c) {
+  if (m.edge_count() > 0) return EditOutcome::reject("a border polygon already exists");
+  if (auto ok = check_points(c.points); !ok.ok) return ok;
+  if (c.points.front() == c.points.back()) return EditOutcome::reject("the first border curve ends where it starts");
+  uint32_t a = m.add_vertex(c.points.front());
+  uint32_t b = m.add_vertex(c.points.back());
+  m.add_edge(a, b, c.points);
+  return EditOutcome::success();
+}
+
+EditOutcome append_border(Mesh& m, const EditCommand& c) {
+  if (has_faces(m)) return EditOutcome::reject("the border polygon is already closed");
+  if (m.edge_count() == 0) return EditOutcome::reject("no border polygon has been started");
+  if (auto ok = check_points(c.points); !ok.ok) return ok;
+  BorderChain chain = open_border(m);
+  if (c.points.back() == m.vertices.position[chain.last])
+    return EditOutcome::reject("the border curve ends where it starts (at the last border vertex)");
+  for (uint32_t v = 0; v < m.vertex_slots(); ++v)
+    if (m.vertex_alive(v) && m.vertices.position[v] == c.points.back())
+      return EditOutcome::reject("the border curve ends on existing vertex " + str(v) + "; close the border instead");
+  uint32_t b = m.add_vertex(c.points.back());
+  m.add_edge(chain.last, b, c.points);
+  return EditOutcome::success();
+}
+
+EditOutcome close_border(Mesh& m, const EditCommand& c) {
+  if (has_faces(m)) return EditOutcome::reject("the border polygon is already closed");
+  if (m.edge_count() == 0) return EditOutcome::reject("no border polygon has been started");
+  if (auto ok = check_points(c.points); !ok.ok) return ok;
+  BorderChain chain = open_border(m);
+  double gap = (c.points.back() - m.vertices.position[chain.first]).norm();
+  if (!(gap <= c.snap_distance))
+    return EditOutcome::reject("the closing curve ends " + std::to_string(gap) + " from the first border vertex, farther than the snap distance " + std::to_string(c.snap_distance));
+  uint32_t e = m.add_edge(chain.last, chain.first, c.points);
+  std::vector<uint32_t> loop;
+  for (uint32_t x : chain.edges) loop.push_back(make_oriented(x, false));
+  loop.push_back(make_oriented(e, false));
+  if (m.add_face(loop) == kNone) return EditOutcome::reject("internal: the border does not form a closed loop");
+  return EditOutcome::success();
+}
+
+// Replaces the oriented edge `old` in f's loop by `with` (already oriented in f's walking direction).
+void replace_in_loop(Mesh& m, uint32_t f, uint32_t old_edge, const std::vector<uint32_t>& with) {
+  std::vector<uint32_t> loop;
+  for (uint32_t oe : m.face_loop(f)) {
+    if (edge_of(oe) == old_edge) loop.insert(loop.end(), with.begin(), with.end());
+    else loop.push_back(oe);
+  }
+  m.set_face_loop(f, loop);
+}
+
+// Resolves a curve end to a vertex of face f, or reports why it cannot be used.
+struct ResolvedEnd {
+  uint32_t vertex = kNone;  // the end is this vertex
+  uint32_t edge = kNone;    // or an interior point of this edge
+  uint32_t point = 0;
+};
+
+EditOutcome resolve_end(const Mesh& m, uint32_t f, const CurveEnd& end, const char* which, ResolvedEnd& out) {
+  if (!m.edge_alive(end.edge)) return EditOutcome::reject(std::string("the curve's ") + which + " names edge " + str(end.edge) + ", which does not exist");
+  if (m.loop_position(f, end.edge) == kNone)
+    return EditOutcome::reject(std::string("the curve's ") + which + " lies on edge " + str(end.edge) + ", which is not on face " + str(f) + ": a curve must start and end on the same face");
+  uint32_t count = m.edges.point_count[end.edge];
+  if (end.point >= count) return EditOutcome::reject(std::string("the curve's ") + which + " names point " + str(end.point) + " of edge " + str(end.edge) + ", which has " + str(count));
+  out = {};
+  if (end.point == 0) out.vertex = m.edges.vertex[end.edge][0];
+  else if (end.point == count - 1) out.vertex = m.edges.vertex[end.edge][1];
+  else {
+    out.edge = end.edge;
+    out.point = end.point;
+  }
+  return EditOutcome::success();
+}
+
+EditOutcome split_face(Mesh& m, const EditCommand& c) {
+  if (!has_faces(m)) return EditOutcome::reject("close the border polygon before splitting faces");
+  if (!m.face_alive(c.face)) return EditOutcome::reject("face " + str(c.face) + " does not exist");
+  if (auto ok = check_points(c.points); !ok.ok) return ok;
+  ResolvedEnd a, b;
+  if (auto ok = resolve_end(m, c.face, c.start, "start", a); !ok.ok) return ok;
+  if (auto ok = resolve_end(m, c.face, c.end, "end", b); !ok.ok) return ok;
+  if (a.vertex != kNone && a.vertex == b.vertex)
+    return EditOutcome::reject("the curve starts and ends on vertex " + str(a.vertex) + ": it would make a face with fewer than 2 edges");
+  if (a.edge != kNone && a.edge == b.edge)
+    return EditOutcome::reject("the curve starts and ends on the same edge " + str(a.edge) + ": it must join two different edges of the face");
+
+  // Steps 1-2 of thesis 5.4.2: split the edges the curve ends on; faces on both sides are updated.
+  uint32_t va = a.vertex != kNone ? a.vertex : split_edge(m, a.edge, a.point);
+  uint32_t vb = b.vertex != kNone ? b.vertex : split_edge(m, b.edge, b.point);
+
+  // Steps 3-6: the new edge, and the face replaced by the two loops on either side of it.
+  std::vector<uint32_t> loop(m.face_loop(c.face).begin(), m.face_loop(c.face).end());
+  uint32_t n = static_cast<uint32_t>(loop.size()), i = kNone, j = kNone;
+  for (uint32_t k = 0; k < n; ++k) {
+    if (m.tail(loop[k]) == va) i = k;
+    if (m.tail(loop[k]) == vb) j = k;
+  }
+  uint32_t e = m.add_edge(va, vb, c.points);
+  std::vector<uint32_t> first, second;
+  for (uint32_t k = i; k != j; k = (k + 1) % n) first.push_back(loop[k]);
+  first.push_back(make_oriented(e, true));
+  for (uint32_t k = j; k != i; k = (k + 1) % n) second.push_back(loop[k]);
+  second.push_back(make_oriented(e, false));
+  m.set_face_loop(c.face, first);
+  m.add_face(second);
+  return EditOutcome::success();
+}
+
+// Joins the two edges at a split vertex that no curve needs any more (valence 2), undoing an edge split.
+void join_at(Mesh& m, uint32_t v) {
+  if (!m.vertex_alive(v) || !(m.vertices.flags[v] & kSplitVertex) || m.valence(v) != 2) return;
+  auto incident = m.vertex_edges(v);
+  uint32_t a = incident[0], b = incident[1];
+  uint32_t u = m.edges.vertex[a][0] == v ? m.edges.vertex[a][1] : m.edges.vertex[a][0];
+  uint32_t w = m.edges.vertex[b][0] == v ? m.edges.vertex[b][1] : m.edges.vertex[b][0];
+  if (u == w) return;  // joining would make an edge from a vertex to itself
+  std::vector<Vec3> line;
+  auto pa = m.polyline(a);
+  if (m.edges.vertex[a][1] == v) line.assign(pa.begin(), pa.end());
+  else line.assign(pa.rbegin(), pa.rend());
+  auto pb = m.polyline(b);
+  if (m.edges.vertex[b][0] == v) line.insert(line.end(), pb.begin() + 1, pb.end());
+  else line.insert(line.end(), pb.rbegin() + 1, pb.rend());
+  const auto faces_of_a = m.edges.face[a];
+  const bool sharp = (m.edges.flags[a] & kSharpEdge) && (m.edges.flags[b] & kSharpEdge);
+  uint32_t c = m.add_edge(u, w, line);
+  if (sharp) m.set_edge_flag(c, kSharpEdge, true);
+  for (uint32_t f : faces_of_a) {
+    if (f == kNone) continue;
+    std::vector<uint32_t> loop;
+    auto old = m.face_loop(f);
+    // The face walks u -> v -> w (forward c) or w -> v -> u (reversed c); drop b, put c where a was.
+    for (uint32_t oe : old) {
+      uint32_t x = edge_of(oe);
+      if (x == b) continue;
+      if (x == a) loop.push_back(make_oriented(c, m.head(oe) == u));
+      else loop.push_back(oe);
+    }
+    m.set_face_loop(f, loop);
+  }
+  m.remove_edge(a);
+  m.remove_edge(b);
+  m.remove_vertex(v);
+}
+
+EditOutcome delete_curve(Mesh& m, const EditCommand& c) {
+  uint32_t e = c.edge;
+  if (!m.edge_alive(e)) return EditOutcome::reject("edge " + str(e) + " does not exist");
+  if (!has_faces(m)) return EditOutcome::reject("curves can be deleted once the border polygon is closed");
+  uint32_t f0 = m.edges.face[e][0], f1 = m.edges.face[e][1];
+  if (f0 == kNone || f1 == kNone) return EditOutcome::reject("edge " + str(e) + " is on the border polygon; only curves inside it can be deleted");
+  // The merged face walks f0 after e, then f1 after e: it must stay a simple loop.
+  std::vector<uint32_t> merged;
+  auto append_after = [&](uint32_t f) {
+    auto loop = m.face_loop(f);
+    uint32_t at = m.loop_position(f, e), n = static_cast<uint32_t>(loop.size());
+    for (uint32_t k = 1; k < n; ++k) merged.push_back(loop[(at + k) % n]);
+  };
+  append_after(f0);
+  append_after(f1);
+  std::vector<uint32_t> seen_edges, seen_vertices;
+  for (uint32_t oe : merged) {
+    seen_edges.push_back(edge_of(oe));
+    seen_vertices.push_back(m.tail(oe));
+  }
+  std::sort(seen_edges.begin(), seen_edges.end());
+  if (std::adjacent_find(seen_edges.begin(), seen_edges.end()) != seen_edges.end())
+    return EditOutcome::reject("faces " + str(f0) + " and " + str(f1) + " share another edge besides " + str(e) + "; deleting it would make a face that touches itself");
+  std::sort(seen_vertices.begin(), seen_vertices.end());
+  if (std::adjacent_find(seen_vertices.begin(), seen_vertices.end()) != seen_vertices.end())
+    return EditOutcome::reject("faces " + str(f0) + " and " + str(f1) + " also meet at a vertex; deleting edge " + str(e) + " would pinch the merged face");
+  if (merged.size() < 2) return EditOutcome::reject("deleting edge " + str(e) + " would leave a face with fewer than 2 edges");
+  const auto ends = m.edges.vertex[e];
+  m.remove_face(f1);
+  m.set_face_loop(f0, merged);
+  m.remove_edge(e);
+  join_at(m, ends[0]);
+  join_at(m, ends[1]);
+  return EditOutcome::success();
+}
+
+}  // namespace
+
+uint32_t split_edge(Mesh& m, uint32_t e, uint32_t point) {
+  auto line = m.polyline(e);
+  std::vector<Vec3> first(line.begin(), line.begin() + point + 1);
+  std::vector<Vec3> second(line.begin() + point, line.end());
+  const auto ends = m.edges.vertex[e];
+  const auto sides = m.edges.face[e];
+  const bool sharp = m.edges.flags[e] & kSharpEdge;
+  uint32_t v = m.add_vertex(first.back(), kSplitVertex);
+  uint32_t ea = m.add_edge(ends[0], v, first);
+  uint32_t eb = m.add_edge(v, ends[1], second);
+  if (sharp) {
+    m.set_edge_flag(ea, kSharpEdge, true);
+    m.set_edge_flag(eb, kSharpEdge, true);
+  }
+  if (sides[0] != kNone) replace_in_loop(m, sides[0], e, {make_oriented(ea, false), make_oriented(eb, false)});
+  if (sides[1] != kNone) replace_in_loop(m, sides[1], e, {make_oriented(eb, true), make_oriented(ea, true)});
+  m.remove_edge(e);
+  return v;
+}
+
+EditOutcome execute_edit(Mesh& mesh, const EditCommand& c) {
+  switch (c.kind) {
+    case EditKind::StartBorder: return start_border(mesh, c);
+    case EditKind::AppendBorder: return append_border(mesh, c);
+    case EditKind::CloseBorder: return close_border(mesh, c);
+    case EditKind::SplitFace: return split_face(mesh, c);
+    case EditKind::DeleteCurve: return delete_curve(mesh, c);
+  }
+  return EditOutcome::reject("unknown edit command");
+}
+
+EditOutcome EditHistory::run(Mesh& mesh, const EditCommand& command) {
+  MeshMark mark = mesh.begin_transaction();
+  EditOutcome outcome = execute_edit(mesh, command);
+  mesh.end_transaction();
+  if (outcome.ok) undo_.push_back({command, std::move(mark)});
+  else mesh.rollback(mark);  // commands check before they write, so this only guards against surprises
+  return outcome;
+}
+
+EditOutcome EditHistory::apply(Mesh& mesh, const EditCommand& command) {
+  EditOutcome outcome = run(mesh, command);
+  if (outcome.ok) redo_.clear();
+  return outcome;
+}
+
+EditOutcome EditHistory::undo(Mesh& mesh) {
+  if (undo_.empty()) return EditOutcome::reject("nothing to undo");
+  mesh.rollback(undo_.back().mark);
+  redo_.push_back(std::move(undo_.back().command));
+  undo_.pop_back();
+  return EditOutcome::success();
+}
+
+EditOutcome EditHistory::redo(Mesh& mesh) {
+  if (redo_.empty()) return EditOutcome::reject("nothing to redo");
+  EditCommand command = std::move(redo_.back());
+  redo_.pop_back();
+  EditOutcome outcome = run(mesh, command);
+  if (!outcome.ok) redo_.push_back(std::move(command));
+  return outcome;
+}
+
+void EditHistory::clear(Mesh& mesh) {
+  undo_.clear();
+  redo_.clear();
+  mesh.forget_history();
+}
+
+}  // namespace fire

@@ -1,0 +1,47 @@
+#pragma once
+// The editing operations a person performs while drawing (thesis 5.4): the border polygon, face
+// splitting by a new curve, deleting a curve, and undo/redo of all of them.
+//
+// Every operation checks its whole input before it changes anything: a rejected command leaves the
+// pools exactly as they were and says why.
+#include <vector>
+
+#include "engine/edit_command.hpp"
+#include "engine/mesh.hpp"
+
+namespace fire {
+
+// Runs one command on the mesh (no history). Border rules: StartBorder needs an empty mesh;
+// AppendBorder starts the new edge at the last vertex of the open border (its first point is moved
+// there, as thesis 5.4.1 prescribes); CloseBorder adds the last edge, whose last point must lie within
+// snap_distance of the first vertex, and creates the first face. SplitFace and DeleteCurve need a
+// closed border.
+EditOutcome execute_edit(Mesh& mesh, const EditCommand& command);
+
+// Splits edge e at interior polyline point `point` (0 < point < count-1): a new vertex and two edges
+// replace e in every face that uses it. Returns the new vertex. Exposed for tools and tests.
+uint32_t split_edge(Mesh& mesh, uint32_t e, uint32_t point);
+
+// Undo by journal rollback (bit-identical pools); redo by running the command again, which is
+// deterministic from the restored state.
+class EditHistory {
+ public:
+  EditOutcome apply(Mesh& mesh, const EditCommand& command);
+  EditOutcome undo(Mesh& mesh);
+  EditOutcome redo(Mesh& mesh);
+  size_t undo_depth() const { return undo_.size(); }
+  size_t redo_depth() const { return redo_.size(); }
+  // Forgets everything (needed after Mesh::compact, which cannot be undone).
+  void clear(Mesh& mesh);
+
+ private:
+  EditOutcome run(Mesh& mesh, const EditCommand& command);
+  struct Entry {
+    EditCommand command;
+    MeshMark mark;
+  };
+  std::vector<Entry> undo_;
+  std::vector<EditCommand> redo_;
+};
+
+}  // namespace fire

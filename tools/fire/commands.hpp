@@ -1,0 +1,16 @@
+#pragma once
+// Each area adds its subcommands to the CLI11 app; a subcommand's callback stores its exit code.
+#include <CLI/CLI.hpp>
+
+namespace fire::cli {
+
+struct Registry {
+  int exit_code = 0;
+};
+
+// network-from-mesh, export-network, replay (engine foundation)
+void add_network_commands(CLI::App& app, Registry& registry);
+// network-from-mesh (synthetic curve networks, systems/synth)
+void add_synth_commands(CLI::App& app, Registry& registry);
+
+}  // namespace fire::cli
