@@ -105,12 +105,14 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
         EditRequest r{RequestKind::Edit, {}, ev.t_us, ev.line};
         r.command.points = std::move(state.stroke);
         state.stroke.clear();
-        bool finite = r.command.points.size() >= 2;
+        if (r.command.points.size() < 2) {
+          reject("the stroke has " + std::to_string(r.command.points.size()) + " pen sample(s); a curve needs at least 2");
+          break;
+        }
+        bool finite = true;
         for (const Vec3& p : r.command.points) finite = finite && is_finite(p);
         if (!finite) {
-          // Let the edit say why (too few points, NaN): one place words the rule.
-          r.command.kind = mesh.edge_count() == 0 ? EditKind::StartBorder : EditKind::AppendBorder;
-          requests.push_back(std::move(r));
+          reject("the stroke has a pen sample that is not finite (NaN or infinity)");
           break;
         }
         if (mesh.edge_count() == 0) {

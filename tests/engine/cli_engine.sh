@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# The engine's commands as a user runs them: help, replay hashes, and bad files.
+set -u
+fire="$1"; src="$2"
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+fail=0
+check() { if eval "$2"; then echo "ok: $1"; else echo "FAILED: $1"; fail=1; fi; }
+# expect_error NAME PATTERN CMD...: non-zero exit, stderr matching PATTERN
+expect_error() {
+  local name="$1" pattern="$2"; shift 2
+  "$@" >"$tmp/out" 2>"$tmp/err"; local rc=$?
+  if [ $rc -ne 0 ] && grep -q -- "$pattern" "$tmp/err"; then echo "ok: $name"; else
+    echo "FAILED: $name (exit $rc)"; cat "$tmp/err"; fail=1; fi
+}
+
+check "fire --help" "'$fire' --help | grep -q replay"
+check "replay --help lists --hash" "'$fire' replay --help | grep -q -- --hash"
+check "export-network --help" "'$fire' export-network --help | grep -q OBJ"
+h1=$("$fire" replay "$src/tools/demo/sketch.log" --hash 2>/dev/null)
+h2=$("$fire" replay "$src/tools/demo/sketch.log" --hash 2>/dev/null)
+check "replay hash is stable ($h1)" "[ -n '$h1' ] && [ '$h1' = '$h2' ]"
+check "replay writes the network" "'$fire' replay '$src/tools/demo/sketch.log' -o '$tmp/demo.fnet' 2>/dev/null && [ -s '$tmp/demo.fnet' ]"
+check "export-network writes one l per edge" "'$fire' export-network '$tmp/demo.fnet' -o '$tmp/demo.obj' && [ \$(grep -c '^l ' '$tmp/demo.obj') -eq 33 ]"
+
+printf 'FIRE-LOG 1\n0 down\n10 pen 1 2' >"$tmp/trunc.log"
+expect_error "truncated log" "trunc.log:3: truncated" "$fire" replay "$tmp/trunc.log"
+printf 'FIRE-LOG 9\n' >"$tmp/v9.log"
+expect_error "unknown log version" "unknown input log version '9'" "$fire" replay "$tmp/v9.log"
+expect_error "missing log" "cannot open" "$fire" replay "$tmp/nope.log"
+head -c 300 "$tmp/demo.fnet" >"$tmp/trunc.fnet"
+expect_error "truncated network" "trunc.fnet: not valid JSON" "$fire" export-network "$tmp/trunc.fnet" -o "$tmp/x.obj"
+sed 's/"version":1/"version":3/' "$tmp/demo.fnet" >"$tmp/v3.fnet"
+expect_error "network version" "unsupported network version 3" "$fire" export-network "$tmp/v3.fnet" -o "$tmp/x.obj"
+: >"$tmp/empty.fnet"
+expect_error "empty network" "empty file" "$fire" export-network "$tmp/empty.fnet" -o "$tmp/x.obj"
+check "no partial output after errors" "[ ! -e '$tmp/x.obj' ]"
+expect_error "unwritable output" "cannot write" "$fire" export-network "$tmp/demo.fnet" -o "$tmp/no/such/dir/x.obj"
+expect_error "unknown subcommand" "" "$fire" frobnicate
+exit $fail

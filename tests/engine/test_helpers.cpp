@@ -1,0 +1,69 @@
+#include "test_helpers.hpp"
+
+#include <algorithm>
+
+#include <catch2/catch.hpp>
+
+namespace fire::test {
+
+std::vector<Vec3> line(const Vec3& a, const Vec3& b, int n) {
+  std::vector<Vec3> out;
+  for (int i = 0; i < n; ++i) out.push_back(a + (b - a) * (double(i) / (n - 1)));
+  return out;
+}
+
+Mesh square(EditHistory* history) {
+  Mesh m;
+  const Vec3 c[4] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  auto run = [&](EditCommand cmd) {
+    EditOutcome r = history ? history->apply(m, cmd) : execute_edit(m, cmd);
+    REQUIRE(r.ok);
+    REQUIRE(m.validate() == "");
+  };
+  run(make(EditKind::StartBorder, line(c[0], c[1])));
+  run(make(EditKind::AppendBorder, line(c[1], c[2])));
+  run(make(EditKind::AppendBorder, line(c[2], c[3])));
+  EditCommand close = make(EditKind::CloseBorder, line(c[3], c[0] + Vec3(0.001, 0, 0)));
+  close.snap_distance = 0.01;
+  run(close);
+  return m;
+}
+
+EditCommand make(EditKind kind, std::vector<Vec3> points) {
+  EditCommand c;
+  c.kind = kind;
+  c.points = std::move(points);
+  return c;
+}
+
+EditCommand remove(uint32_t e) {
+  EditCommand c = make(EditKind::DeleteCurve);
+  c.edge = e;
+  return c;
+}
+
+EditCommand split(uint32_t face, CurveEnd a, CurveEnd b, const std::vector<Vec3>& points) {
+  EditCommand c = make(EditKind::SplitFace, points);
+  c.face = face;
+  c.start = a;
+  c.end = b;
+  return c;
+}
+
+Vec3 at(const Mesh& m, uint32_t e, uint32_t k) { return m.polyline(e)[k]; }
+
+std::vector<uint32_t> face_sizes(const Mesh& m) {
+  std::vector<uint32_t> s;
+  for (uint32_t f = 0; f < m.face_slots(); ++f)
+    if (m.face_alive(f)) s.push_back(m.faces.edge_count[f]);
+  std::sort(s.begin(), s.end());
+  return s;
+}
+
+uint32_t edge_between(const Mesh& m, uint32_t a, uint32_t b) {
+  for (uint32_t e : m.vertex_edges(a))
+    if (m.edges.vertex[e][0] == b || m.edges.vertex[e][1] == b) return e;
+  return kNone;
+}
+
+}  // namespace fire::test

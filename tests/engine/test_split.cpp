@@ -1,0 +1,317 @@
+// Each split case on a hand-made square, with exact counts and incidences; every rejection; delete and
+// the join it triggers; undo/redo returning identical pools.
+#include <algorithm>
+
+#include <catch2/catch.hpp>
+
+#include "test_helpers.hpp"
+
+using namespace fire;
+using namespace fire::test;
+
+namespace {
+
+// Runs `cmd` through a history and checks undo gives back the pools before it, and redo the pools after it.
+void apply_undo_redo(Mesh& m, EditHistory& h, const EditCommand& cmd) {
+  Mesh before = m;
+  REQUIRE(h.apply(m, cmd).ok);
+  REQUIRE(m.validate() == "");
+  Mesh after = m;
+  REQUIRE(h.undo(m).ok);
+  REQUIRE(m.validate() == "");
+  CHECK(m.same_pools(before));
+  CHECK(m.hash() == before.hash());
+  REQUIRE(h.redo(m).ok);
+  CHECK(m.same_pools(after));
+}
+
+size_t border_edges(const Mesh& m) {
+  size_t n = 0;
+  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e) && m.is_border_edge(e)) ++n;
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("border polygon: four strokes and a snapping close make one face", "[split]") {
+  Mesh m = square();
+  CHECK(m.vertex_count() == 4);
+  CHECK(m.edge_count() == 4);
+  CHECK(m.face_count() == 1);
+  CHECK(m.faces.edge_count[0] == 4);
+  CHECK(m.live_point_count() == 20);
+  // The closing stroke ended 1 mm off; its last point is now exactly the first vertex.
+  CHECK(at(m, 3, 4) == Vec3(0, 0, 0));
+  for (uint32_t e = 0; e < 4; ++e) {
+    CHECK(m.edges.face[e][0] == 0);
+    CHECK(m.edges.face[e][1] == kNone);
+  }
+}
+
+TEST_CASE("split edge-edge: two new vertices, four edge halves, one new edge", "[split]") {
+  EditHistory h;
+  Mesh m = square(&h);
+  const EdgeId bottom = m.edge_id(0), top = m.edge_id(2);
+  auto cmd = split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}, 7));
+  apply_undo_redo(m, h, cmd);
+  CHECK(m.vertex_count() == 6);
+  CHECK(m.edge_count() == 7);
+  CHECK(m.face_count() == 2);
+  CHECK(face_sizes(m) == std::vector<uint32_t>{4, 4});
+  CHECK(border_edges(m) == 6);
+  CHECK_FALSE(m.valid(bottom));  // the split edges are gone; their slots may be reused, with a new generation
+  CHECK_FALSE(m.valid(top));
+  // The new vertices sit on the old polylines' middle points and have valence 3.
+  uint32_t a = kNone, b = kNone;
+  for (uint32_t v = 0; v < m.vertex_slots(); ++v) {
+    if (!m.vertex_alive(v)) continue;
+    if (m.vertices.position[v] == Vec3(0.5, 0, 0)) a = v;
+    if (m.vertices.position[v] == Vec3(0.5, 1, 0)) b = v;
+  }
+  REQUIRE(a != kNone);
+  REQUIRE(b != kNone);
+  CHECK(m.valence(a) == 3);
+  CHECK(m.valence(b) == 3);
+  uint32_t e = edge_between(m, a, b);
+  REQUIRE(e != kNone);
+  CHECK(m.edges.point_count[e] == 7);
+  CHECK(m.edges.face[e][0] != kNone);
+  CHECK(m.edges.face[e][1] != kNone);
+  // Each half of the bottom edge keeps its 3 points.
+  CHECK(m.edges.point_count[edge_between(m, 0, a)] == 3);
+  CHECK(m.edges.point_count[edge_between(m, a, 1)] == 3);
+}
+
+TEST_CASE("split vertex-edge and edge-vertex", "[split]") {
+  SECTION("vertex-edge") {
+    EditHistory h;
+    Mesh m = square(&h);
+    apply_undo_redo(m, h, split(0, {0, 0}, {2, 2}, line({0, 0, 0}, {0.5, 1, 0})));
+    CHECK(m.vertex_count() == 5);
+    CHECK(m.edge_count() == 6);
+    CHECK(face_sizes(m) == std::vector<uint32_t>{3, 4});
+    CHECK(m.valence(0) == 3);
+  }
+  SECTION("edge-vertex") {
+    EditHistory h;
+    Mesh m = square(&h);
+    apply_undo_redo(m, h, split(0, {0, 2}, {1, 4}, line({0.5, 0, 0}, {1, 1, 0})));
+    CHECK(m.vertex_count() == 5);
+    CHECK(m.edge_count() == 6);
+    CHECK(face_sizes(m) == std::vector<uint32_t>{3, 4});
+    CHECK(m.valence(2) == 3);
+  }
+}
+
+TEST_CASE("split vertex-vertex: no new vertex", "[split]") {
+  EditHistory h;
+  Mesh m = square(&h);
+  apply_undo_redo(m, h, split(0, {0, 0}, {2, 0}, line({0, 0, 0}, {1, 1, 0})));
+  CHECK(m.vertex_count() == 4);
+  CHECK(m.edge_count() == 5);
+  CHECK(face_sizes(m) == std::vector<uint32_t>{3, 3});
+  CHECK(m.valence(0) == 3);
+  CHECK(m.valence(2) == 3);
+  CHECK(m.valence(1) == 2);
+}
+
+TEST_CASE("split between adjacent vertices makes a two-sided face", "[split]") {
+  EditHistory h;
+  Mesh m = square(&h);
+  apply_undo_redo(m, h, split(0, {0, 0}, {0, 4}, line({0, 0, 0}, {1, 0, 0.2})));
+  CHECK(face_sizes(m) == std::vector<uint32_t>{2, 4});
+}
+
+TEST_CASE("splitting an interior edge updates the face on its other side", "[split]") {
+  EditHistory h;
+  Mesh m = square(&h);
+  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}, 5))).ok);
+  uint32_t middle = kNone, right = kNone;
+  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+    if (!m.edge_alive(e)) continue;
+    if (!m.is_border_edge(e)) middle = e;
+    if (e == 1) right = e;
+  }
+  REQUIRE(middle != kNone);
+  uint32_t right_face = m.edges.face[right][0];
+  uint32_t left_face = m.other_face(middle, right_face);
+  REQUIRE(m.faces.edge_count[left_face] == 4);
+  apply_undo_redo(m, h, split(right_face, {middle, 2}, {right, 2}, line({0.5, 0.5, 0}, {1, 0.5, 0})));
+  CHECK(m.vertex_count() == 8);
+  CHECK(m.edge_count() == 10);
+  CHECK(face_sizes(m) == std::vector<uint32_t>{4, 4, 5});
+  CHECK(m.faces.edge_count[left_face] == 5);  // the left face now walks both halves of the middle curve
+  CHECK(m.vertex_count() - m.edge_count() + m.face_count() == 1);  // still a disk
+}
+
+TEST_CASE("every bad edit is rejected with a reason and changes nothing", "[split][reject]") {
+  EditHistory h;
+  Mesh m = square(&h);
+  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok);
+  const uint32_t left = m.edges.face[3][0];
+  const uint32_t right = m.edges.face[1][0];
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  struct Case {
+    const char* name;
+    EditCommand cmd;
+    const char* reason_part;
+  };
+  std::vector<Case> cases = {
+      {"ends on another face's edge", split(left, {3, 2}, {1, 2}, line({0, 0.5, 0}, {1, 0.5, 0})), "same face"},
+      {"both ends on one vertex", split(left, {3, 0}, {3, 0}, line({0, 1, 0}, {0, 1, 0.1})), "fewer than 2 edges"},
+      {"both ends on one edge", split(left, {3, 1}, {3, 3}, line({0, 0.75, 0}, {0, 0.25, 0})), "same edge"},
+      {"NaN point", split(left, {3, 2}, {3, 0}, {{0, 0.5, 0}, {nan, 0.5, 0}, {0, 1, 0}}), "not finite"},
+      {"infinite point", split(left, {3, 2}, {3, 0}, {{0, 0.5, 0}, {0.1, inf, 0}, {0, 1, 0}}), "not finite"},
+      {"one point", split(left, {3, 2}, {3, 0}, {{0, 0.5, 0}}), "at least 2 points"},
+      {"missing face", split(99, {3, 2}, {3, 0}, line({0, 0.5, 0}, {0, 1, 0})), "does not exist"},
+      {"point index past the polyline", split(left, {3, 9}, {3, 0}, line({0, 0.5, 0}, {0, 1, 0})), "has 5"},
+      {"edge past the pool", split(left, {500, 1}, {3, 0}, line({0, 0.5, 0}, {0, 1, 0})), "does not exist"},
+      {"second border", make(EditKind::StartBorder, line({0, 0, 1}, {1, 0, 1})), "already exists"},
+      {"append after close", make(EditKind::AppendBorder, line({0, 0, 1}, {1, 0, 1})), "already closed"},
+      {"delete a border edge", remove(1), "border"},
+      {"delete a missing edge", remove(77), "does not exist"},
+  };
+  (void)right;
+  for (const Case& c : cases) {
+    INFO(c.name);
+    Mesh before = m;
+    EditOutcome r = h.apply(m, c.cmd);
+    CHECK_FALSE(r.ok);
+    CHECK_THAT(r.reason, Catch::Matchers::Contains(c.reason_part));
+    CHECK(m.same_pools(before));
+    CHECK(m.validate() == "");
+  }
+}
+
+TEST_CASE("border rejections", "[split][reject]") {
+  Mesh m;
+  CHECK_FALSE(execute_edit(m, make(EditKind::AppendBorder, line({0, 0, 0}, {1, 0, 0}))).ok);
+  CHECK_FALSE(execute_edit(m, split(0, {0, 0}, {0, 1}, line({0, 0, 0}, {1, 0, 0}))).ok);
+  CHECK_FALSE(execute_edit(m, make(EditKind::StartBorder, {{0, 0, 0}, {0, 0, 0}})).ok);
+  REQUIRE(execute_edit(m, make(EditKind::StartBorder, line({0, 0, 0}, {1, 0, 0}))).ok);
+  REQUIRE(execute_edit(m, make(EditKind::AppendBorder, line({1, 0, 0}, {1, 1, 0}))).ok);
+  EditCommand far = make(EditKind::CloseBorder, line({1, 1, 0}, {0.2, 0, 0}));
+  far.snap_distance = 0.01;
+  Mesh before = m;
+  EditOutcome r = execute_edit(m, far);
+  CHECK_FALSE(r.ok);
+  CHECK_THAT(r.reason, Catch::Matchers::Contains("snap distance"));
+  CHECK(m.same_pools(before));
+  CHECK(m.face_count() == 0);
+  EditCommand near = make(EditKind::CloseBorder, line({1, 1, 0}, {0.005, 0, 0}));
+  near.snap_distance = 0.01;
+  REQUIRE(execute_edit(m, near).ok);
+  CHECK(face_sizes(m) == std::vector<uint32_t>{3});
+  CHECK(m.validate() == "");
+}
+
+TEST_CASE("deleting a curve merges its faces and joins the edge splits it needed", "[split][delete]") {
+  EditHistory h;
+  Mesh m = square(&h);
+  std::vector<Vec3> bottom(m.polyline(0).begin(), m.polyline(0).end());
+  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok);
+  uint32_t middle = kNone;
+  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e) && !m.is_border_edge(e)) middle = e;
+  EditCommand del = make(EditKind::DeleteCurve);
+  del.edge = middle;
+  apply_undo_redo(m, h, del);
+  CHECK(m.vertex_count() == 4);
+  CHECK(m.edge_count() == 4);
+  CHECK(face_sizes(m) == std::vector<uint32_t>{4});
+  // The bottom edge is whole again, with the same points.
+  uint32_t e = edge_between(m, 0, 1);
+  REQUIRE(e != kNone);
+  auto joined = m.polyline(e);
+  std::vector<Vec3> got(joined.begin(), joined.end());
+  if (m.edges.vertex[e][0] != 0) std::reverse(got.begin(), got.end());
+  CHECK(got == bottom);
+}
+
+TEST_CASE("deleting a curve keeps a vertex other curves still need", "[split][delete]") {
+  EditHistory h;
+  Mesh m = square(&h);
+  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok);
+  // A second curve from the bottom split vertex to the top-right corner.
+  uint32_t a = kNone;
+  for (uint32_t v = 0; v < m.vertex_slots(); ++v)
+    if (m.vertex_alive(v) && m.vertices.position[v] == Vec3(0.5, 0, 0)) a = v;
+  uint32_t right_edge_half = edge_between(m, a, 1);
+  uint32_t f = m.edges.face[right_edge_half][0] != kNone ? m.edges.face[right_edge_half][0] : m.edges.face[right_edge_half][1];
+  uint32_t at_a = m.edges.vertex[right_edge_half][0] == a ? 0 : m.edges.point_count[right_edge_half] - 1;
+  REQUIRE(h.apply(m, split(f, {right_edge_half, at_a}, {1, 4}, line({0.5, 0, 0}, {1, 1, 0}))).ok);
+  uint32_t middle = kNone;
+  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e) && !m.is_border_edge(e) && m.edges.point_count[e] == 5 &&
+        m.polyline(e)[4] == Vec3(0.5, 1, 0))
+      middle = e;
+  REQUIRE(middle != kNone);
+  EditCommand del = make(EditKind::DeleteCurve);
+  del.edge = middle;
+  REQUIRE(h.apply(m, del).ok);
+  CHECK(m.validate() == "");
+  CHECK(m.vertex_alive(a));  // still holds the second curve
+  CHECK(m.valence(a) == 3);
+  CHECK(face_sizes(m) == std::vector<uint32_t>{3, 4});
+}
+
+TEST_CASE("compaction squeezes tombstones and keeps the network", "[pools]") {
+  EditHistory h;
+  Mesh m = square(&h);
+  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok);
+  EditCommand del = remove(kNone);
+  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e) && !m.is_border_edge(e)) del.edge = e;
+  REQUIRE(h.apply(m, del).ok);  // leaves tombstones: the joined edges' slots
+  REQUIRE(m.edges.free_list.size() > 0);
+  size_t v = m.vertex_count(), e = m.edge_count(), f = m.face_count(), p = m.live_point_count();
+  CompactionMap map = m.compact();
+  h.clear(m);
+  CHECK(m.validate() == "");
+  CHECK(m.vertex_slots() == v);
+  CHECK(m.edge_slots() == e);
+  CHECK(m.face_slots() == f);
+  CHECK(m.points.size() == p);
+  CHECK(m.edges.free_list.empty());
+  CHECK(m.vertices.free_list.empty());
+  // The map sends live slots, in order, onto 0..n-1 and dead ones nowhere.
+  uint32_t next = 0;
+  for (uint32_t x : map.edge)
+    if (x != kNone) CHECK(x == next++);
+  CHECK(next == e);
+  CHECK(std::count(map.edge.begin(), map.edge.end(), kNone) > 0);
+}
+
+TEST_CASE("handles carry generations", "[pools]") {
+  EditHistory h;
+  Mesh m = square(&h);
+  EdgeId bottom = m.edge_id(0);
+  CHECK(m.valid(bottom));
+  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok);
+  CHECK_FALSE(m.valid(bottom));
+  REQUIRE(h.undo(m).ok);
+  CHECK(m.valid(bottom));
+}
+
+TEST_CASE("validate names the first broken invariant", "[pools]") {
+  Mesh m = square();
+  m.points.set(m.edges.point_offset[1], Vec3(5, 5, 5));
+  CHECK_THAT(m.validate(), Catch::Matchers::Contains("edge 1's polyline does not start at its vertex"));
+  Mesh n = square();
+  auto fs = n.edges.face[2];
+  fs[0] = kNone;
+  n.edges.face.set(2, fs);
+  CHECK_THAT(n.validate(), Catch::Matchers::Contains("face 0 uses edge 2 which does not name it back"));
+}
+
+TEST_CASE("dirty tags mark what an edit touched", "[pools]") {
+  Mesh m = square();
+  m.clear_dirty();
+  REQUIRE(execute_edit(m, split(0, {0, 0}, {2, 0}, line({0, 0, 0}, {1, 1, 0}))).ok);
+  CHECK(m.faces.dirty[0] == 1);
+  CHECK(m.faces.dirty[1] == 1);
+  CHECK(m.edges.dirty[1] == 1);  // now walked by the new face
+  CHECK(m.vertices.dirty[1] == 0);  // untouched corner
+}
