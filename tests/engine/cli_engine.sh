@@ -19,6 +19,10 @@ check "export-network --help" "'$fire' export-network --help | grep -q OBJ"
 h1=$("$fire" replay "$src/tools/demo/sketch.log" --hash 2>/dev/null)
 h2=$("$fire" replay "$src/tools/demo/sketch.log" --hash 2>/dev/null)
 check "replay hash is stable ($h1)" "[ -n '$h1' ] && [ '$h1' = '$h2' ]"
+# The hash every build on every machine must print for the bundled demo (regenerate it only when the demo
+# log or the meaning of the pools changes on purpose).
+golden=$(cat "$src/tests/engine/demo.hash")
+check "replay hash matches the recorded one ($golden)" "[ '$h1' = '$golden' ]"
 check "replay writes the network" "'$fire' replay '$src/tools/demo/sketch.log' -o '$tmp/demo.fnet' 2>/dev/null && [ -s '$tmp/demo.fnet' ]"
 check "export-network writes one l per edge" "'$fire' export-network '$tmp/demo.fnet' -o '$tmp/demo.obj' && [ \$(grep -c '^l ' '$tmp/demo.obj') -eq 33 ]"
 

@@ -315,3 +315,29 @@ TEST_CASE("dirty tags mark what an edit touched", "[pools]") {
   CHECK(m.edges.dirty[1] == 1);  // now walked by the new face
   CHECK(m.vertices.dirty[1] == 0);  // untouched corner
 }
+
+TEST_CASE("border edits undo and redo like every other edit", "[split][undo]") {
+  EditHistory h;
+  Mesh empty;
+  Mesh m = square(&h);
+  Mesh closed = m;
+  REQUIRE(h.undo_depth() == 4);
+  REQUIRE(h.undo(m).ok);  // reopens the border
+  CHECK(m.face_count() == 0);
+  CHECK(m.edge_count() == 3);
+  CHECK(m.validate() == "");
+  while (h.undo_depth() > 0) REQUIRE(h.undo(m).ok);
+  CHECK(m.same_pools(empty));
+  CHECK_FALSE(h.undo(m).ok);
+  while (h.redo_depth() > 0) REQUIRE(h.redo(m).ok);
+  CHECK(m.same_pools(closed));
+  CHECK_FALSE(h.redo(m).ok);
+  // A new edit after undo drops what could have been redone.
+  REQUIRE(h.undo(m).ok);
+  REQUIRE(h.apply(m, split(0, {0, 0}, {1, 4}, line({0, 0, 0}, {1, 1, 0}))).ok == false);  // border still open
+  REQUIRE(h.redo_depth() == 1);
+  EditCommand close = make(EditKind::CloseBorder, line({0, 1, 0}, {0, 0, 0}));
+  close.snap_distance = 0.01;
+  REQUIRE(h.apply(m, close).ok);
+  CHECK(h.redo_depth() == 0);
+}
