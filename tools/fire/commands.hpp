@@ -8,9 +8,12 @@ struct Registry {
   int exit_code = 0;
 };
 
-// network-from-mesh, export-network, replay (engine foundation)
+// replay, export-network (engine foundation)
 void add_network_commands(CLI::App& app, Registry& registry);
 // network-from-mesh (synthetic curve networks, systems/synth)
 void add_synth_commands(CLI::App& app, Registry& registry);
+
+// simulate wand|sketch, calibrate, track (stereo tracking, systems/tracking)
+void add_tracking_commands(CLI::App& app, Registry& registry);
 
 }  // namespace fire::cli

@@ -1,0 +1,171 @@
+#pragma once
+// Catmull-Clark subdivision equal to OpenSubdiv's Catmark scheme with boundary interpolation
+// EdgeAndCorner (boundary edges are infinitely sharp, boundary vertices with one face are corners),
+// infinitely sharp creases, faces of any size and vertices of any valence.
+//
+// Topology lives in flat index arrays per level. Refinement from level l to l+1 is given by
+// parent-to-child index maps (implicit, see below) and stencils: each child vertex is a weighted sum
+// of parent points. The stencils are stored in the structure the scheme gives them: a face point's
+// sources are its face's vertices, an edge point's its edge's ends and faces, a vertex point's its
+// ring (ring_neighbors and ring_corners), and the weights follow from the vertex rule and valence.
+// evaluate() applies them level by level, so moving the base points re-evaluates every level without
+// touching topology. stencil_table() writes the same stencils out as explicit (source, weight) rows and
+// factorize() composes them into last-level-from-base rows (for solvers that need the matrix); applying
+// those is slower than evaluate() (about 2x level by level, 2.2-2.7x factorized: perf/RESULTS.md).
+//
+// Child components follow OpenSubdiv's uniform ordering (Vtr::Refinement with
+// orderVerticesFromFacesFirst = false), so level l of a Refinement has the same vertex, edge and
+// face numbering as level l of a Far::TopologyRefiner built from the same faces:
+//   child vertices: parent vertex v -> v, parent face f -> V + f, parent edge e -> V + F + e;
+//   child faces:    face f gets one quad per corner; the quad of corner c (global corner index) is c;
+//   child edges:    corner c of face f gives the interior edge c (face point to edge point of the edge
+//                   leaving corner c); parent edge e gives edges C + 2e + k, k = 0,1 (edge point to the
+//                   child of edge_vertices[2e + k]);  V, F, E, C = parent vertex, face, edge, corner counts.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "engine/common.hpp"
+
+namespace fire::subdivide {
+
+inline constexpr uint32_t kNone = 0xffffffffu;
+
+// The rule that moves a vertex, from its count of infinitely sharp incident edges (boundary edges
+// included): 0 smooth, 1 dart (moves like smooth), 2 crease, more than 2 corner. A boundary vertex with
+// a single face and a vertex with no face are corners.
+enum class VertexRule : uint8_t { smooth, dart, crease, corner };
+
+// The base mesh as plain arrays: face f uses face_vertices[face_offsets[f] .. face_offsets[f+1]),
+// counter-clockwise seen from outside; sharp_edges holds vertex index pairs (a0, b0, a1, b1, ...) of
+// edges that are infinitely sharp creases.
+struct BaseTopology {
+  uint32_t vertex_count = 0;
+  std::span<const uint32_t> face_offsets;
+  std::span<const uint32_t> face_vertices;
+  std::span<const uint32_t> sharp_edges;
+};
+
+// One level's topology. A "corner" is one entry of face_vertices; corner c of face f lies in
+// [face_offsets[f], face_offsets[f+1]). Only face_offsets and face_vertices are filled in a last level
+// built without adjacency (RefinementOptions::last_level_adjacency = false).
+struct Level {
+  uint32_t vertex_count = 0;
+  std::vector<uint32_t> face_offsets{0};  // face count + 1
+  std::vector<uint32_t> face_vertices;    // per corner
+  std::vector<uint32_t> face_edges;       // per corner: the edge from this corner to the next one
+  std::vector<uint32_t> corner_faces;     // per corner: its face; level 0 only (later levels: corner / 4)
+
+  std::vector<uint32_t> edge_vertices;  // 2 per edge (OpenSubdiv's order)
+  std::vector<uint32_t> edge_corners;   // 2 per edge: the corner it leaves in each face; 2nd kNone on a boundary
+  std::vector<uint8_t> edge_sharp;      // 1 for infinitely sharp (boundary or marked) edges
+
+  // The one-ring of vertex v, counter-clockwise: ring slots ring_offsets[v] .. ring_offsets[v+1], one
+  // per incident edge. Slot i holds edge i, the vertex at its other end, and the corner of v in the
+  // face that lies between edge i and edge i+1 (edge i leaves v in that face). On a boundary vertex
+  // slot 0 holds the leading boundary edge and the last slot the trailing one, whose corner is kNone.
+  // The first slot of an interior vertex is the one OpenSubdiv starts with (it decides the side a
+  // crease's limit normal is taken on).
+  std::vector<uint32_t> ring_offsets;  // vertex count + 1
+  std::vector<uint32_t> ring_edges;
+  std::vector<uint32_t> ring_neighbors;
+  std::vector<uint32_t> ring_corners;
+  std::vector<VertexRule> vertex_rules;
+
+  uint32_t face_count() const { return static_cast<uint32_t>(face_offsets.size() - 1); }
+  uint32_t corner_count() const { return static_cast<uint32_t>(face_vertices.size()); }
+  uint32_t edge_count() const { return static_cast<uint32_t>(edge_vertices.size() / 2); }
+  bool has_adjacency() const { return !ring_offsets.empty(); }
+  uint32_t corner_face(uint32_t corner) const { return corner_faces.empty() ? corner >> 2 : corner_faces[corner]; }
+  // Face `side` (0 or 1) of edge e; kNone for side 1 of a boundary edge.
+  uint32_t edge_face(uint32_t e, uint32_t side) const {
+    const uint32_t corner = edge_corners[2 * e + side];
+    return corner == kNone ? kNone : corner_face(corner);
+  }
+};
+
+// Sparse rows in CSR form: row r is the sum over k in [offsets[r], offsets[r+1]) of
+// weights[k] * point[sources[k]].
+struct StencilTable {
+  std::vector<uint32_t> offsets{0};
+  std::vector<uint32_t> sources;
+  std::vector<double> weights;
+  uint32_t row_count() const { return static_cast<uint32_t>(offsets.size() - 1); }
+};
+
+struct RefinementOptions {
+  int levels = 1;  // 0 .. kMaxLevels
+  // The last level's edges and rings, needed for build_limit_stencils; without them only its faces are
+  // built (what Far::TopologyRefiner builds by default).
+  bool last_level_adjacency = true;
+};
+inline constexpr int kMaxLevels = 10;
+
+struct Refinement {
+  std::vector<Level> levels;  // levels[0] is the base mesh
+  const Level& last() const { return levels.back(); }
+};
+
+// Builds the levels. Errors name the offending face, edge or vertex: a face with fewer
+// than 3 vertices or a repeated vertex, an index out of range, an edge shared by more than 2 faces or
+// twice in the same direction (inconsistent orientation), a vertex whose faces do not form one fan,
+// a sharp edge that is not an edge, a refinement too large for 32-bit indices.
+Result<Refinement> build_refinement(const BaseTopology& base, const RefinementOptions& options);
+
+// Points of the last level from base points (one per base vertex), level by level; scratch holds the
+// intermediate levels (pass the same vectors again to avoid allocations; base_points must not alias
+// either).
+void evaluate(const Refinement& refinement, std::span<const Vec3> base_points, std::vector<Vec3>& last_level_points,
+              std::vector<Vec3>& scratch);
+
+// Points of every level: level_points[0] is a copy of base_points.
+void evaluate_all_levels(const Refinement& refinement, std::span<const Vec3> base_points,
+                         std::vector<std::vector<Vec3>>& level_points);
+
+// Level `level`'s points -> level `level + 1`'s points as explicit rows (level < levels.size() - 1).
+StencilTable stencil_table(const Refinement& refinement, size_t level);
+
+// dst[r] = row r of table applied to src (dst.size() == table.row_count()).
+void apply(const StencilTable& table, std::span<const Vec3> src, std::span<Vec3> dst);
+
+// outer applied after inner, as one table (rows of outer, sources of inner).
+StencilTable compose(const StencilTable& outer, const StencilTable& inner);
+
+// All levels' stencils composed: last-level points straight from base points.
+StencilTable factorize(const Refinement& refinement);
+
+// Limit masks of the last level's vertices (Catmull-Clark limit position and two limit tangents per
+// vertex, with OpenSubdiv's smooth, crease and corner masks), as rows over last-level points.
+struct LimitStencils {
+  std::vector<uint32_t> offsets{0};
+  std::vector<uint32_t> sources;
+  std::vector<double> position;
+  std::vector<double> tangent1;
+  std::vector<double> tangent2;
+};
+
+// Requires a last level with adjacency whose faces are all quads (true after one refinement).
+Result<LimitStencils> build_limit_stencils(const Refinement& refinement);
+
+// Limit positions and unit normals (tangent1 x tangent2, zero where the tangents are parallel or the
+// vertex has no face) of the last level's vertices, from the last level's points.
+void evaluate_limit(const LimitStencils& limit, std::span<const Vec3> last_level_points, std::vector<Vec3>& positions,
+                    std::vector<Vec3>& normals);
+
+// One call from a polygon mesh to its subdivided quads and limit surface samples.
+struct SubdivisionInput {
+  std::span<const Vec3> positions;
+  std::span<const uint32_t> face_offsets;
+  std::span<const uint32_t> face_vertices;
+  std::span<const uint32_t> sharp_edges;
+};
+struct SubdividedMesh {
+  std::vector<Vec3> positions;         // last level points
+  std::vector<uint32_t> quads;         // 4 per face
+  std::vector<Vec3> limit_positions;   // per vertex of the last level
+  std::vector<Vec3> limit_normals;
+};
+// levels >= 1. Rejects non-finite positions besides what build_refinement rejects.
+Result<SubdividedMesh> subdivide(const SubdivisionInput& input, int levels);
+
+}  // namespace fire::subdivide

@@ -1,0 +1,43 @@
+#pragma once
+// Synthetic curve networks from a polygon control mesh (thesis chapter 7): unrefine the mesh by dropping
+// edge loops, turn each chain of kept edges into one polyline edge, collapse interior vertices of
+// valence 2 (thesis figure 63) and add seeded Gaussian noise to the polylines.
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "engine/common.hpp"
+#include "engine/mesh.hpp"
+
+namespace fire {
+
+// A polygon mesh as flat arrays (the layout of platform's PolygonMesh, which systems may not include).
+struct PolygonMeshView {
+  std::span<const Vec3> positions;
+  std::span<const uint32_t> face_offsets;   // face f uses face_vertices[face_offsets[f] .. face_offsets[f+1])
+  std::span<const uint32_t> face_vertices;  // 0-based vertex indices
+  std::string_view source;                  // names the mesh in error messages (a file name)
+};
+
+struct UnrefineOptions {
+  uint32_t unrefine = 1;          // keep every K-th edge loop; 1 keeps every edge
+  double noise_percent = 0;       // Gaussian sigma, in percent of the mean control edge length
+  uint64_t seed = 0;              // seeds the noise
+  uint32_t samples_per_edge = 8;  // polyline points each control edge contributes (at least 8)
+};
+
+inline constexpr uint32_t kMinSamplesPerEdge = 8;
+
+// Builds the curve network. Errors (naming `control.source`): a non-manifold edge (more than 2 faces),
+// inconsistent face orientation, bad indices or coordinates, options out of range, and an unrefinement so
+// coarse that a merged region is not a disk. The result is compact and passes Mesh::validate().
+Result<Mesh> network_from_mesh(const PolygonMeshView& control, const UnrefineOptions& options);
+
+// The polyline of one chain of control vertices: each control edge contributes `samples_per_edge` points
+// spaced linearly from its first end (inclusive) to its second (exclusive), then the chain's last vertex.
+// Appends chain_size-1 times samples_per_edge plus one points to `out`.
+void sample_chain_linear(std::span<const Vec3> positions, std::span<const uint32_t> chain,
+                         uint32_t samples_per_edge, std::vector<Vec3>& out);
+
+}  // namespace fire

@@ -1,0 +1,866 @@
+#include "systems/tracking/simulate.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <random>
+
+#include "systems/tracking/hid.hpp"
+#include "systems/tracking/registration.hpp"
+
+namespace fire::tracking {
+namespace {
+
+// Random numbers from raw 64-bit draws: the standard distributions differ between standard
+// libraries, these do not. One stream per concern, so that turning one knob (say, dropouts)
+// leaves the noise of every blob unchanged.
+class Random {
+ public:
+  Random(uint64_t seed, uint64_t stream) : gen_(seed ^ (0x9E3779B97F4A7C15ull * (stream + 1))) {}
+  double uniform() { return static_cast<double>(gen_() >> 11) * 0x1.0p-53; }
+  double uniform(double a, double b) { return a + (b - a) * uniform(); }
+  double normal() {
+    const double u1 = 1.0 - uniform();  // (0, 1]
+    const double u2 = uniform();
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
+  }
+  double exponential(double mean) { return -mean * std::log(1.0 - uniform()); }
+
+ private:
+  std::mt19937_64 gen_;
+};
+
+// Each scenario draws from its own streams, so a wand and a sketch session with the same seed
+// share the rig (drawn from rig_seed) but no noise.
+enum Scenario : uint64_t { kWandScenario = 1, kSketchScenario = 2 };
+enum Stream : uint64_t { kRigStream, kClockStream, kStrayStream, kMotionStream, kNoiseStream0, kNoiseStream1,
+                         kTimingStream0, kTimingStream1, kOcclusionStream0, kOcclusionStream1 };
+uint64_t stream_of(Scenario scenario, Stream s) { return 64 * scenario + s; }
+
+constexpr double kMergeDistancePx = 8.0;  // one pixel of the 128 x 96 sensor
+constexpr int kStrayDevice = 1;
+constexpr int kStraySource = 100;
+constexpr double kLedRadius = 0.0015;  // the LED's centre sits this far off the surface it touches
+
+// The same pinhole-plus-radial model as Camera::project, written out here so that the simulator
+// does not test the calibration with the calibration's own code.
+Vec2 true_projection(const Camera& c, const Vec3& X) {
+  const Vec3 xc = c.R * X + c.t;
+  const double x = xc.x() / xc.z(), y = xc.y() / xc.z();
+  const double r2 = x * x + y * y;
+  const double radial = 1.0 + c.K.k1 * r2 + c.K.k2 * r2 * r2;
+  return {c.K.fx * radial * x + c.K.cx, c.K.fy * radial * y + c.K.cy};
+}
+
+Eigen::Matrix3d look_at(const Vec3& centre, const Vec3& target, double roll_rad) {
+  const Vec3 z = (target - centre).normalized();
+  const Vec3 y = (Vec3::UnitY() - Vec3::UnitY().dot(z) * z).normalized();
+  const Vec3 x = y.cross(z);
+  Eigen::Matrix3d R;
+  R.row(0) = x;
+  R.row(1) = y;
+  R.row(2) = z;
+  return Eigen::AngleAxisd(roll_rad, Vec3::UnitZ()).toRotationMatrix() * R;
+}
+
+Status check_rig(const RigOptions& o) {
+  const std::pair<const char*, double> named[] = {
+      {"baseline", o.baseline_m},   {"distance", o.target_distance_m}, {"focal", o.focal_px},
+      {"focal error", o.focal_error}, {"k1", o.k1},                   {"k2", o.k2},
+      {"noise", o.noise_px},        {"rate", o.rate_hz},              {"drift", o.drift_ppm},
+      {"latency", o.latency_ms},    {"clock offset", o.clock_offset_ms}, {"jitter", o.jitter_ms},
+      {"dropout", o.dropout},       {"stray", o.stray},               {"occlusion", o.occlusion_per_s}};
+  for (const auto& [name, value] : named)
+    if (!std::isfinite(value)) return Status::failure(std::string("the ") + name + " must be a finite number");
+  if (!(o.baseline_m > 0) || !(o.target_distance_m > 0)) return Status::failure("baseline and distance must be positive");
+  if (!(o.focal_px > 100)) return Status::failure("the focal length must exceed 100 px");
+  if (!(std::abs(o.focal_error) < 0.5)) return Status::failure("the focal error must be within (-0.5, 0.5)");
+  if (o.noise_px < 0 || o.jitter_ms < 0 || o.occlusion_per_s < 0) return Status::failure("noise, jitter and occlusion rate must not be negative");
+  if (!(o.rate_hz >= 1 && o.rate_hz <= 1000)) return Status::failure("the report rate must be within 1..1000 Hz");
+  if (!(std::abs(o.drift_ppm) < 10000)) return Status::failure("the drift must be within +-10000 ppm");
+  if (o.latency_ms < 0 || o.latency_ms + o.clock_offset_ms < 0) return Status::failure("both cameras' latencies must be non-negative");
+  if (!(o.dropout >= 0 && o.dropout < 1)) return Status::failure("dropout must be within [0, 1)");
+  if (!(o.stray >= 0 && o.stray <= 1)) return Status::failure("stray must be within [0, 1]");
+  return Status::success();
+}
+
+// Ray-triangle intersection (Moller-Trumbore); the distance along `dir` or nothing.
+std::optional<double> intersect(const Vec3& origin, const Vec3& dir, const std::array<Vec3, 3>& tri) {
+  const Vec3 e1 = tri[1] - tri[0], e2 = tri[2] - tri[0];
+  const Vec3 p = dir.cross(e2);
+  const double det = e1.dot(p);
+  if (std::abs(det) < 1e-18) return std::nullopt;
+  const double inv = 1.0 / det;
+  const Vec3 s = origin - tri[0];
+  const double u = s.dot(p) * inv;
+  if (u < 0 || u > 1) return std::nullopt;
+  const Vec3 q = s.cross(e1);
+  const double v = dir.dot(q) * inv;
+  if (v < 0 || u + v > 1) return std::nullopt;
+  return e2.dot(q) * inv;
+}
+
+using Triangles = std::vector<std::array<Vec3, 3>>;
+
+bool segment_blocked(const Triangles& tris, const Vec3& from, const Vec3& to) {
+  const Vec3 d = to - from;
+  const double len = d.norm();
+  const Vec3 dir = d / len;
+  for (const auto& tri : tris) {
+    const auto t = intersect(from, dir, tri);
+    if (t && *t > 0 && *t < len) return true;
+  }
+  return false;
+}
+
+// What one camera exposes at one instant: lit LEDs in the world, and the truth line to log.
+struct SceneSample {
+  std::vector<Vec3> lights;
+  std::string truth_name;
+  std::vector<double> truth_values;  // after device and exposure instant
+};
+using Scene = std::function<SceneSample(double t_s)>;
+
+struct Clock {
+  double rate_hz, phase_s, latency_s, jitter_s;
+};
+
+struct PendingReport {
+  int64_t t_us;
+  int device;
+  double exposure_s;
+  std::vector<uint8_t> bytes;
+  SceneSample scene;
+};
+
+struct Blob {
+  Vec2 px;
+  uint8_t size;
+  int source;
+};
+
+// Slot assignment as the camera does it: an object keeps its slot while it stays in view; a
+// newcomer takes the lowest free slot.
+struct SlotTracker {
+  std::array<int, kIrSlots> owner{-1, -1, -1, -1};
+  std::array<IrSlot, kIrSlots> assign(const std::vector<Blob>& blobs) {
+    for (int& o : owner)
+      if (std::none_of(blobs.begin(), blobs.end(), [&](const Blob& b) { return b.source == o; })) o = -1;
+    std::array<IrSlot, kIrSlots> slots{};
+    for (const Blob& b : blobs) {
+      auto it = std::find(owner.begin(), owner.end(), b.source);
+      if (it == owner.end()) it = std::find(owner.begin(), owner.end(), -1);
+      if (it == owner.end()) continue;  // the camera tracks four objects at most
+      *it = b.source;
+      slots[static_cast<size_t>(it - owner.begin())] =
+          IrSlot{.seen = true, .x = static_cast<uint16_t>(b.px.x()), .y = static_cast<uint16_t>(b.px.y()), .size = b.size};
+    }
+    return slots;
+  }
+};
+
+struct Interval {
+  double begin, end;
+};
+
+std::vector<Interval> occlusion_intervals(Random& rng, double rate_per_s, double duration_s) {
+  std::vector<Interval> out;
+  if (rate_per_s <= 0) return out;
+  double t = rng.exponential(1.0 / rate_per_s);
+  while (t < duration_s) {
+    const double len = rng.uniform(0.05, 0.3);
+    out.push_back({t, t + len});
+    t += len + rng.exponential(1.0 / rate_per_s);
+  }
+  return out;
+}
+
+bool inside(const std::vector<Interval>& intervals, double t) {
+  return std::any_of(intervals.begin(), intervals.end(), [&](const Interval& i) { return t >= i.begin && t < i.end; });
+}
+
+void add_meta(std::vector<InputEvent>& ev, const std::string& key, const std::string& text) {
+  InputEvent e;
+  e.kind = EventKind::Meta;
+  e.name = key;
+  e.text = text;
+  ev.push_back(std::move(e));
+}
+
+void add_truth(std::vector<InputEvent>& ev, int64_t t_us, const std::string& name, std::vector<double> values) {
+  InputEvent e;
+  e.t_us = t_us;
+  e.kind = EventKind::Truth;
+  e.name = name;
+  e.values = std::move(values);
+  ev.push_back(std::move(e));
+}
+
+std::string numbers(std::initializer_list<double> v) {
+  std::string s;
+  for (double d : v) {
+    if (!s.empty()) s += ' ';
+    s += format_double(d);
+  }
+  return s;
+}
+
+std::string rig_options_text(const RigOptions& o) {
+  return "baseline_m=" + format_double(o.baseline_m) + " target_distance_m=" + format_double(o.target_distance_m) +
+         " focal_px=" + format_double(o.focal_px) + " focal_error=" + format_double(o.focal_error) +
+         " k1=" + format_double(o.k1) + " k2=" + format_double(o.k2) + " noise_px=" + format_double(o.noise_px) +
+         " rate_hz=" + format_double(o.rate_hz) + " drift_ppm=" + format_double(o.drift_ppm) +
+         " latency_ms=" + format_double(o.latency_ms) + " clock_offset_ms=" + format_double(o.clock_offset_ms) +
+         " jitter_ms=" + format_double(o.jitter_ms) + " dropout=" + format_double(o.dropout) +
+         " stray=" + format_double(o.stray) + " occlusion_per_s=" + format_double(o.occlusion_per_s);
+}
+
+// Runs both cameras over [0, duration) and writes the session: header facts, then every report
+// in host arrival order, each followed by its truth.
+SimulatedSession run_session(const RigOptions& o, Scenario scenario, const SimulatedRig& rig, double duration_s, const Scene& scene,
+                             const Triangles& occluders, std::vector<InputEvent> header) {
+  SimulatedSession session;
+  SimulationStats& stats = session.stats;
+  stats.duration_s = duration_s;
+
+  Random clock_rng(o.seed, stream_of(scenario, kClockStream));
+  std::array<Clock, 2> clocks;
+  for (int d = 0; d < 2; ++d) {
+    const double rate = o.rate_hz * (1.0 + (d == 0 ? -0.5 : 0.5) * o.drift_ppm * 1e-6);
+    clocks[d] = Clock{rate, clock_rng.uniform(0.0, 1.0 / rate),
+                      (o.latency_ms + (d == 1 ? o.clock_offset_ms : 0.0)) * 1e-3, o.jitter_ms * 1e-3};
+  }
+  for (int d = 0; d < 2; ++d) {
+    const Camera& c = rig.cameras[d];
+    const Intrinsics& n = rig.nominal[d];
+    add_meta(header, "nominal_intrinsics", std::to_string(d) + " " + numbers({n.fx, n.fy, n.cx, n.cy, n.k1, n.k2}));
+    std::vector<double> v{static_cast<double>(d), c.K.fx, c.K.fy, c.K.cx, c.K.cy, c.K.k1, c.K.k2};
+    for (int r = 0; r < 3; ++r)
+      for (int k = 0; k < 3; ++k) v.push_back(c.R(r, k));
+    for (int k = 0; k < 3; ++k) v.push_back(c.t(k));
+    add_truth(header, 0, "camera", std::move(v));
+  }
+  for (int d = 0; d < 2; ++d)
+    add_truth(header, 0, "clock",
+              {static_cast<double>(d), clocks[d].rate_hz, clocks[d].phase_s * 1e6, clocks[d].latency_s * 1e6,
+               clocks[d].jitter_s * 1e6});
+
+  // The stray reflection: a fixed spot in one camera's image, present in whole seconds.
+  Random stray_rng(o.seed, stream_of(scenario, kStrayStream));
+  const Vec2 stray_px(stray_rng.uniform(100, 924), stray_rng.uniform(100, 668));
+  std::vector<char> stray_on(static_cast<size_t>(std::ceil(duration_s)) + 1);
+  for (char& on : stray_on) on = stray_rng.uniform() < o.stray;
+
+  std::vector<PendingReport> reports;
+  for (int d = 0; d < 2; ++d) {
+    const Camera& cam = rig.cameras[d];
+    const Vec3 centre = cam.centre();
+    Random noise(o.seed, stream_of(scenario, d == 0 ? kNoiseStream0 : kNoiseStream1));
+    Random timing(o.seed, stream_of(scenario, d == 0 ? kTimingStream0 : kTimingStream1));
+    Random occlusion_rng(o.seed, stream_of(scenario, d == 0 ? kOcclusionStream0 : kOcclusionStream1));
+    const std::vector<Interval> hand = occlusion_intervals(occlusion_rng, o.occlusion_per_s, duration_s);
+    SlotTracker slots;
+    const Clock& clock = clocks[d];
+    for (int64_t k = 0;; ++k) {
+      const double exposure = clock.phase_s + static_cast<double>(k) / clock.rate_hz;
+      if (exposure >= duration_s) break;
+      SceneSample sample = scene(exposure);
+      std::vector<Blob> blobs;
+      for (size_t i = 0; i < sample.lights.size(); ++i) {
+        const Vec3& X = sample.lights[i];
+        if ((cam.R * X + cam.t).z() <= 0) continue;
+        ++stats.led_images;
+        if (inside(hand, exposure) || (!occluders.empty() && segment_blocked(occluders, X, centre))) {
+          ++stats.occluded;
+          continue;
+        }
+        const Vec2 p = true_projection(cam, X) + o.noise_px * Vec2(noise.normal(), noise.normal());
+        const double depth = (cam.R * X + cam.t).z();
+        const auto size = static_cast<uint8_t>(std::clamp<long>(std::lround(3.2 / depth), 1, 15));
+        blobs.push_back({p, size, static_cast<int>(i)});
+      }
+      if (d == kStrayDevice && stray_on[static_cast<size_t>(exposure)]) {
+        ++stats.stray_frames;
+        blobs.push_back({stray_px + o.noise_px * Vec2(noise.normal(), noise.normal()), 2, kStraySource});
+      }
+      // Blobs within one sensor pixel are one blob to the camera.
+      for (size_t a = 0; a < blobs.size(); ++a)
+        for (size_t b = a + 1; b < blobs.size();) {
+          if ((blobs[a].px - blobs[b].px).norm() < kMergeDistancePx) {
+            blobs[a].px = 0.5 * (blobs[a].px + blobs[b].px);
+            blobs[a].size = static_cast<uint8_t>(std::min(15, blobs[a].size + blobs[b].size));
+            blobs.erase(blobs.begin() + static_cast<std::ptrdiff_t>(b));
+            ++stats.merged;
+          } else {
+            ++b;
+          }
+        }
+      std::vector<Blob> visible;
+      for (Blob b : blobs) {
+        b.px = Vec2(std::round(b.px.x()), std::round(b.px.y()));
+        if (b.px.x() < 0 || b.px.x() > kWiimoteWidth - 1 || b.px.y() < 0 || b.px.y() > kWiimoteHeight - 1) {
+          if (b.source != kStraySource) ++stats.out_of_view;
+          continue;
+        }
+        visible.push_back(b);
+      }
+      IrReport report;
+      report.report_id = 0x33;
+      report.accel = {0x82, 0x7F, 0x9B};  // at rest, lying flat
+      report.slots = slots.assign(visible);
+      // Lost reports still cost the draws above, so a dropout does not shift later noise.
+      const double jitter = clock.jitter_s * timing.normal();
+      if (timing.uniform() < o.dropout) {
+        ++stats.dropped[d];
+        continue;
+      }
+      const double arrival = exposure + std::max(0.0, clock.latency_s + jitter);
+      reports.push_back({std::llround(arrival * 1e6), d, exposure, encode_ir_report(report), std::move(sample)});
+      ++stats.reports[d];
+    }
+  }
+  std::stable_sort(reports.begin(), reports.end(), [](const PendingReport& a, const PendingReport& b) {
+    return a.t_us != b.t_us ? a.t_us < b.t_us : a.device < b.device;
+  });
+  session.events = std::move(header);
+  session.events.reserve(session.events.size() + 2 * reports.size());
+  for (PendingReport& r : reports) {
+    InputEvent hid;
+    hid.t_us = r.t_us;
+    hid.kind = EventKind::Hid;
+    hid.device = r.device;
+    hid.bytes = std::move(r.bytes);
+    session.events.push_back(std::move(hid));
+    std::vector<double> values{static_cast<double>(r.device), r.exposure_s * 1e6};
+    values.insert(values.end(), r.scene.truth_values.begin(), r.scene.truth_values.end());
+    add_truth(session.events, r.t_us, r.scene.truth_name, std::move(values));
+  }
+  return session;
+}
+
+std::vector<InputEvent> common_header(const char* scenario, const RigOptions& o) {
+  std::vector<InputEvent> h;
+  add_meta(h, "scenario", scenario);
+  add_meta(h, "seed", std::to_string(o.seed) + " rig_seed=" + std::to_string(o.rig_seed));
+  add_meta(h, "rig", rig_options_text(o));
+  return h;
+}
+
+// Catmull-Rom through evenly timed keys; `keys` needs one extra key before and two after.
+template <class V>
+V catmull_rom(const std::vector<V>& keys, double u) {
+  const auto i = static_cast<size_t>(u);
+  const double s = u - static_cast<double>(i);
+  const V& p0 = keys[i];
+  const V& p1 = keys[i + 1];
+  const V& p2 = keys[i + 2];
+  const V& p3 = keys[i + 3];
+  const double s2 = s * s, s3 = s2 * s;
+  return 0.5 * ((2.0 * p1) + (-p0 + p2) * s + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * s2 + (-p0 + 3.0 * p1 - 3.0 * p2 + p3) * s3);
+}
+
+// --- the sketch: strokes on the object's surface ---
+
+struct PlacedMesh {
+  Triangles triangles;
+  double height = 0;
+  Vec3 base_centre = Vec3::Zero();  // on the object's axis at its lowest point
+};
+
+Result<PlacedMesh> place_mesh(const MeshView& mesh, double height_m, double distance_m) {
+  using R = Result<PlacedMesh>;
+  if (mesh.positions.empty() || mesh.face_offsets.size() < 2) return R::failure("the mesh has no faces");
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Vec3& p : mesh.positions) {
+    if (!p.allFinite()) return R::failure("the mesh has a non-finite vertex");
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const double extent = hi.z() - lo.z();
+  if (!(extent > 0)) return R::failure("the mesh is flat along z (its up axis)");
+  if (!(height_m > 0) || !std::isfinite(height_m)) return R::failure("the object height must be positive");
+  const double scale = height_m / extent;
+  // Model (x, y, z) with z up -> world (x, -z, y): a rotation about x, up becomes -y.
+  const Vec3 axis(0.5 * (lo.x() + hi.x()), 0.5 * (lo.y() + hi.y()), lo.z());
+  PlacedMesh out;
+  out.height = height_m;
+  out.base_centre = Vec3(0, 0.5 * height_m, distance_m);
+  auto place = [&](const Vec3& p) -> Vec3 {
+    const Vec3 q = (p - axis) * scale;
+    return Vec3(q.x(), -q.z(), q.y()) + out.base_centre;
+  };
+  for (size_t f = 0; f + 1 < mesh.face_offsets.size(); ++f) {
+    const uint32_t first = mesh.face_offsets[f], last = mesh.face_offsets[f + 1];
+    if (last < first + 3 || last > mesh.face_vertices.size()) return R::failure("face " + std::to_string(f) + " is malformed");
+    for (uint32_t k = first; k < last; ++k)
+      if (mesh.face_vertices[k] >= mesh.positions.size())
+        return R::failure("face " + std::to_string(f) + " uses a vertex out of range");
+    const Vec3 a = place(mesh.positions[mesh.face_vertices[first]]);
+    for (uint32_t k = first + 1; k + 1 < last; ++k)
+      out.triangles.push_back({a, place(mesh.positions[mesh.face_vertices[k]]), place(mesh.positions[mesh.face_vertices[k + 1]])});
+  }
+  return out;
+}
+
+// A stroke drawn from (theta0, h0) to (theta1, h1): azimuth about the object's axis (0 faces the
+// cameras) and height as a fraction of the object's.
+struct StrokePlan {
+  double theta0_deg, h0, theta1_deg, h1;
+};
+
+constexpr StrokePlan kStrokePlans[] = {
+    {0, 0.05, 0, 0.9},     {-55, 0.25, 55, 0.25},  {-30, 0.05, -30, 0.9}, {-55, 0.45, 55, 0.45},
+    {-50, 0.1, 40, 0.85},  {30, 0.05, 30, 0.9},    {-55, 0.08, 55, 0.08}, {-50, 0.05, -50, 0.9},
+    {-55, 0.62, 55, 0.62}, {50, 0.15, -40, 0.7},   {50, 0.05, 50, 0.9},   {-50, 0.8, 50, 0.8},
+};
+
+// Samples the surface along the plan by casting horizontal rays outward from the axis; the
+// outermost hit is the surface. The radius is smoothed over a few millimetres, as a pen tip
+// glides over the facets of a polygonal model, and the LED sits kLedRadius outside.
+std::vector<Vec3> stroke_path(const PlacedMesh& m, const StrokePlan& plan) {
+  constexpr int kSamples = 800;
+  std::vector<double> radius, theta, height;
+  for (int i = 0; i <= kSamples; ++i) {
+    const double u = static_cast<double>(i) / kSamples;
+    const double th = (plan.theta0_deg + u * (plan.theta1_deg - plan.theta0_deg)) * std::numbers::pi / 180.0;
+    const double h = (plan.h0 + u * (plan.h1 - plan.h0)) * m.height;
+    const Vec3 origin = m.base_centre - Vec3(0, h, 0);
+    const Vec3 dir(std::sin(th), 0, -std::cos(th));
+    double best = -1;
+    for (const auto& tri : m.triangles)
+      if (const auto t = intersect(origin, dir, tri); t && *t > best) best = *t;
+    if (best <= 0) break;  // the ray left the object: the stroke ends here
+    radius.push_back(best);
+    theta.push_back(th);
+    height.push_back(h);
+  }
+  std::vector<Vec3> path;
+  const int n = static_cast<int>(radius.size());
+  if (n < 2) return path;
+  constexpr int kHalfWindow = 15;
+  constexpr double kSigma = 5.0;
+  for (int i = 0; i < n; ++i) {
+    double sum = 0, weight = 0;
+    for (int k = std::max(0, i - kHalfWindow); k <= std::min(n - 1, i + kHalfWindow); ++k) {
+      const double w = std::exp(-0.5 * (k - i) * (k - i) / (kSigma * kSigma));
+      sum += w * radius[static_cast<size_t>(k)];
+      weight += w;
+    }
+    const double r = sum / weight + kLedRadius;
+    const auto s = static_cast<size_t>(i);
+    path.push_back(m.base_centre - Vec3(0, height[s], 0) + r * Vec3(std::sin(theta[s]), 0, -std::cos(theta[s])));
+  }
+  return path;
+}
+
+struct Polyline {
+  std::vector<Vec3> points;
+  std::vector<double> arc;  // cumulative length
+  Vec3 at(double s) const {
+    if (s <= 0) return points.front();
+    if (s >= arc.back()) return points.back();
+    const size_t i = static_cast<size_t>(std::upper_bound(arc.begin(), arc.end(), s) - arc.begin()) - 1;
+    const double len = arc[i + 1] - arc[i];
+    return len > 0 ? Vec3(points[i] + (s - arc[i]) / len * (points[i + 1] - points[i])) : points[i];
+  }
+};
+
+Polyline make_polyline(std::vector<Vec3> points) {
+  Polyline p;
+  p.arc.push_back(0);
+  for (size_t i = 1; i < points.size(); ++i) p.arc.push_back(p.arc.back() + (points[i] - points[i - 1]).norm());
+  p.points = std::move(points);
+  return p;
+}
+
+// Constant acceleration up to the cruise speed and down again (a triangle on short strokes).
+struct SpeedProfile {
+  double length, cruise, accel;
+  double ramp_time() const { return std::min(cruise / accel, std::sqrt(length / accel)); }
+  double duration() const {
+    const double tr = ramp_time();
+    const double peak = accel * tr;
+    return 2 * tr + (length - peak * tr) / peak;
+  }
+  // Distance travelled and speed at time t into the move.
+  std::pair<double, double> at(double t) const {
+    const double tr = ramp_time(), peak = accel * tr, total = duration();
+    if (t <= 0) return {0, 0};
+    if (t >= total) return {length, 0};
+    if (t < tr) return {0.5 * accel * t * t, accel * t};
+    if (t > total - tr) {
+      const double r = total - t;
+      return {length - 0.5 * accel * r * r, accel * r};
+    }
+    return {0.5 * peak * tr + peak * (t - tr), peak};
+  }
+};
+
+enum class Phase { Travel, Hold, Move };
+struct Segment {
+  Phase phase;
+  double begin, end;
+  int stroke;      // index into the strokes drawn
+  Vec3 from, to;   // Travel: straight line, Hold: `from`
+};
+
+}  // namespace
+
+Result<SimulatedRig> make_simulated_rig(const RigOptions& o) {
+  if (Status s = check_rig(o); !s) return Result<SimulatedRig>::failure(s.error);
+  Random rng(o.rig_seed, kRigStream);
+  SimulatedRig rig;
+  const Vec3 target(0, 0, o.target_distance_m);
+  for (int d = 0; d < 2; ++d) {
+    Intrinsics K;
+    K.fx = o.focal_px * (1.0 + rng.uniform(-0.01, 0.01));
+    K.fy = K.fx * (1.0 + rng.uniform(-0.003, 0.003));
+    K.cx = 512 + rng.uniform(-10, 10);
+    K.cy = 384 + rng.uniform(-10, 10);
+    K.k1 = o.k1 * (1.0 + rng.uniform(-0.2, 0.2));
+    K.k2 = o.k2;
+    const Vec3 centre((d == 0 ? -0.5 : 0.5) * o.baseline_m, rng.uniform(-0.01, 0.01), rng.uniform(-0.01, 0.01));
+    const Vec3 aim = target + Vec3(rng.uniform(-0.03, 0.03), rng.uniform(-0.03, 0.03), rng.uniform(-0.03, 0.03));
+    const Eigen::Matrix3d R = look_at(centre, aim, rng.uniform(-2, 2) * std::numbers::pi / 180.0);
+    rig.cameras[d] = Camera{K, R, -R * centre};
+    rig.nominal[d] = Intrinsics{.fx = K.fx * (1.0 + o.focal_error), .fy = K.fy * (1.0 + o.focal_error),
+                                .cx = 512, .cy = 384, .k1 = 0, .k2 = 0};
+  }
+  return rig;
+}
+
+Result<SimulatedSession> simulate_wand(const RigOptions& o, const WandOptions& w) {
+  using R = Result<SimulatedSession>;
+  Result<SimulatedRig> rig = make_simulated_rig(o);
+  if (!rig) return R::failure(rig.error());
+  if (!(w.duration_s > 0 && w.duration_s <= 3600)) return R::failure("wand duration must be within (0, 3600] s");
+  if (!(w.length_m > 0.01 && w.length_m < 2)) return R::failure("wand length must be within (0.01, 2) m");
+
+  // The wand's centre and direction pass through random keys every half second: centres in a
+  // box in front of the rig, directions kept away from the line of sight (where its two LEDs
+  // would merge) and turning less than 90 degrees per key, as a hand waves.
+  constexpr double kKeyInterval = 0.5;
+  Random motion(o.seed, stream_of(kWandScenario, kMotionStream));
+  const size_t keys = static_cast<size_t>(w.duration_s / kKeyInterval) + 4;
+  std::vector<Vec3> centres, directions;
+  for (size_t i = 0; i < keys; ++i) {
+    centres.emplace_back(motion.uniform(-0.2, 0.2), motion.uniform(-0.15, 0.15),
+                         o.target_distance_m + motion.uniform(-0.2, 0.2));
+    Vec3 d;
+    do {
+      d = Vec3(motion.normal(), motion.normal(), motion.normal());
+    } while (d.norm() < 1e-3 || std::abs(d.normalized().z()) > 0.75);
+    d.normalize();
+    if (!directions.empty() && d.dot(directions.back()) < 0) d = -d;
+    directions.push_back(d);
+  }
+  const double half = 0.5 * w.length_m;
+  Scene scene = [&](double t) {
+    const double u = t / kKeyInterval;
+    const Vec3 c = catmull_rom(centres, u);
+    const Vec3 d = catmull_rom(directions, u).normalized();
+    const Vec3 a = c + half * d, b = c - half * d;
+    return SceneSample{{a, b}, "wand", {a.x(), a.y(), a.z(), b.x(), b.y(), b.z()}};
+  };
+  std::vector<InputEvent> header = common_header("wand", o);
+  add_meta(header, "wand_length_m", format_double(w.length_m));
+  return run_session(o, kWandScenario, *rig, w.duration_s, scene, {}, std::move(header));
+}
+
+Result<SimulatedSession> simulate_sketch(const RigOptions& o, const SketchOptions& sk, const MeshView& mesh) {
+  using R = Result<SimulatedSession>;
+  Result<SimulatedRig> rig = make_simulated_rig(o);
+  if (!rig) return R::failure(rig.error());
+  if (!(sk.duration_s > 0 && sk.duration_s <= 3600)) return R::failure("sketch duration must be within (0, 3600] s");
+  if (sk.strokes < 1 || sk.strokes > 1000) return R::failure("strokes must be within 1..1000");
+  if (!(sk.speed_m_s > 0.01 && sk.speed_m_s <= 5)) return R::failure("pen speed must be within (0.01, 5] m/s");
+  if (!(sk.hold_s >= 0 && sk.hold_s <= 60)) return R::failure("hold must be within [0, 60] s");
+  Result<PlacedMesh> placed = place_mesh(mesh, sk.height_m, o.target_distance_m);
+  if (!placed) return R::failure(placed.error());
+
+  constexpr double kAccel = 5.0;      // m/s^2, a brisk but human start and stop
+  constexpr double kTravel_s = 0.6;   // unlit move from one stroke to the next
+  constexpr double kLeadIn_s = 0.5;   // unlit before the first stroke
+  std::vector<Polyline> strokes;
+  std::vector<Segment> timeline;
+  double t = kLeadIn_s;
+  const size_t plan_count = std::size(kStrokePlans);
+  for (int i = 0; i < sk.strokes && t < sk.duration_s; ++i) {
+    StrokePlan plan = kStrokePlans[static_cast<size_t>(i) % plan_count];
+    // Later rounds of the plan list turn by a few degrees, so that no stroke repeats.
+    const double turn = 7.0 * static_cast<double>(static_cast<size_t>(i) / plan_count);
+    plan.theta0_deg += turn;
+    plan.theta1_deg += turn;
+    Polyline path = make_polyline(stroke_path(*placed, plan));
+    if (path.points.size() < 2) continue;
+    const int id = static_cast<int>(strokes.size());
+    const Vec3 start = path.points.front(), end = path.points.back();
+    const Vec3 prev = timeline.empty() ? start : timeline.back().from;
+    if (timeline.empty()) {
+      timeline.push_back({Phase::Travel, 0, t, id, start, start});
+    } else {
+      timeline.push_back({Phase::Travel, t, t + kTravel_s, id, prev, start});
+      t += kTravel_s;
+    }
+    const double move = SpeedProfile{path.arc.back(), sk.speed_m_s, kAccel}.duration();
+    timeline.push_back({Phase::Hold, t, t + sk.hold_s, id, start, start});
+    t += sk.hold_s;
+    timeline.push_back({Phase::Move, t, t + move, id, start, end});
+    t += move;
+    timeline.push_back({Phase::Hold, t, t + sk.hold_s, id, end, end});
+    t += sk.hold_s;
+    strokes.push_back(std::move(path));
+  }
+  if (strokes.empty()) return R::failure("no stroke could be placed on the mesh (does its +z axis point up?)");
+  const double duration = std::min(sk.duration_s, t + 0.3);
+  timeline.push_back({Phase::Travel, t, std::numeric_limits<double>::infinity(), -1, timeline.back().from,
+                      timeline.back().from});
+
+  Scene scene = [&](double time) {
+    const auto it = std::upper_bound(timeline.begin(), timeline.end(), time,
+                                     [](double v, const Segment& s) { return v < s.begin; });
+    const Segment& seg = *(it == timeline.begin() ? it : it - 1);
+    Vec3 p = seg.from;
+    bool lit = false;
+    double speed = 0, still = 0;
+    switch (seg.phase) {
+      case Phase::Travel: {
+        const double len = seg.end - seg.begin;
+        const double u = std::isfinite(len) && len > 0 ? std::clamp((time - seg.begin) / len, 0.0, 1.0) : 0.0;
+        p = seg.from + u * (seg.to - seg.from);
+        break;
+      }
+      case Phase::Hold:
+        lit = true;
+        still = time - seg.begin;
+        break;
+      case Phase::Move: {
+        const Polyline& path = strokes[static_cast<size_t>(seg.stroke)];
+        const auto [s, v] = SpeedProfile{path.arc.back(), sk.speed_m_s, kAccel}.at(time - seg.begin);
+        p = path.at(s);
+        lit = true;
+        speed = v;
+        break;
+      }
+    }
+    SceneSample out{{}, "pen", {p.x(), p.y(), p.z(), lit ? 1.0 : 0.0, speed, still}};
+    if (lit) out.lights.push_back(p);
+    return out;
+  };
+  std::vector<InputEvent> header = common_header("sketch", o);
+  add_meta(header, "mesh", sk.mesh_name + " height_m=" + format_double(sk.height_m));
+  add_meta(header, "sketch", "strokes=" + std::to_string(strokes.size()) + " speed_m_s=" + format_double(sk.speed_m_s) +
+                                 " hold_s=" + format_double(sk.hold_s));
+  Result<SimulatedSession> session = run_session(o, kSketchScenario, *rig, duration, scene, placed->triangles, std::move(header));
+  if (session) session->stats.strokes = static_cast<int>(strokes.size());
+  return session;
+}
+
+SessionTruth read_session_truth(std::span<const InputEvent> events) {
+  SessionTruth truth;
+  std::array<bool, 2> camera_seen{};
+  std::array<bool, 2> clock_seen{};
+  auto finite = [](const std::vector<double>& v) {
+    return std::all_of(v.begin(), v.end(), [](double d) { return std::isfinite(d); });
+  };
+  auto device_of = [](double d) { return d == 0.0 ? 0 : d == 1.0 ? 1 : -1; };
+  for (const InputEvent& e : events) {
+    if (e.kind == EventKind::Truth) {
+      const std::vector<double>& v = e.values;
+      const int d = v.empty() ? -1 : device_of(v[0]);
+      if (e.name == "camera") {
+        if (v.size() != 19 || !finite(v) || d < 0) {
+          ++truth.rejected_lines;
+          continue;
+        }
+        Camera& c = truth.cameras[d];
+        c.K = Intrinsics{.fx = v[1], .fy = v[2], .cx = v[3], .cy = v[4], .k1 = v[5], .k2 = v[6]};
+        for (int r = 0; r < 3; ++r)
+          for (int k = 0; k < 3; ++k) c.R(r, k) = v[7 + 3 * r + k];
+        c.t = Vec3(v[16], v[17], v[18]);
+        camera_seen[d] = true;
+      } else if (e.name == "clock") {
+        if (v.size() != 5 || !finite(v) || d < 0) {
+          ++truth.rejected_lines;
+          continue;
+        }
+        truth.latency_us[d] = v[3];
+        clock_seen[d] = true;
+      } else if (e.name == "pen") {
+        if (v.size() != 8 || !finite(v) || d < 0) {
+          ++truth.rejected_lines;
+          continue;
+        }
+        truth.pen.push_back({d, e.t_us, Vec3(v[2], v[3], v[4]), v[5] != 0.0, v[6], v[7]});
+      }
+    } else if (e.kind == EventKind::Meta) {
+      if (e.name == "nominal_intrinsics") {
+        std::vector<double> v;
+        const char* p = e.text.c_str();
+        const char* end = p + e.text.size();
+        while (p < end) {
+          while (p < end && *p == ' ') ++p;
+          if (p == end) break;
+          double x;
+          const auto r = std::from_chars(p, end, x);
+          if (r.ec != std::errc()) {
+            v.clear();
+            break;
+          }
+          v.push_back(x);
+          p = r.ptr;
+        }
+        const int d = v.empty() ? -1 : device_of(v[0]);
+        if (v.size() != 7 || !finite(v) || d < 0 || !(v[1] > 0) || !(v[2] > 0)) {
+          ++truth.rejected_lines;
+          continue;
+        }
+        truth.nominal[d] = Intrinsics{.fx = v[1], .fy = v[2], .cx = v[3], .cy = v[4], .k1 = v[5], .k2 = v[6]};
+        truth.has_nominal[d] = true;
+      } else if (e.name == "wand_length_m") {
+        double x = 0;
+        const auto r = std::from_chars(e.text.data(), e.text.data() + e.text.size(), x);
+        if (r.ec != std::errc() || r.ptr != e.text.data() + e.text.size() || !std::isfinite(x) || !(x > 0)) {
+          ++truth.rejected_lines;
+          continue;
+        }
+        truth.wand_length_m = x;
+        truth.has_wand_length = true;
+      }
+    }
+  }
+  truth.has_cameras = camera_seen[0] && camera_seen[1];
+  truth.has_clocks = clock_seen[0] && clock_seen[1];
+  return truth;
+}
+
+namespace {
+
+void accumulate(ErrorStats& s, double err_m) {
+  const double mm = err_m * 1e3;
+  ++s.samples;
+  s.rms_mm += mm * mm;  // the sum of squares until finish()
+  s.max_mm = std::max(s.max_mm, mm);
+}
+
+void finish(ErrorStats& s) { s.rms_mm = s.samples ? std::sqrt(s.rms_mm / static_cast<double>(s.samples)) : 0.0; }
+
+double angle_deg(const Eigen::Matrix3d& R) {
+  return std::acos(std::clamp(0.5 * (R.trace() - 1.0), -1.0, 1.0)) * 180.0 / std::numbers::pi;
+}
+
+}  // namespace
+
+Result<PenAccuracy> evaluate_pen_accuracy(const PenTrack& track, const CameraFrames& cam0, const SessionTruth& truth,
+                                          double settle_s) {
+  if (!truth.has_cameras)
+    return Result<PenAccuracy>::failure("the log holds no camera truth (was it written by fire simulate sketch?)");
+  std::vector<const PenTruth*> by_time;  // camera 0's pen truths, in arrival order
+  for (const PenTruth& p : truth.pen)
+    if (p.device == 0) by_time.push_back(&p);
+  const Camera& c0 = truth.cameras[0];
+  enum class Kind { Static, Settling, Dynamic };
+  struct Compared {
+    Vec3 filtered, truth;
+    Kind kind;
+  };
+  std::vector<Compared> compared;
+  // Consecutive static samples of one stroke form a hold: one rest point for the registration.
+  std::vector<Vec3> hold_measured, hold_true;
+  std::vector<int> hold_count;
+  bool in_hold = false;
+  uint32_t hold_stroke = 0;
+  PenAccuracy acc;
+  for (const PenSample& s : track.samples) {
+    if (s.cam0_frame >= cam0.size()) {
+      ++acc.unmatched;
+      continue;
+    }
+    const int64_t key = cam0.t_us[s.cam0_frame];
+    const auto it = std::lower_bound(by_time.begin(), by_time.end(), key,
+                                     [](const PenTruth* p, int64_t t) { return p->t_us < t; });
+    if (it == by_time.end() || (*it)->t_us != key) {
+      ++acc.unmatched;
+      continue;
+    }
+    const PenTruth& p = **it;
+    if (!p.lit) {
+      ++acc.phantom;
+      continue;
+    }
+    const Vec3 X = c0.R * p.position + c0.t;
+    const double filtered = (s.filtered - X).norm(), raw = (s.raw - X).norm();
+    const Kind kind = p.speed_m_s > 0 ? Kind::Dynamic : p.still_s >= settle_s ? Kind::Static : Kind::Settling;
+    compared.push_back({s.filtered, X, kind});
+    if (kind == Kind::Dynamic) {
+      accumulate(acc.dynamic_filtered, filtered);
+      accumulate(acc.dynamic_raw, raw);
+    } else if (kind == Kind::Static) {
+      accumulate(acc.static_filtered, filtered);
+      accumulate(acc.static_raw, raw);
+      if (!in_hold || hold_stroke != s.stroke) {
+        hold_measured.push_back(Vec3::Zero());
+        hold_true.push_back(Vec3::Zero());
+        hold_count.push_back(0);
+      }
+      hold_measured.back() += s.filtered;
+      hold_true.back() += X;
+      ++hold_count.back();
+      hold_stroke = s.stroke;
+    } else {
+      accumulate(acc.settling_filtered, filtered);
+    }
+    in_hold = kind == Kind::Static;
+  }
+  for (ErrorStats* e : {&acc.static_filtered, &acc.settling_filtered, &acc.dynamic_filtered, &acc.static_raw, &acc.dynamic_raw})
+    finish(*e);
+  for (size_t h = 0; h < hold_count.size(); ++h) {
+    hold_measured[h] /= hold_count[h];
+    hold_true[h] /= hold_count[h];
+  }
+  if (const Result<RigidTransform> reg = register_rigid(hold_measured, hold_true); reg) {
+    acc.registered = true;
+    acc.registration_points = hold_count.size();
+    acc.registration_rms_mm = reg->rms_residual * 1e3;
+    for (const Compared& c : compared) {
+      const double e = (reg->R * c.filtered + reg->t - c.truth).norm();
+      if (c.kind == Kind::Static) accumulate(acc.registered_static, e);
+      if (c.kind == Kind::Dynamic) accumulate(acc.registered_dynamic, e);
+    }
+    finish(acc.registered_static);
+    finish(acc.registered_dynamic);
+  }
+  return acc;
+}
+
+Result<RigErrors> compare_rig(const CalibrationResult& rig, const SessionTruth& truth) {
+  if (!truth.has_cameras) return Result<RigErrors>::failure("the log holds no camera truth");
+  const Camera& t0 = truth.cameras[0];
+  const Camera& t1 = truth.cameras[1];
+  // Camera 1 relative to camera 0, for the truth and for the rig (whose camera 0 need not be at the origin).
+  const Eigen::Matrix3d R_true = t1.R * t0.R.transpose();
+  const Vec3 b_true = t1.t - R_true * t0.t;
+  const Eigen::Matrix3d R_cal = rig.cam1.R * rig.cam0.R.transpose();
+  const Vec3 b_cal = rig.cam1.t - R_cal * rig.cam0.t;
+  RigErrors e;
+  e.baseline_error_mm = (b_cal.norm() - b_true.norm()) * 1e3;
+  e.rotation_error_deg = angle_deg(R_cal.transpose() * R_true);
+  e.direction_error_deg =
+      std::acos(std::clamp(b_cal.normalized().dot(b_true.normalized()), -1.0, 1.0)) * 180.0 / std::numbers::pi;
+  const Camera* cal[2] = {&rig.cam0, &rig.cam1};
+  for (int d = 0; d < 2; ++d) {
+    const Intrinsics& k = cal[d]->K;
+    const Intrinsics& t = truth.cameras[d].K;
+    e.focal_error_px[d] = 0.5 * ((k.fx - t.fx) + (k.fy - t.fy));
+    e.principal_point_error_px[d] = std::hypot(k.cx - t.cx, k.cy - t.cy);
+    e.k1_error[d] = k.k1 - t.k1;
+  }
+  return e;
+}
+
+}  // namespace fire::tracking

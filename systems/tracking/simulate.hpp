@@ -1,0 +1,167 @@
+#pragma once
+// The simulated rig: two virtual Wii Remotes watching a waved calibration wand or a pen that
+// traces curves on an object, written as the engine's input log (engine/INPUT_LOG.md) with the
+// exact bytes of each device report (mode 0x33) and the ground truth alongside.
+//
+// Time model. Each remote exposes a frame every 1 / (rate * (1 + drift)) seconds of true time
+// on its own crystal, starting at a random phase, so the two cameras' instants slide past each
+// other. A report reaches the host `latency + jitter` later and is logged with that host
+// arrival time: the log holds no exposure instants. Camera 1's latency exceeds camera 0's by
+// the clock offset, which only the geometry can reveal. Every instant is data; seeded
+// std::mt19937_64 streams make a session byte-identical for a given seed and options.
+//
+// World frame: x right, y down, z forward from the midpoint between the cameras. Log lines:
+//   meta scenario wand|sketch, meta seed N rig_seed=M, meta rig OPTIONS..., meta nominal_intrinsics D fx fy cx cy k1 k2,
+//   meta wand_length_m L (wand); meta mesh NAME height_m=H, meta sketch strokes=N speed_m_s=V hold_s=S (sketch)
+//   truth camera D fx fy cx cy k1 k2 R00 R01 R02 R10 R11 R12 R20 R21 R22 t0 t1 t2   (x_cam = R X + t)
+//   truth clock D rate_hz phase_us latency_us jitter_us
+//   after every report of device D (same t_us):
+//     truth wand D exposure_us ax ay az bx by bz                 (the two LEDs, world metres)
+//     truth pen D exposure_us x y z led speed_m_s still_s        (led 1 = lit; still_s = time since
+//                                                                 the pen stopped, 0 while moving)
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "engine/common.hpp"
+#include "engine/input_log.hpp"
+#include "systems/tracking/calibration.hpp"
+#include "systems/tracking/camera.hpp"
+#include "systems/tracking/track.hpp"
+
+namespace fire::tracking {
+
+struct RigOptions {
+  uint64_t seed = 1;               // noise, timing, motion, dropouts, stray, occlusions
+  uint64_t rig_seed = 1;           // the true cameras: calibrate and track sessions of one rig share it
+  double baseline_m = 0.5;         // distance between the two cameras
+  double target_distance_m = 0.8;  // both cameras converge on (0, 0, target_distance)
+  double focal_px = 1330;          // mean true focal length; each camera differs by up to 1 %
+  double focal_error = 0;          // the nominal (starting) focal lengths are true * (1 + focal_error)
+  double k1 = 0.03, k2 = 0;        // radial distortion of the true cameras (k1 varies by 20 % per camera)
+  double noise_px = 0.3;           // Gaussian blob noise per coordinate, before rounding to integers
+  double rate_hz = 100;            // nominal report rate
+  double drift_ppm = 100;          // camera 1's crystal runs this much faster than camera 0's
+  double latency_ms = 6;           // camera 0's report latency
+  double clock_offset_ms = 2;      // camera 1's extra latency
+  double jitter_ms = 0.3;          // standard deviation of the arrival jitter
+  double dropout = 0.005;          // probability that a report is lost
+  double stray = 0.25;             // fraction of the time camera 1 sees a stray reflection
+  double occlusion_per_s = 0;      // rate of brief hand occlusions (50 to 300 ms) per camera
+};
+
+struct WandOptions {
+  double duration_s = 60;
+  double length_m = 0.3;
+};
+
+struct SketchOptions {
+  double duration_s = 60;  // the session stops after this even if strokes remain
+  int strokes = 12;
+  double speed_m_s = 0.5;
+  double hold_s = 1.0;    // the pen rests this long, lit, at both ends of every stroke
+  double height_m = 0.2;  // the object is scaled to this height (its +z axis is up)
+  std::string mesh_name = "pawn.obj";  // recorded in the log's meta
+};
+
+// A polygon mesh passed in by the caller (systems read no files).
+struct MeshView {
+  std::span<const Vec3> positions;
+  std::span<const uint32_t> face_offsets;   // face f: face_vertices[face_offsets[f] .. face_offsets[f+1])
+  std::span<const uint32_t> face_vertices;  // 0-based
+};
+
+struct SimulationStats {
+  std::array<size_t, 2> reports{};  // written per device
+  std::array<size_t, 2> dropped{};  // lost per device
+  size_t led_images = 0;            // lit LEDs in front of a camera, summed over its frames
+  size_t occluded = 0;              // of those, hidden by the object or a hand
+  size_t out_of_view = 0;           // of those, imaged outside the 1024 x 768 image
+  size_t merged = 0;                // blob pairs merged because they fell within one sensor pixel
+  size_t stray_frames = 0;          // frames showing the stray reflection
+  int strokes = 0;                  // sketch: strokes drawn
+  double duration_s = 0;
+};
+
+struct SimulatedSession {
+  std::vector<InputEvent> events;  // in log order (format_input_log writes them)
+  SimulationStats stats;
+};
+
+// The accuracy rig: the true cameras and the intrinsics calibration is told to start from.
+struct SimulatedRig {
+  std::array<Camera, 2> cameras;
+  std::array<Intrinsics, 2> nominal;
+};
+Result<SimulatedRig> make_simulated_rig(const RigOptions& rig);
+
+Result<SimulatedSession> simulate_wand(const RigOptions& rig, const WandOptions& wand);
+Result<SimulatedSession> simulate_sketch(const RigOptions& rig, const SketchOptions& sketch, const MeshView& mesh);
+
+// What a simulated log says about itself, read back from its truth and meta lines.
+struct PenTruth {
+  int device = 0;
+  int64_t t_us = 0;  // the report's logged arrival time (the key to match a report)
+  Vec3 position = Vec3::Zero();
+  bool lit = false;
+  double speed_m_s = 0;
+  double still_s = 0;
+};
+struct SessionTruth {
+  bool has_cameras = false;
+  std::array<Camera, 2> cameras;
+  std::array<bool, 2> has_nominal{};
+  std::array<Intrinsics, 2> nominal{};
+  bool has_wand_length = false;
+  double wand_length_m = 0;
+  bool has_clocks = false;
+  std::array<double, 2> latency_us{};
+  std::vector<PenTruth> pen;  // in log order
+  size_t rejected_lines = 0;  // truth or meta lines of known names with a wrong count or non-finite numbers
+};
+SessionTruth read_session_truth(std::span<const InputEvent> events);
+
+struct ErrorStats {
+  size_t samples = 0;
+  double rms_mm = 0;
+  double max_mm = 0;
+};
+
+struct PenAccuracy {
+  ErrorStats static_filtered;    // the pen resting for at least settle_s
+  ErrorStats settling_filtered;  // the pen resting for less than settle_s (the filter catching up)
+  ErrorStats dynamic_filtered;   // the pen moving
+  ErrorStats static_raw, dynamic_raw;  // the same before the One Euro filter
+  size_t unmatched = 0;  // samples whose report has no pen truth line
+  size_t phantom = 0;    // samples taken while the truth says the LED was off
+  // The same after registering the rig's frame to the truth as a user registers it to the object,
+  // by resting the pen on known points: each hold's mean filtered position against its true
+  // position (register_rigid). This removes what no wand can observe (a small rotation of the
+  // whole rig about camera 0, from its principal point) and keeps every other error.
+  bool registered = false;
+  size_t registration_points = 0;
+  double registration_rms_mm = 0;
+  ErrorStats registered_static, registered_dynamic;
+};
+
+// Compares each sample with the pen's true position at its camera 0 report's exposure. The truth
+// is moved into camera 0's frame with camera 0's true pose (X_cam0 = R0 X + t0): the calibrated
+// rig has camera 0 at its origin, so no registration stands between the two. Fails when the
+// log has no camera truth.
+Result<PenAccuracy> evaluate_pen_accuracy(const PenTrack& track, const CameraFrames& cam0, const SessionTruth& truth,
+                                          double settle_s);
+
+// How far a calibrated rig is from the simulator's cameras (camera 1 relative to camera 0).
+struct RigErrors {
+  double baseline_error_mm = 0;   // |t| of the calibrated rig minus the true camera distance
+  double rotation_error_deg = 0;  // angle of R_cal^T R_true
+  double direction_error_deg = 0; // angle between the baselines
+  std::array<double, 2> focal_error_px{};  // mean of fx and fy errors
+  std::array<double, 2> principal_point_error_px{};
+  std::array<double, 2> k1_error{};
+};
+Result<RigErrors> compare_rig(const CalibrationResult& rig, const SessionTruth& truth);
+
+}  // namespace fire::tracking

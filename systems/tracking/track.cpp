@@ -1,0 +1,543 @@
+#include "systems/tracking/track.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace fire::tracking {
+namespace {
+
+constexpr double kMatchGatePx = 60.0;     // farthest a blob moves between two frames (about 2 m/s at 0.8 m)
+constexpr double kMaxFrameGap = 2.5;      // interpolate across one lost report, not across more
+constexpr double kEpipolarCapPx = 5.0;    // a blob farther than this from its epipolar line counts as this far
+constexpr double kJumpGate_m = 0.02;      // pen positions this far apart are different things
+constexpr double kMaxPenSpeed_m_s = 5.0;  // a hand moves the pen no faster
+constexpr double kMovingPx = 1.5;         // a blob moving less per frame says little about timing
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+// Typical spacing of a camera's frames on its fitted clock.
+double frame_period_us(const CameraFrames& f) {
+  std::vector<double> d;
+  for (size_t k = 1; k < f.size(); ++k) d.push_back(f.t_frame_us[k] - f.t_frame_us[k - 1]);
+  return median(std::move(d));
+}
+
+// For each frame, the blob of the next frame each of its blobs continues as (-1: none).
+// A match must be mutual, within the gate, and clearly nearer than any other candidate.
+using BlobLinks = std::vector<std::array<int8_t, kIrSlots>>;
+
+BlobLinks link_blobs(const CameraFrames& f) {
+  BlobLinks links(f.size());
+  for (size_t k = 0; k < f.size(); ++k) {
+    links[k].fill(-1);
+    if (k + 1 == f.size()) break;
+    const int na = f.blob_count[k], nb = f.blob_count[k + 1];
+    auto nearest = [](const std::array<Vec2, kIrSlots>& from, int n, const Vec2& p, double& d1, double& d2) {
+      int best = -1;
+      d1 = d2 = std::numeric_limits<double>::infinity();
+      for (int j = 0; j < n; ++j) {
+        const double d = (from[j] - p).norm();
+        if (d < d1) {
+          d2 = d1;
+          d1 = d;
+          best = j;
+        } else if (d < d2) {
+          d2 = d;
+        }
+      }
+      return best;
+    };
+    for (int i = 0; i < na; ++i) {
+      double d1, d2, e1, e2;
+      const int j = nearest(f.blobs[k + 1], nb, f.blobs[k][i], d1, d2);
+      if (j < 0 || d1 > kMatchGatePx || !(d1 < 0.5 * d2)) continue;
+      if (nearest(f.blobs[k], na, f.blobs[k + 1][j], e1, e2) != i || !(e1 < 0.5 * e2)) continue;
+      links[k][i] = static_cast<int8_t>(j);
+    }
+  }
+  return links;
+}
+
+// Camera 1's blobs at instant t, interpolated between the frames that bracket it.
+struct Interpolated {
+  int count = 0;
+  std::array<Vec2, kIrSlots> px;
+  std::array<int, kIrSlots> source;  // blob index in the earlier frame
+  size_t frame = 0;                  // the earlier frame
+  double s = 0;                      // fraction of the way to the later frame
+};
+
+class Interpolator {
+ public:
+  explicit Interpolator(const CameraFrames& f) : f_(f), links_(link_blobs(f)), max_gap_us_(kMaxFrameGap * frame_period_us(f)) {}
+
+  bool at(double t, Interpolated& out) const {
+    out.count = 0;
+    const auto it = std::upper_bound(f_.t_frame_us.begin(), f_.t_frame_us.end(), t);
+    if (it == f_.t_frame_us.begin() || it == f_.t_frame_us.end()) return false;
+    const size_t j = static_cast<size_t>(it - f_.t_frame_us.begin()) - 1;
+    const double t0 = f_.t_frame_us[j], t1 = f_.t_frame_us[j + 1];
+    if (t1 - t0 > max_gap_us_) return false;
+    out.frame = j;
+    out.s = (t - t0) / (t1 - t0);
+    for (int i = 0; i < f_.blob_count[j]; ++i) {
+      const int8_t next = links_[j][i];
+      if (next < 0) continue;
+      const Vec2& a = f_.blobs[j][i];
+      const Vec2& b = f_.blobs[j + 1][next];
+      out.px[out.count] = a + out.s * (b - a);
+      out.source[out.count] = i;
+      ++out.count;
+    }
+    return out.count > 0;
+  }
+  const BlobLinks& links() const { return links_; }
+  double max_gap_us() const { return max_gap_us_; }
+
+ private:
+  const CameraFrames& f_;
+  BlobLinks links_;
+  double max_gap_us_;
+};
+
+Eigen::Matrix3d skew(const Vec3& v) {
+  Eigen::Matrix3d S;
+  S << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return S;
+}
+
+// Sampson distance to x1^T E x0 = 0 in normalized coordinates.
+double sampson(const Eigen::Matrix3d& E, const Vec2& n0, const Vec2& n1) {
+  const Vec3 a = n0.homogeneous(), b = n1.homogeneous();
+  const Vec3 Ea = E * a, Etb = E.transpose() * b;
+  const double denom = Ea.head<2>().squaredNorm() + Etb.head<2>().squaredNorm();
+  return denom > 0 ? std::abs(b.dot(Ea)) / std::sqrt(denom) : std::numeric_limits<double>::infinity();
+}
+
+}  // namespace
+
+DeviceStreams decode_device_streams(std::span<const InputEvent> events) {
+  DeviceStreams out;
+  ReportCounts& c = out.counts;
+  for (const InputEvent& e : events) {
+    if (e.kind != EventKind::Hid) continue;
+    if (!e.hid_ok) {
+      ++c.garbled;
+      continue;
+    }
+    if (e.device != 0 && e.device != 1) {
+      ++c.unknown_device;
+      continue;
+    }
+    const DecodedReport r = decode_ir_report(e.bytes);
+    switch (r.status) {
+      case ReportStatus::Empty: ++c.garbled; continue;
+      case ReportStatus::NotIr: ++c.not_ir; continue;
+      case ReportStatus::BadLength: ++c.bad_length; continue;
+      case ReportStatus::UnknownId: ++c.unknown_id; continue;
+      case ReportStatus::Ok: break;
+    }
+    ++c.ir_reports;
+    c.out_of_range_slots += static_cast<size_t>(r.out_of_range_slots);
+    CameraFrames& f = out.cameras[e.device];
+    std::array<Vec2, kIrSlots> blobs;
+    blobs.fill(Vec2::Zero());
+    uint8_t n = 0;
+    for (const IrSlot& s : r.report.slots)
+      if (s.seen) blobs[n++] = Vec2(s.x, s.y);
+    f.t_us.push_back(e.t_us);
+    f.t_frame_us.push_back(static_cast<double>(e.t_us));
+    f.blob_count.push_back(n);
+    f.blobs.push_back(blobs);
+  }
+  return out;
+}
+
+void fit_frame_clock(CameraFrames& f) {
+  const size_t n = f.size();
+  for (size_t k = 0; k < n; ++k) f.t_frame_us[k] = static_cast<double>(f.t_us[k]);
+  if (n < 3) return;
+  std::vector<double> gaps;
+  for (size_t k = 1; k < n; ++k)
+    if (f.t_us[k] > f.t_us[k - 1]) gaps.push_back(static_cast<double>(f.t_us[k] - f.t_us[k - 1]));
+  const double period = median(gaps);
+  if (!(period > 0)) return;
+  // Frame numbers: a phase-locked loop on the regular clock tolerates jitter up to half a period
+  // in any one report, where counting the gaps between neighbours would not. A report later than
+  // that looks like one after a lost report; when the next one then falls in the same slot, the
+  // earlier one was late, and it gets its slot back.
+  std::vector<double> number(n, 0.0);
+  double predicted = static_cast<double>(f.t_us[0]);
+  double last_gap = 1;
+  for (size_t k = 1; k < n; ++k) {
+    const double t = static_cast<double>(f.t_us[k]);
+    double gap = std::round((t - predicted) / period);
+    if (gap <= 0 && last_gap >= 2) {
+      number[k - 1] -= 1;
+      predicted -= period;
+      gap = std::round((t - predicted) / period);
+    }
+    gap = std::max(1.0, gap);
+    number[k] = number[k - 1] + gap;
+    predicted += gap * period;
+    predicted += 0.1 * (t - predicted);
+    last_gap = gap;
+  }
+  constexpr ptrdiff_t kHalfWindow = 200;  // +-2 s: long enough to average the jitter, short for slow drift
+  const double t_origin = static_cast<double>(f.t_us[0]);
+  auto arrival = [&](size_t i) { return static_cast<double>(f.t_us[i]) - t_origin; };
+  // Per report, the least-squares line t = a + b n through its neighbours.
+  std::vector<Eigen::Vector2d> line(n);
+  auto fit = [&] {
+    for (ptrdiff_t k = 0; k < static_cast<ptrdiff_t>(n); ++k) {
+      const auto lo = static_cast<size_t>(std::max<ptrdiff_t>(0, k - kHalfWindow));
+      const auto hi = static_cast<size_t>(std::min<ptrdiff_t>(static_cast<ptrdiff_t>(n) - 1, k + kHalfWindow));
+      double mean_n = 0, mean_t = 0;
+      for (size_t i = lo; i <= hi; ++i) {
+        mean_n += number[i];
+        mean_t += arrival(i);
+      }
+      const double count = static_cast<double>(hi - lo + 1);
+      mean_n /= count;
+      mean_t /= count;
+      double snn = 0, snt = 0;
+      for (size_t i = lo; i <= hi; ++i) {
+        snn += (number[i] - mean_n) * (number[i] - mean_n);
+        snt += (number[i] - mean_n) * (arrival(i) - mean_t);
+      }
+      const double slope = snn > 0 ? snt / snn : period;
+      line[static_cast<size_t>(k)] = Eigen::Vector2d(mean_t - slope * mean_n, slope);
+    }
+  };
+  fit();
+  // The loop can still number a report one off (one early right after a lost one takes the lost
+  // one's number): choose every report's number within one of the loop's, increasing, so that the
+  // arrivals sit closest to their lines (a Viterbi pass over three states per report), and refit.
+  auto miss = [&](size_t k, int j) {
+    const double r = arrival(k) - (line[k](0) + line[k](1) * (number[k] + j));
+    return r * r;
+  };
+  std::vector<std::array<double, 3>> cost(n);
+  std::vector<std::array<int8_t, 3>> from(n);
+  for (int j = 0; j < 3; ++j) cost[0][j] = miss(0, j - 1);
+  for (size_t k = 1; k < n; ++k)
+    for (int j = 0; j < 3; ++j) {
+      cost[k][j] = std::numeric_limits<double>::infinity();
+      for (int i = 0; i < 3; ++i)
+        if (number[k - 1] + (i - 1) < number[k] + (j - 1) && cost[k - 1][i] < cost[k][j]) {
+          cost[k][j] = cost[k - 1][i];
+          from[k][j] = static_cast<int8_t>(i);
+        }
+      cost[k][j] += miss(k, j - 1);
+    }
+  int state = static_cast<int>(std::min_element(cost[n - 1].begin(), cost[n - 1].end()) - cost[n - 1].begin());
+  bool renumbered = false;
+  for (size_t k = n; k-- > 0;) {
+    renumbered |= state != 1;
+    const int previous = k > 0 ? from[k][state] : 1;
+    number[k] += state - 1;
+    state = previous;
+  }
+  if (renumbered) fit();
+  for (size_t k = 0; k < n; ++k) {
+    const double t = t_origin + line[k](0) + line[k](1) * number[k];
+    f.t_frame_us[k] = k == 0 ? t : std::max(t, f.t_frame_us[k - 1] + 1.0);
+  }
+}
+
+size_t remove_static_blobs(CameraFrames& f, double radius_px, int min_frames) {
+  const size_t n = f.size();
+  auto has_blob_near = [&](size_t k, const Vec2& p) {
+    for (int i = 0; i < f.blob_count[k]; ++i)
+      if ((f.blobs[k][i] - p).norm() <= radius_px) return true;
+    return false;
+  };
+  std::vector<std::array<bool, kIrSlots>> still(n);
+  const auto need = static_cast<size_t>(std::max(2, min_frames));  // one frame proves nothing still
+  for (size_t k = 0; k < n; ++k) {
+    still[k].fill(false);
+    for (int i = 0; i < f.blob_count[k]; ++i) {
+      const Vec2 p = f.blobs[k][i];
+      size_t run = 1;
+      for (size_t j = k; j > 0 && run < need && has_blob_near(j - 1, p); --j) ++run;
+      for (size_t j = k + 1; j < n && run < need && has_blob_near(j, p); ++j) ++run;
+      still[k][i] = run >= need;
+    }
+  }
+  size_t removed = 0;
+  for (size_t k = 0; k < n; ++k) {
+    uint8_t kept = 0;
+    for (int i = 0; i < f.blob_count[k]; ++i) {
+      if (still[k][i]) {
+        ++removed;
+        continue;
+      }
+      f.blobs[k][kept++] = f.blobs[k][i];
+    }
+    f.blob_count[k] = kept;
+  }
+  return removed;
+}
+
+TimeOffsetEstimate estimate_time_offset(const DeviceStreams& streams, const Camera& c0, const Camera& c1,
+                                        double search_us) {
+  TimeOffsetEstimate out;
+  const CameraFrames& f0 = streams.cameras[0];
+  const CameraFrames& f1 = streams.cameras[1];
+  if (f0.size() < 3 || f1.size() < 3 || !(search_us > 0)) return out;
+  const Eigen::Matrix3d R = c1.R * c0.R.transpose();
+  const Vec3 t = c1.t - R * c0.t;
+  const Eigen::Matrix3d E = skew(t) * R;
+  const double focal = 0.25 * (c0.K.fx + c0.K.fy + c1.K.fx + c1.K.fy);
+
+  // Moving camera 0 blobs carry the timing; resting ones fit every offset alike.
+  const Interpolator cam1(f1);
+  const Interpolator cam0(f0);
+  struct Sample {
+    double t;
+    Vec2 n0;
+  };
+  std::vector<Sample> samples;
+  for (size_t k = 0; k + 1 < f0.size(); ++k) {
+    if (f0.t_frame_us[k + 1] - f0.t_frame_us[k] > cam0.max_gap_us()) continue;
+    for (int i = 0; i < f0.blob_count[k]; ++i) {
+      const int8_t next = cam0.links()[k][i];
+      if (next < 0 || (f0.blobs[k + 1][next] - f0.blobs[k][i]).norm() < kMovingPx) continue;
+      samples.push_back({f0.t_frame_us[k], c0.undistort_normalized(f0.blobs[k][i])});
+    }
+  }
+  out.samples = samples.size();
+  if (samples.size() < 30) return out;
+
+  auto cost = [&](double offset) {
+    double sum = 0;
+    Interpolated ip;
+    for (const Sample& s : samples) {
+      double best = kEpipolarCapPx;
+      if (cam1.at(s.t + offset, ip))
+        for (int j = 0; j < ip.count; ++j)
+          best = std::min(best, focal * sampson(E, s.n0, c1.undistort_normalized(ip.px[j])));
+      sum += best;
+    }
+    return sum / static_cast<double>(samples.size());
+  };
+  constexpr double kStep = 1000.0;
+  std::vector<double> grid;
+  double best_offset = 0, best_cost = std::numeric_limits<double>::infinity();
+  for (double d = -std::floor(search_us / kStep) * kStep; d <= search_us; d += kStep) {
+    const double c = cost(d);
+    grid.push_back(c);
+    if (c < best_cost) {
+      best_cost = c;
+      best_offset = d;
+    }
+  }
+  // Golden-section refinement within one grid step either side.
+  const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
+  double a = best_offset - kStep, b = best_offset + kStep;
+  double x1 = b - phi * (b - a), x2 = a + phi * (b - a);
+  double f1c = cost(x1), f2c = cost(x2);
+  while (b - a > 1.0) {
+    if (f1c < f2c) {
+      b = x2;
+      x2 = x1;
+      f2c = f1c;
+      x1 = b - phi * (b - a);
+      f1c = cost(x1);
+    } else {
+      a = x1;
+      x1 = x2;
+      f1c = f2c;
+      x2 = a + phi * (b - a);
+      f2c = cost(x2);
+    }
+  }
+  const double refined = 0.5 * (a + b);
+  const double refined_cost = cost(refined);
+  if (refined_cost < best_cost) {
+    best_cost = refined_cost;
+    best_offset = refined;
+  }
+  out.offset_us = best_offset;
+  out.cost_px = best_cost;
+  out.cost_at_zero_px = cost(0.0);
+  out.observable = best_cost < 0.7 * median(grid);
+  return out;
+}
+
+WandExtraction extract_wand_observations(const DeviceStreams& streams, double cam1_offset_us) {
+  WandExtraction out;
+  const CameraFrames& f0 = streams.cameras[0];
+  const CameraFrames& f1 = streams.cameras[1];
+  out.frames = f0.size();
+  if (f1.size() < 2) {
+    for (size_t k = 0; k < f0.size(); ++k) (f0.blob_count[k] == 2 ? out.no_partner : out.not_two_blobs)++;
+    return out;
+  }
+  const Interpolator cam1(f1);
+  Interpolated ip;
+  for (size_t k = 0; k < f0.size(); ++k) {
+    if (f0.blob_count[k] != 2) {
+      ++out.not_two_blobs;
+      continue;
+    }
+    if (!cam1.at(f0.t_frame_us[k] + cam1_offset_us, ip) || ip.count != 2 || f1.blob_count[ip.frame] != 2 ||
+        f1.blob_count[ip.frame + 1] != 2) {
+      ++out.no_partner;
+      continue;
+    }
+    WandObservation o;
+    o.t_us = std::llround(f0.t_frame_us[k]);
+    o.cam0 = {f0.blobs[k][0], f0.blobs[k][1]};
+    o.cam1 = {ip.px[0], ip.px[1]};
+    out.observations.push_back(o);
+  }
+  return out;
+}
+
+Result<WandCalibration> calibrate_wand_streams(DeviceStreams streams, const CalibrationOptions& options) {
+  using R = Result<WandCalibration>;
+  WandCalibration out;
+  for (CameraFrames& f : streams.cameras) {
+    fit_frame_clock(f);
+    out.static_blobs_removed += remove_static_blobs(f);
+  }
+  // Calibrate with no offset, read the offset off the rig, calibrate again with it; the
+  // rig improves with the offset and the offset with the rig, so repeat until it settles.
+  constexpr int kMaxRounds = 4;
+  constexpr double kSettled_us = 50.0;
+  double offset = 0;
+  for (int round = 1; round <= kMaxRounds; ++round) {
+    out.extraction = extract_wand_observations(streams, offset);
+    Result<CalibrationResult> rig = calibrate_wand(out.extraction.observations, options);
+    if (!rig)
+      return R::failure(rig.error() + " (" + std::to_string(out.extraction.observations.size()) + " of " +
+                        std::to_string(out.extraction.frames) + " camera 0 frames gave wand observations)");
+    out.rig = *rig;
+    out.calibrations = round;
+    out.time_offset_used_us = offset;
+    out.time_offset = estimate_time_offset(streams, rig->cam0, rig->cam1);
+    if (!out.time_offset.observable || std::abs(out.time_offset.offset_us - offset) < kSettled_us) break;
+    offset = out.time_offset.offset_us;
+  }
+  return out;
+}
+
+PenTrack track_pen(const DeviceStreams& streams, const Camera& c0, const Camera& c1, double cam1_offset_us,
+                   const PenTrackOptions& options) {
+  PenTrack out;
+  const CameraFrames& f0 = streams.cameras[0];
+  const CameraFrames& f1 = streams.cameras[1];
+  if (f0.size() == 0 || f1.size() < 2) return out;
+  const Interpolator cam1(f1);
+  Interpolated ip;
+  OneEuroState filter;
+  bool down = false;
+  double last_sample_t = -std::numeric_limits<double>::infinity();
+  Vec3 last_position = Vec3::Zero();
+  for (size_t k = 0; k < f0.size(); ++k) {
+    const double t = f0.t_frame_us[k];
+    if (down && t - last_sample_t > static_cast<double>(options.max_gap_us)) down = false;
+    if (f0.blob_count[k] == 0 || !cam1.at(t + cam1_offset_us, ip)) continue;
+    ++out.frames_seen_by_both;
+    // Epipolar lines run along the baseline, so a stray blob level with the LED in the other
+    // camera also fits the geometry. While the pen is down the candidate nearest its last
+    // position wins; a stroke only starts from a frame where every fitting pair agrees.
+    std::array<Triangulation, kIrSlots * kIrSlots> fits;
+    int fit_count = 0;
+    for (int i = 0; i < f0.blob_count[k]; ++i)
+      for (int j = 0; j < ip.count; ++j) {
+        const Triangulation tri =
+            triangulate(c0, c1, f0.blobs[k][i], ip.px[j], options.method, options.max_reprojection_px);
+        if (tri.accepted) fits[fit_count++] = tri;
+      }
+    if (fit_count == 0) {
+      ++out.rejected_reprojection;
+      continue;
+    }
+    const Triangulation* best = nullptr;
+    if (down) {
+      const double gate = kJumpGate_m + kMaxPenSpeed_m_s * (t - last_sample_t) * 1e-6;
+      for (int c = 0; c < fit_count; ++c)
+        if ((fits[c].X - last_position).norm() <= gate &&
+            (!best || (fits[c].X - last_position).norm() < (best->X - last_position).norm()))
+          best = &fits[c];
+      if (!best) {
+        ++out.rejected_jump;
+        continue;
+      }
+    } else {
+      best = &fits[0];
+      for (int c = 1; c < fit_count; ++c) {
+        if ((fits[c].X - best->X).norm() > kJumpGate_m) best = nullptr;
+        if (!best) break;
+        if (fits[c].reprojection_error_px < best->reprojection_error_px) best = &fits[c];
+      }
+      if (!best) {
+        ++out.ambiguous;
+        continue;
+      }
+    }
+    if (!down) {
+      down = true;
+      ++out.strokes;
+      filter = OneEuroState{};
+    }
+    const int64_t t_us = std::llround(t);
+    const std::optional<Vec3> smooth = one_euro_step(filter, options.filter, t_us, best->X);
+    if (!smooth) {
+      ++out.rejected_filter;
+      continue;
+    }
+    out.samples.push_back({t_us, out.strokes - 1, static_cast<uint32_t>(k), best->X, *smooth, best->reprojection_error_px});
+    last_sample_t = t;
+    last_position = best->X;
+  }
+  return out;
+}
+
+std::vector<InputEvent> pen_events(const PenTrack& track, const StrokeShaping& shaping) {
+  std::vector<InputEvent> out;
+  auto event = [](int64_t t, EventKind kind, const Vec3& p = Vec3::Zero()) {
+    InputEvent e;
+    e.t_us = t;
+    e.kind = kind;
+    e.p = p;
+    return e;
+  };
+  size_t i = 0;
+  while (i < track.samples.size()) {
+    size_t end = i;
+    while (end < track.samples.size() && track.samples[end].stroke == track.samples[i].stroke) ++end;
+    TimedPolyline stroke;
+    for (size_t k = i; k < end; ++k) {
+      stroke.t_us.push_back(track.samples[k].t_us);
+      stroke.points.push_back(track.samples[k].filtered);
+    }
+    if (shaping.simplify_tolerance > 0) {
+      TimedPolyline kept;
+      for (size_t k : rdp_simplify(stroke.points, shaping.simplify_tolerance)) {
+        kept.t_us.push_back(stroke.t_us[k]);
+        kept.points.push_back(stroke.points[k]);
+      }
+      stroke = std::move(kept);
+    }
+    if (shaping.resample_spacing > 0) stroke = resample_by_arc_length(stroke, shaping.resample_spacing);
+    if (!stroke.points.empty()) {
+      out.push_back(event(stroke.t_us.front(), EventKind::Down));
+      for (size_t k = 0; k < stroke.points.size(); ++k) out.push_back(event(stroke.t_us[k], EventKind::Pen, stroke.points[k]));
+      out.push_back(event(stroke.t_us.back(), EventKind::Up));
+    }
+    i = end;
+  }
+  return out;
+}
+
+}  // namespace fire::tracking

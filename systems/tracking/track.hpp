@@ -1,0 +1,141 @@
+#pragma once
+// From logged device reports to what the engine consumes: pen samples with down/up, and the
+// time-aligned wand observations that calibration needs.
+//
+// Time. The two remotes are not synchronized and their reports carry no timestamps; each report
+// is logged when it reaches the host. Per camera, the remote's regular frame clock is recovered
+// from those arrival times (fit_frame_clock). What no timestamp shows is the difference of the
+// two cameras' latencies; it is estimated from the geometry (estimate_time_offset): moving blobs
+// only satisfy the epipolar constraint when camera 1's track is read at the right instant.
+// Camera 1's blob tracks are then interpolated to camera 0's instants before triangulating.
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "engine/common.hpp"
+#include "engine/input_log.hpp"
+#include "systems/tracking/calibration.hpp"
+#include "systems/tracking/camera.hpp"
+#include "systems/tracking/hid.hpp"
+#include "systems/tracking/signal.hpp"
+#include "systems/tracking/triangulation.hpp"
+
+namespace fire::tracking {
+
+// The IR reports of one camera, one entry per report (structure of arrays).
+struct CameraFrames {
+  std::vector<int64_t> t_us;       // host arrival time, as logged (the key to the report's line)
+  std::vector<double> t_frame_us;  // the remote's frame clock on the host's time axis (fit_frame_clock)
+  std::vector<uint8_t> blob_count;
+  std::vector<std::array<Vec2, kIrSlots>> blobs;  // the seen blobs first, in slot order
+  size_t size() const { return t_us.size(); }
+};
+
+struct DeviceStreams {
+  std::array<CameraFrames, 2> cameras;
+  ReportCounts counts;
+};
+
+// Decodes every `hid` event of devices 0 and 1; garbled, truncated, unknown and out-of-range
+// input is counted in `counts` and skipped, never fatal. t_frame_us starts as the arrival time.
+DeviceStreams decode_device_streams(std::span<const InputEvent> events);
+
+// Replaces arrival jitter by the remote's regular clock: frame numbers follow from the gaps
+// between reports (a lost report leaves a gap of two periods), then each report's instant is
+// read off a least-squares line through (frame number, arrival time) over its neighbours.
+void fit_frame_clock(CameraFrames& frames);
+
+// Drops blobs that stay within `radius_px` of where they are for `min_frames` consecutive
+// frames: stray reflections and lamps stand still, a waved wand does not. For wand logs only
+// (a pen rests on purpose). Returns the number of blobs dropped.
+size_t remove_static_blobs(CameraFrames& frames, double radius_px = 2.5, int min_frames = 50);
+
+struct TimeOffsetEstimate {
+  double offset_us = 0;         // camera 1 logs an instant this much later than camera 0 does
+  double cost_px = 0;           // mean capped epipolar distance at the offset
+  double cost_at_zero_px = 0;   // the same with no offset
+  size_t samples = 0;           // moving camera 0 blobs that entered the cost
+  bool observable = false;      // the cost has a clear minimum (the blobs moved enough)
+};
+
+// Searches offsets within +-search_us for the one that makes moving blobs fit the rig's
+// epipolar geometry best, each camera 0 blob against the nearest interpolated camera 1 blob.
+TimeOffsetEstimate estimate_time_offset(const DeviceStreams& streams, const Camera& c0, const Camera& c1,
+                                        double search_us = 50000);
+
+// --- calibration data ---
+
+struct WandExtraction {
+  std::vector<WandObservation> observations;
+  size_t frames = 0;          // camera 0 frames
+  size_t not_two_blobs = 0;   // camera 0 frames without exactly two blobs
+  size_t no_partner = 0;      // camera 1 could not be interpolated to the instant with two tracked blobs
+};
+
+// One observation per camera 0 frame that shows exactly the two LEDs while camera 1 shows them
+// in the frames just before and after its instant (+ cam1_offset_us): camera 1's blobs are
+// matched between those frames and interpolated. Frames with a third blob are skipped: run
+// remove_static_blobs first so a stray reflection costs nothing.
+WandExtraction extract_wand_observations(const DeviceStreams& streams, double cam1_offset_us);
+
+struct WandCalibration {
+  CalibrationResult rig;
+  double time_offset_used_us = 0;  // the offset the final calibration's observations used
+  TimeOffsetEstimate time_offset;   // estimated from the final rig
+  int calibrations = 0;        // rounds of calibration with a refined time offset
+  WandExtraction extraction;   // of the last round
+  size_t static_blobs_removed = 0;
+};
+
+// The whole pipeline for a wand log: frame clocks, stray blobs, observations, calibration;
+// then the time offset from the calibrated rig and calibration again until it settles.
+Result<WandCalibration> calibrate_wand_streams(DeviceStreams streams, const CalibrationOptions& options);
+
+// --- the pen ---
+
+struct PenTrackOptions {
+  TriangulationMethod method = TriangulationMethod::Optimal;
+  double max_reprojection_px = 2.0;
+  // Tuned on the simulated rig (perf/RESULTS.md): the static error falls, the error at 0.5 m/s
+  // grows by a few tenths of a millimetre of lag.
+  OneEuroParams filter{.min_cutoff_hz = 1.0, .beta = 300.0, .derivative_cutoff_hz = 2.0};
+  int64_t max_gap_us = 60000;  // the pen stays down through shorter losses of the LED
+};
+
+struct PenSample {
+  int64_t t_us = 0;         // camera 0's frame instant, rounded
+  uint32_t stroke = 0;
+  uint32_t cam0_frame = 0;  // index into camera 0's frames: the report it came from
+  Vec3 raw = Vec3::Zero();       // triangulated, in the rig's frame (camera 0's), metres
+  Vec3 filtered = Vec3::Zero();  // after the One Euro filter
+  double reprojection_px = 0;
+};
+
+struct PenTrack {
+  std::vector<PenSample> samples;
+  uint32_t strokes = 0;
+  size_t frames_seen_by_both = 0;    // camera 0 frames with a blob in both cameras
+  size_t rejected_reprojection = 0;  // of those, no blob pair within the reprojection threshold
+  size_t rejected_jump = 0;          // pen down, but every fitting pair far from the last position
+  size_t ambiguous = 0;              // pen up, and fitting pairs that disagree (a stray blob on the LED's epipolar line)
+  size_t rejected_filter = 0;        // samples the filter refused (non-finite, or time not advancing)
+};
+
+// The pen is down while both cameras see its LED (shorter gaps than max_gap_us are bridged).
+// Each camera 0 blob is paired with each interpolated camera 1 blob and triangulated; pairs
+// beyond the reprojection threshold are rejected, and of the rest the one nearest the pen's last
+// position is the pen, so a stray reflection in one camera is ignored. Samples are filtered per stroke.
+PenTrack track_pen(const DeviceStreams& streams, const Camera& c0, const Camera& c1, double cam1_offset_us,
+                   const PenTrackOptions& options);
+
+struct StrokeShaping {
+  double simplify_tolerance = 0;  // Ramer-Douglas-Peucker, metres; 0 keeps every sample
+  double resample_spacing = 0;    // arc-length resampling, metres; 0 keeps the samples' spacing
+};
+
+// down, pen..., up per stroke, with the filtered positions: a log `fire replay` can consume.
+std::vector<InputEvent> pen_events(const PenTrack& track, const StrokeShaping& shaping = {});
+
+}  // namespace fire::tracking

@@ -1,0 +1,356 @@
+// network_from_mesh: synthetic curve networks from the shared control meshes and hand-made ones.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <map>
+#include <string>
+
+#include "platform/obj.hpp"
+#include "systems/synth/network_from_mesh.hpp"
+
+using namespace fire;
+
+namespace {
+
+const std::string kMeshes = std::string(FIRE_SHARED_DIR) + "/data/meshes/";
+
+PolygonMesh load(const std::string& name) {
+  auto pm = read_obj(kMeshes + name);
+  INFO(pm.error());
+  REQUIRE(pm.ok());
+  return *pm;
+}
+
+PolygonMeshView view_of(const PolygonMesh& pm, std::string_view source) {
+  return {pm.positions, pm.face_offsets, pm.face_vertices, source};
+}
+
+Result<Mesh> network(const PolygonMesh& pm, uint32_t k, double noise = 0, uint64_t seed = 0,
+                     uint32_t samples = kMinSamplesPerEdge) {
+  UnrefineOptions o;
+  o.unrefine = k;
+  o.noise_percent = noise;
+  o.seed = seed;
+  o.samples_per_edge = samples;
+  return network_from_mesh(view_of(pm, "test.obj"), o);
+}
+
+std::map<uint32_t, size_t> face_sizes(const Mesh& m) {
+  std::map<uint32_t, size_t> sizes;
+  for (uint32_t f = 0; f < m.face_slots(); ++f)
+    if (m.face_alive(f)) ++sizes[m.faces.edge_count[f]];
+  return sizes;
+}
+
+bool on_border(const Mesh& m, uint32_t v) {
+  for (uint32_t e : m.vertex_edges(v))
+    if (m.is_border_edge(e)) return true;
+  return false;
+}
+
+PolygonMesh grid(uint32_t n) {  // n x n quads in the plane z = 0, consistently oriented
+  PolygonMesh pm;
+  for (uint32_t y = 0; y <= n; ++y)
+    for (uint32_t x = 0; x <= n; ++x) pm.positions.emplace_back(x, y, 0);
+  auto id = [n](uint32_t x, uint32_t y) { return y * (n + 1) + x; };
+  for (uint32_t y = 0; y < n; ++y)
+    for (uint32_t x = 0; x < n; ++x) {
+      for (uint32_t v : {id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y + 1)}) pm.face_vertices.push_back(v);
+      pm.face_offsets.push_back(uint32_t(pm.face_vertices.size()));
+    }
+  return pm;
+}
+
+double mean_control_edge_length(const PolygonMesh& pm) {
+  std::map<std::pair<uint32_t, uint32_t>, double> lengths;
+  for (size_t f = 0; f < pm.face_count(); ++f)
+    for (uint32_t i = pm.face_offsets[f]; i < pm.face_offsets[f + 1]; ++i) {
+      uint32_t a = pm.face_vertices[i], b = pm.face_vertices[i + 1 < pm.face_offsets[f + 1] ? i + 1 : pm.face_offsets[f]];
+      lengths[{std::min(a, b), std::max(a, b)}] = (pm.positions[a] - pm.positions[b]).norm();
+    }
+  double sum = 0;
+  for (auto& [key, len] : lengths) sum += len;
+  return sum / double(lengths.size());
+}
+
+}  // namespace
+
+TEST_CASE("torus: K=1 keeps every edge, K=2 every other loop", "[synth]") {
+  PolygonMesh torus = load("torus.obj");
+  auto k1 = network(torus, 1);
+  REQUIRE(k1.ok());
+  CHECK(k1->validate().empty());
+  CHECK(k1->face_count() == 32);
+  CHECK(k1->edge_count() == 64);
+  CHECK(k1->vertex_count() == 32);
+  CHECK(face_sizes(*k1) == std::map<uint32_t, size_t>{{4, 32}});
+
+  auto k2 = network(torus, 2);
+  REQUIRE(k2.ok());
+  CHECK(k2->validate().empty());
+  CHECK(k2->face_count() == 8);
+  CHECK(k2->edge_count() == 16);
+  CHECK(k2->vertex_count() == 8);
+  CHECK(face_sizes(*k2) == std::map<uint32_t, size_t>{{4, 8}});
+  // Every network edge of K=2 replaces two control edges: 2 * 8 + 1 points.
+  for (uint32_t e = 0; e < k2->edge_slots(); ++e) CHECK(k2->edges.point_count[e] == 17);
+}
+
+TEST_CASE("exact counts on every shared manifold mesh for K = 1, 2, 3", "[synth]") {
+  // Checked by hand: K=1 reproduces each control mesh. The cube's and the pyramid's vertices are all
+  // extraordinary, so they have no loops to drop. The torus (8 x 4 loops) keeps 4 x 2, then 3 x 2 loops.
+  // The pawn keeps every K-th of its 24 rings from the border and of its 24 meridians, plus the ring of
+  // short loops around its valence-12 pole; border vertices of valence 2 stay (pentagons, hexagons at the
+  // border). The rook's 2-gons are triangles whose third corner was collapsed.
+  struct Expected {
+    const char* mesh;
+    uint32_t k;
+    size_t vertices, edges, faces, points;
+    std::map<uint32_t, size_t> sizes;
+  };
+  const std::vector<Expected> table = {
+      {"cube.obj", 1, 8, 12, 6, 108, {{4, 6}}},
+      {"cube.obj", 2, 8, 12, 6, 108, {{4, 6}}},
+      {"cube.obj", 3, 8, 12, 6, 108, {{4, 6}}},
+      {"pyramid.obj", 1, 5, 8, 5, 72, {{3, 4}, {4, 1}}},
+      {"pyramid.obj", 2, 5, 8, 5, 72, {{3, 4}, {4, 1}}},
+      {"pyramid.obj", 3, 5, 8, 5, 72, {{3, 4}, {4, 1}}},
+      {"torus.obj", 1, 32, 64, 32, 576, {{4, 32}}},
+      {"torus.obj", 2, 8, 16, 8, 272, {{4, 8}}},
+      {"torus.obj", 3, 6, 12, 6, 236, {{4, 6}}},
+      {"pawn.obj", 1, 601, 1188, 588, 10692, {{4, 588}}},
+      {"pawn.obj", 2, 169, 324, 156, 5220, {{3, 12}, {4, 132}, {5, 12}}},
+      {"pawn.obj", 3, 89, 156, 68, 3452, {{4, 60}, {6, 8}}},
+      {"rook.obj", 1, 768, 1544, 777, 13896, {{3, 44}, {4, 733}}},
+      {"rook.obj", 2, 315, 617, 303, 7961, {{2, 5}, {3, 40}, {4, 212}, {5, 44}, {6, 2}}},
+      {"rook.obj", 3, 225, 435, 211, 6115, {{2, 7}, {3, 42}, {4, 122}, {5, 22}, {6, 18}}},
+  };
+  for (const Expected& x : table) {
+    INFO(x.mesh << " K=" << x.k);
+    auto net = network(load(x.mesh), x.k);
+    INFO((net.ok() ? std::string() : net.error()));
+    REQUIRE(net.ok());
+    const Mesh& m = *net;
+    CHECK(m.validate().empty());
+    CHECK(m.vertex_count() == x.vertices);
+    CHECK(m.edge_count() == x.edges);
+    CHECK(m.face_count() == x.faces);
+    CHECK(m.live_point_count() == x.points);
+    CHECK(face_sizes(m) == x.sizes);
+    // Compact: no tombstones.
+    CHECK(m.vertex_slots() == x.vertices);
+    CHECK(m.edge_slots() == x.edges);
+    CHECK(m.face_slots() == x.faces);
+    // Unrefinement keeps the topology: V - E + F of a sphere, a torus, and a disk (pawn, rook).
+    const std::map<std::string, long> euler = {{"cube.obj", 2}, {"pyramid.obj", 2}, {"torus.obj", 0}, {"pawn.obj", 1}, {"rook.obj", 1}};
+    CHECK(long(x.vertices) - long(x.edges) + long(x.faces) == euler.at(x.mesh));
+    // Thesis figure 63: no interior vertex of valence 2 survives.
+    for (uint32_t v = 0; v < m.vertex_slots(); ++v)
+      if (!on_border(m, v)) CHECK(m.valence(v) >= 3);
+  }
+}
+
+TEST_CASE("a 4 x 4 grid unrefined by 2 keeps its border and middle lines", "[synth]") {
+  // Lines 0..4 in each direction; counted from the border (0 1 2 1 0), K=2 keeps lines 0, 2, 4: four
+  // regions of 2 x 2 quads. Border vertices all stay (16), plus the centre; each region has 2 + 2 border
+  // edges and 2 half middle lines.
+  auto net = network(grid(4), 2);
+  REQUIRE(net.ok());
+  const Mesh& m = *net;
+  CHECK(m.validate().empty());
+  CHECK(m.vertex_count() == 17);
+  CHECK(m.edge_count() == 20);
+  CHECK(m.face_count() == 4);
+  CHECK(face_sizes(m) == std::map<uint32_t, size_t>{{6, 4}});
+  size_t long_edges = 0;
+  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+    const bool border = m.is_border_edge(e);
+    CHECK(m.edges.point_count[e] == (border ? 9u : 17u));
+    long_edges += !border;
+  }
+  CHECK(long_edges == 4);
+  uint32_t centre = kNone;
+  for (uint32_t v = 0; v < m.vertex_slots(); ++v)
+    if (m.vertices.position[v] == Vec3(2, 2, 0)) centre = v;
+  REQUIRE(centre != kNone);
+  CHECK(m.valence(centre) == 4);
+
+  // K=3 on 3 x 3 quads keeps only the border: one 12-sided face whose every border vertex stays.
+  auto coarse = network(grid(3), 3);
+  REQUIRE(coarse.ok());
+  CHECK(coarse->validate().empty());
+  CHECK(coarse->vertex_count() == 12);
+  CHECK(coarse->edge_count() == 12);
+  CHECK(face_sizes(*coarse) == std::map<uint32_t, size_t>{{12, 1}});
+}
+
+TEST_CASE("a closed curve with no other vertex keeps two of its vertices", "[synth]") {
+  // Two quads glued along their four edges: every vertex has valence 2, and an edge may not join a
+  // vertex to itself, so two vertices stay and each face is a 2-gon.
+  PolygonMesh pillow;
+  pillow.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0)};
+  pillow.face_vertices = {0, 1, 2, 3, 3, 2, 1, 0};
+  pillow.face_offsets = {0, 4, 8};
+  auto net = network(pillow, 1);
+  REQUIRE(net.ok());
+  CHECK(net->validate().empty());
+  CHECK(net->vertex_count() == 2);
+  CHECK(net->edge_count() == 2);
+  CHECK(face_sizes(*net) == std::map<uint32_t, size_t>{{2, 2}});
+  for (uint32_t e = 0; e < net->edge_slots(); ++e) CHECK(net->edges.point_count[e] == 17);
+}
+
+TEST_CASE("polylines sample the control edges linearly, at least 8 points per edge", "[synth]") {
+  PolygonMesh torus = load("torus.obj");
+  for (uint32_t samples : {8u, 12u}) {
+    auto net = network(torus, 1, 0, 0, samples);
+    REQUIRE(net.ok());
+    for (uint32_t e = 0; e < net->edge_slots(); ++e) {
+      auto line = net->polyline(e);
+      REQUIRE(line.size() == samples + 1);
+      const Vec3 a = line.front(), b = line.back();
+      for (uint32_t j = 0; j <= samples; ++j) {
+        const double t = double(j) / samples;
+        CHECK(line[j] == (1.0 - t) * a + t * b);
+      }
+    }
+  }
+  // At K=2 every network edge runs through a collapsed control vertex at its middle sample.
+  auto net = network(torus, 2);
+  REQUIRE(net.ok());
+  for (uint32_t e = 0; e < net->edge_slots(); ++e) {
+    const Vec3 middle = net->polyline(e)[8];
+    CHECK(std::find(torus.positions.begin(), torus.positions.end(), middle) != torus.positions.end());
+  }
+  // Fewer than 8 samples per edge is refused.
+  auto sparse = network(torus, 1, 0, 0, 7);
+  REQUIRE_FALSE(sparse.ok());
+  CHECK_THAT(sparse.error(), Catch::Contains("test.obj") && Catch::Contains("samples per edge"));
+}
+
+TEST_CASE("noise is seeded, reproducible, and moves only interior polyline points", "[synth]") {
+  PolygonMesh torus = load("torus.obj");
+  auto clean = network(torus, 2);
+  auto a = network(torus, 2, 5.0, 42);
+  auto b = network(torus, 2, 5.0, 42);
+  auto c = network(torus, 2, 5.0, 43);
+  REQUIRE((clean.ok() && a.ok() && b.ok() && c.ok()));
+  CHECK(a->validate().empty());
+  CHECK(a->same_pools(*b));
+  CHECK(a->hash() == b->hash());
+  CHECK_FALSE(a->same_pools(*c));
+  CHECK(a->hash() != c->hash());
+  CHECK_FALSE(a->same_pools(*clean));
+
+  // Same topology and vertices; every interior point moved, ends stayed.
+  REQUIRE(a->edge_slots() == clean->edge_slots());
+  for (uint32_t v = 0; v < a->vertex_slots(); ++v) CHECK(a->vertices.position[v] == clean->vertices.position[v]);
+  double sum_sq = 0;
+  size_t interior = 0, moved = 0;
+  for (uint32_t e = 0; e < a->edge_slots(); ++e) {
+    auto noisy = a->polyline(e), straight = clean->polyline(e);
+    REQUIRE(noisy.size() == straight.size());
+    CHECK(noisy.front() == straight.front());
+    CHECK(noisy.back() == straight.back());
+    for (size_t i = 1; i + 1 < noisy.size(); ++i) {
+      ++interior;
+      moved += noisy[i] != straight[i];
+      sum_sq += (noisy[i] - straight[i]).squaredNorm();
+    }
+  }
+  CHECK(moved == interior);
+  // Standard deviation: 5 percent of the mean control edge length, per coordinate.
+  const double sigma = 0.05 * mean_control_edge_length(torus);
+  const double measured = std::sqrt(sum_sq / (3.0 * double(interior)));
+  CHECK(measured == Approx(sigma).epsilon(0.1));
+}
+
+TEST_CASE("fan.obj is non-manifold: the error names an edge shared by 3 faces", "[synth]") {
+  PolygonMesh fan = load("fan.obj");
+  auto net = network_from_mesh(view_of(fan, "fan.obj"), UnrefineOptions{});
+  REQUIRE_FALSE(net.ok());
+  CHECK(net.error() ==
+        "fan.obj: edge between vertices 8 and 9 (OBJ numbering) is shared by 3 faces; a polyline mesh needs a manifold mesh");
+}
+
+TEST_CASE("faces walking an edge the same way are rejected", "[synth]") {
+  PolygonMesh flipped;
+  flipped.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0)};
+  flipped.face_vertices = {0, 1, 2, 2, 0, 3};  // both faces walk vertex 3 -> vertex 1
+  flipped.face_offsets = {0, 3, 6};
+  auto net = network(flipped, 1);
+  REQUIRE_FALSE(net.ok());
+  CHECK_THAT(net.error(), Catch::Contains("test.obj: faces 1 and 2") && Catch::Contains("oriented consistently"));
+}
+
+TEST_CASE("an unrefinement too coarse for the mesh is refused with the reason", "[synth]") {
+  // The torus has 4 loops around its tube: K=4 keeps one, which cannot bound disks.
+  PolygonMesh torus = load("torus.obj");
+  auto net = network_from_mesh(view_of(torus, "torus.obj"), UnrefineOptions{4});
+  REQUIRE_FALSE(net.ok());
+  CHECK_THAT(net.error(), Catch::StartsWith("unrefine 4 too coarse for torus.obj: the region merged from") &&
+                              Catch::Contains("is not a disk"));
+}
+
+TEST_CASE("bad OBJ input is reported with the file and the problem", "[synth]") {
+  auto text = [](const char* s) { return std::string(s); };
+  SECTION("truncated in a vertex line") {
+    auto pm = parse_obj(text("v 0 0 0\nv 1 0 0\nv 1 1"), "cut.obj");
+    REQUIRE_FALSE(pm.ok());
+    CHECK_THAT(pm.error(), Catch::StartsWith("cut.obj:3:") && Catch::Contains("three coordinates"));
+  }
+  SECTION("truncated before the faces") {
+    auto pm = parse_obj(text("v 0 0 0\nv 1 0 0\nv 1 1 0\n"), "nofaces.obj");
+    REQUIRE_FALSE(pm.ok());
+    CHECK_THAT(pm.error(), Catch::StartsWith("nofaces.obj") && Catch::Contains("no faces"));
+  }
+  SECTION("malformed face") {
+    auto pm = parse_obj(text("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 x\n"), "bad.obj");
+    REQUIRE_FALSE(pm.ok());
+    CHECK_THAT(pm.error(), Catch::StartsWith("bad.obj:4:"));
+  }
+  SECTION("NaN coordinate") {
+    auto pm = parse_obj(text("v 0 0 0\nv nan 0 0\nv 1 1 0\nf 1 2 3\n"), "nan.obj");
+    REQUIRE_FALSE(pm.ok());
+    CHECK_THAT(pm.error(), Catch::StartsWith("nan.obj:2:") && Catch::Contains("not finite"));
+  }
+  SECTION("empty file") {
+    auto pm = parse_obj(text(""), "empty.obj");
+    REQUIRE_FALSE(pm.ok());
+    CHECK_THAT(pm.error(), Catch::StartsWith("empty.obj") && Catch::Contains("no vertices"));
+  }
+  SECTION("missing file") {
+    auto pm = read_obj(kMeshes + "no-such-mesh.obj");
+    REQUIRE_FALSE(pm.ok());
+    CHECK_THAT(pm.error(), Catch::Contains("no-such-mesh.obj"));
+  }
+}
+
+TEST_CASE("bad views and options are refused, naming the source", "[synth]") {
+  PolygonMesh quad;
+  quad.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0)};
+  quad.face_vertices = {0, 1, 2, 3};
+  quad.face_offsets = {0, 4};
+  REQUIRE(network(quad, 1).ok());
+  CHECK(network(quad, 1)->face_count() == 1);
+
+  CHECK_THAT(network(quad, 0).error(), Catch::Contains("unrefine must be at least 1"));
+  CHECK_THAT(network(quad, 1, -1.0).error(), Catch::Contains("noise percent"));
+  CHECK_THAT(network(quad, 1, std::nan("")).error(), Catch::Contains("noise percent"));
+  PolygonMesh huge = quad;
+  for (Vec3& p : huge.positions) p *= 1e300;
+  CHECK_THAT(network(huge, 1, 1e10).error(), Catch::Contains("overflows"));
+
+  PolygonMesh nan = quad;
+  nan.positions[2] = Vec3(1, std::nan(""), 0);
+  CHECK(network(nan, 1).error() == "test.obj: vertex 3 has a non-finite coordinate");
+  PolygonMesh out_of_range = quad;
+  out_of_range.face_vertices[3] = 9;
+  CHECK(network(out_of_range, 1).error() == "test.obj: face 1 uses vertex 10 that does not exist");
+  PolygonMesh repeated = quad;
+  repeated.face_vertices[3] = 1;
+  CHECK(network(repeated, 1).error() == "test.obj: face 1 uses vertex 2 twice");
+  PolygonMesh faceless = quad;
+  faceless.face_vertices.clear();
+  faceless.face_offsets = {0};
+  CHECK_THAT(network(faceless, 1).error(), Catch::Contains("no faces"));
+}

@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# The tracking commands end to end on a short scenario, as a user runs them:
+#   commands.sh FIRE_BINARY WORK_DIR
+# Checks that each prints one JSON line whose accuracy fields are finite numbers, that a damaged
+# log still tracks with its bad reports counted, and that bad input fails with a message.
+set -euo pipefail
+fire="$1"
+dir="$2"
+rm -rf "$dir"
+mkdir -p "$dir"
+cd "$dir"
+
+fail() { echo "FAIL: $*" >&2; exit 1; }
+# A finite JSON number for "key" (JSON has no NaN or infinity: those would be null or absent).
+has_number() { # json key
+  grep -Eq "\"$2\":-?[0-9]+(\.[0-9]+)?([eE][-+]?[0-9]+)?[,}]" <<<"$1" || fail "no finite \"$2\" in: $1"
+}
+one_line() { # output
+  [ "$(printf '%s\n' "$1" | wc -l)" -eq 1 ] || fail "expected exactly one line of output, got: $1"
+}
+
+out=$("$fire" simulate wand --duration-s 10 --clock-offset-ms 5 --focal-error 0.02 -o w.log)
+one_line "$out"
+has_number "$out" duration_s
+out=$("$fire" calibrate w.log -o rig.json)
+one_line "$out"
+for k in reprojection_rms_px wand_length_error_mm observations_used observations_rejected rejected_reports time_offset_ms; do
+  has_number "$out" "$k"
+done
+[ -s rig.json ] || fail "rig.json not written"
+
+out=$("$fire" simulate sketch --strokes 2 --hold-s 0.5 --clock-offset-ms 5 --focal-error 0.02 -o s.log)
+one_line "$out"
+for m in thesis dlt optimal; do
+  out=$("$fire" track s.log --rig rig.json -o pen.log --truth --method "$m")
+  one_line "$out"
+  for k in static_rms_mm dynamic_rms_mm samples strokes rejected_reports time_offset_ms; do has_number "$out" "$k"; done
+done
+head -1 pen.log | grep -qx 'FIRE-LOG 1' || fail "pen.log is not an input log"
+grep -q ' down$' pen.log && grep -q ' up$' pen.log && grep -q ' pen ' pen.log || fail "pen.log lacks down/pen/up"
+
+# Damage some reports: an odd hex digit count, a truncated report, an unknown id, a NaN truth line.
+awk 'BEGIN{n=0} / hid /{n++; if (n==100) $4=$4"f"; if (n==200) $4=substr($4,1,10); if (n==300) $4="99" substr($4,3)}
+     {print} / hid 0 /{if (!done && n>400) {print $1" truth pen 0 nan 0 0 0 1 0 0"; done=1}}' s.log > damaged.log
+out=$("$fire" track damaged.log --rig rig.json -o pen2.log --truth)
+one_line "$out"
+has_number "$out" static_rms_mm
+grep -q '"garbled":1,' <<<"$out" || fail "garbled report not counted: $out"
+grep -q '"bad_length":1,' <<<"$out" || fail "truncated report not counted: $out"
+grep -q '"unknown_id":1,' <<<"$out" || fail "unknown report id not counted: $out"
+grep -q '"truth_lines_rejected":1' <<<"$out" || fail "NaN truth line not counted: $out"
+
+# Bad input fails with a message naming the problem, and a non-zero exit.
+expect_failure() { # what, command...
+  local what="$1"; shift
+  if "$@" >out.txt 2>err.txt; then fail "$what: succeeded"; fi
+  grep -q "^fire " err.txt || fail "$what: no 'fire <command>: ...' message: $(cat err.txt)"
+}
+printf 'not a log\n' > junk.log
+expect_failure "calibrate a file that is not a log" "$fire" calibrate junk.log -o x.json
+expect_failure "calibrate a log without wand" "$fire" calibrate pen.log -o x.json
+expect_failure "track with a missing rig" "$fire" track s.log --rig missing.json -o x.log
+printf '{"format":"fire-rig"' > broken.json
+expect_failure "track with a broken rig" "$fire" track s.log --rig broken.json -o x.log
+expect_failure "track --truth on a log without truth" "$fire" track pen.log --rig rig.json -o x.log --truth
+expect_failure "simulate with a NaN option" "$fire" simulate wand --noise-px nan -o x.log
+expect_failure "track with a NaN filter option" "$fire" track s.log --rig rig.json -o x.log --beta nan
+echo "tracking commands: ok"

@@ -1,0 +1,233 @@
+// The simulated rig end to end on short sessions: deterministic logs, bytes that match the truth,
+// a wand session that calibrates, a sketch session that tracks, and a damaged log that still does.
+#include <catch2/catch.hpp>
+#include <algorithm>
+#include <sstream>
+#include <string>
+
+#include "engine/input_log.hpp"
+#include "platform/obj.hpp"
+#include "systems/tracking/simulate.hpp"
+#include "systems/tracking/track.hpp"
+
+using namespace fire;
+using namespace fire::tracking;
+
+namespace {
+
+const PolygonMesh& pawn() {
+  static const PolygonMesh mesh = [] {
+    Result<PolygonMesh> m = read_obj(std::string(FIRE_SHARED_DIR) + "/data/meshes/pawn.obj");
+    REQUIRE(m.ok());
+    return *m;
+  }();
+  return mesh;
+}
+
+MeshView pawn_view() { return MeshView{pawn().positions, pawn().face_offsets, pawn().face_vertices}; }
+
+SketchOptions short_sketch() {
+  SketchOptions s;
+  s.strokes = 3;
+  s.hold_s = 0.6;
+  return s;
+}
+
+// The log as text and read back, as `fire track` sees it.
+InputLog through_text(const std::vector<InputEvent>& events) {
+  Result<InputLog> log = parse_input_log(format_input_log(events), "simulated");
+  REQUIRE(log.ok());
+  return *log;
+}
+
+// A short wand session calibrated once, shared by the tests that need a rig.
+struct Calibrated {
+  RigOptions rig;
+  WandCalibration cal;
+  SessionTruth truth;
+};
+const Calibrated& calibrated() {
+  static const Calibrated c = [] {
+    Calibrated out;
+    out.rig.seed = 7;
+    out.rig.rig_seed = 7;
+    out.rig.clock_offset_ms = 5;
+    out.rig.focal_error = 0.02;
+    Result<SimulatedSession> wand = simulate_wand(out.rig, WandOptions{.duration_s = 12, .length_m = 0.3});
+    REQUIRE(wand.ok());
+    const InputLog log = through_text(wand->events);
+    out.truth = read_session_truth(log.events);
+    REQUIRE(out.truth.has_nominal[0]);
+    REQUIRE(out.truth.has_wand_length);
+    CalibrationOptions options{.nominal0 = out.truth.nominal[0], .nominal1 = out.truth.nominal[1],
+                               .wand_length_m = out.truth.wand_length_m, .max_iterations = 100};
+    Result<WandCalibration> cal = calibrate_wand_streams(decode_device_streams(log.events), options);
+    REQUIRE(cal.ok());
+    out.cal = *cal;
+    return out;
+  }();
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("a simulated session is byte-identical for the same seed and options") {
+  RigOptions rig;
+  rig.seed = 3;
+  const WandOptions wand{.duration_s = 2, .length_m = 0.3};
+  const std::string a = format_input_log(simulate_wand(rig, wand)->events);
+  const std::string b = format_input_log(simulate_wand(rig, wand)->events);
+  CHECK(a == b);
+  const std::string s1 = format_input_log(simulate_sketch(rig, short_sketch(), pawn_view())->events);
+  const std::string s2 = format_input_log(simulate_sketch(rig, short_sketch(), pawn_view())->events);
+  CHECK(s1 == s2);
+  RigOptions other = rig;
+  other.seed = 4;
+  CHECK(format_input_log(simulate_wand(other, wand)->events) != a);
+  // The rig follows rig_seed alone: a different noise seed keeps the cameras.
+  CHECK(make_simulated_rig(other)->cameras[1].t == make_simulated_rig(rig)->cameras[1].t);
+}
+
+TEST_CASE("every report holds exactly the rounded images of the true LEDs") {
+  RigOptions rig;
+  rig.noise_px = 0;
+  rig.stray = 0;
+  rig.dropout = 0;
+  Result<SimulatedSession> s = simulate_wand(rig, WandOptions{.duration_s = 1, .length_m = 0.3});
+  REQUIRE(s.ok());
+  const InputLog log = through_text(s->events);
+  const SessionTruth truth = read_session_truth(log.events);
+  REQUIRE(truth.has_cameras);
+  size_t checked = 0;
+  for (size_t i = 0; i + 1 < log.events.size(); ++i) {
+    const InputEvent& e = log.events[i];
+    if (e.kind != EventKind::Hid) continue;
+    const InputEvent& t = log.events[i + 1];
+    REQUIRE(t.kind == EventKind::Truth);
+    REQUIRE(t.name == "wand");
+    REQUIRE(t.values[0] == e.device);
+    REQUIRE(e.bytes.size() == kReport33Size);
+    const DecodedReport d = decode_ir_report(e.bytes);
+    REQUIRE(d.status == ReportStatus::Ok);
+    std::vector<std::pair<int, int>> expected, got;
+    for (int led = 0; led < 2; ++led) {
+      const Vec3 X(t.values[2 + 3 * led], t.values[3 + 3 * led], t.values[4 + 3 * led]);
+      const Vec2 p = truth.cameras[e.device].project(X);
+      const int x = static_cast<int>(std::lround(p.x())), y = static_cast<int>(std::lround(p.y()));
+      if (x >= 0 && x <= 1023 && y >= 0 && y <= 767) expected.emplace_back(x, y);
+    }
+    for (const IrSlot& slot : d.report.slots)
+      if (slot.seen) got.emplace_back(slot.x, slot.y);
+    std::sort(expected.begin(), expected.end());
+    std::sort(got.begin(), got.end());
+    CHECK(got == expected);
+    ++checked;
+  }
+  CHECK(checked > 190);
+}
+
+TEST_CASE("options no rig can have are refused with a reason") {
+  RigOptions bad;
+  bad.noise_px = -1;
+  CHECK_FALSE(simulate_wand(bad, WandOptions{}).ok());
+  RigOptions nan_focal;
+  nan_focal.focal_px = std::nan("");
+  CHECK_FALSE(make_simulated_rig(nan_focal).ok());
+  CHECK_FALSE(simulate_wand(RigOptions{}, WandOptions{.duration_s = 0, .length_m = 0.3}).ok());
+  const std::vector<Vec3> flat{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  const std::vector<uint32_t> offsets{0, 3}, faces{0, 1, 2};
+  const Result<SimulatedSession> s = simulate_sketch(RigOptions{}, short_sketch(), MeshView{flat, offsets, faces});
+  REQUIRE_FALSE(s.ok());
+  CHECK(s.error().find("flat") != std::string::npos);
+}
+
+TEST_CASE("a 12 s wand session with a 2 % focal error and a 5 ms clock offset calibrates") {
+  const Calibrated& c = calibrated();
+  CHECK(c.cal.rig.reprojection_rms_px < 0.35);
+  CHECK(std::abs(c.cal.time_offset_used_us - 5000.0) < 300.0);
+  CHECK(c.cal.rig.observations_used > 800);
+  CHECK(c.cal.static_blobs_removed > 0);  // the stray reflection
+  const Result<RigErrors> e = compare_rig(c.cal.rig, c.truth);
+  REQUIRE(e.ok());
+  CHECK(std::abs(e->baseline_error_mm) < 1.0);
+  CHECK(e->rotation_error_deg < 0.1);
+  CHECK(std::abs(e->focal_error_px[0]) < 3.0);  // from 26 px wrong
+  CHECK(std::abs(e->focal_error_px[1]) < 3.0);
+}
+
+TEST_CASE("a short sketch session tracks within a millimetre or two") {
+  const Calibrated& c = calibrated();
+  Result<SimulatedSession> sketch = simulate_sketch(c.rig, short_sketch(), pawn_view());
+  REQUIRE(sketch.ok());
+  CHECK(sketch->stats.strokes == 3);
+  const InputLog log = through_text(sketch->events);
+  DeviceStreams streams = decode_device_streams(log.events);
+  for (CameraFrames& f : streams.cameras) fit_frame_clock(f);
+  const TimeOffsetEstimate offset = estimate_time_offset(streams, c.cal.rig.cam0, c.cal.rig.cam1);
+  REQUIRE(offset.observable);
+  CHECK(std::abs(offset.offset_us - 5000.0) < 300.0);
+  const PenTrack track = track_pen(streams, c.cal.rig.cam0, c.cal.rig.cam1, offset.offset_us, PenTrackOptions{});
+  CHECK(track.strokes == 3);
+  const Result<PenAccuracy> acc = evaluate_pen_accuracy(track, streams.cameras[0], read_session_truth(log.events), 0.25);
+  REQUIRE(acc.ok());
+  CHECK(acc->static_filtered.samples > 100);
+  CHECK(acc->dynamic_filtered.samples > 50);
+  CHECK(acc->static_filtered.rms_mm < 1.0);
+  CHECK(acc->dynamic_filtered.rms_mm < 2.0);
+  CHECK(acc->phantom == 0);
+  CHECK(acc->unmatched == 0);
+}
+
+TEST_CASE("a damaged log: bad reports and NaN lines are counted, the rest still tracks") {
+  const Calibrated& c = calibrated();
+  Result<SimulatedSession> sketch = simulate_sketch(c.rig, short_sketch(), pawn_view());
+  REQUIRE(sketch.ok());
+  // Damage the text the way a failing device or disk would: every 40th report garbled, truncated,
+  // with an unknown id, with an impossible y, or from a device that does not exist.
+  std::istringstream in(format_input_log(sketch->events));
+  std::string text, line;
+  size_t reports = 0;
+  size_t garbled = 0, truncated = 0, foreign = 0, out_of_range = 0, stranger = 0;
+  bool nan_written = false;
+  while (std::getline(in, line)) {
+    const size_t at = line.find(" hid ");
+    if (at != std::string::npos) {
+      const size_t hex = line.find(' ', at + 5) + 1;
+      switch (reports++ % 40) {
+        case 3: line += "z"; ++garbled; break;
+        case 11: line.resize(hex + 20); ++truncated; break;
+        case 19: line.replace(hex, 2, "99"); ++foreign; break;
+        case 27: line.replace(hex + 12, 6, "0520c0"); ++out_of_range; break;  // slot 0: y = 800
+        case 35: line[at + 5] = '7'; ++stranger; break;
+        default: break;
+      }
+    }
+    text += line + "\n";
+    if (!nan_written && at != std::string::npos && reports > 200) {
+      const std::string t = line.substr(0, line.find(' '));
+      text += t + " pen nan 0 0\n" + t + " truth pen 0 nan 0 0 0 1 0 0\n";
+      nan_written = true;
+    }
+  }
+  Result<InputLog> log = parse_input_log(text, "damaged");
+  REQUIRE(log.ok());
+  CHECK(log->rejected_hid_lines == garbled);
+  const SessionTruth truth = read_session_truth(log->events);
+  CHECK(truth.rejected_lines == 1);
+  DeviceStreams streams = decode_device_streams(log->events);
+  CHECK(streams.counts.garbled == garbled);
+  CHECK(streams.counts.bad_length == truncated);
+  CHECK(streams.counts.unknown_id == foreign);
+  CHECK(streams.counts.unknown_device == stranger);
+  CHECK(streams.counts.out_of_range_slots == out_of_range);
+  CHECK(streams.counts.rejected_reports() == garbled + truncated + foreign + stranger);
+  for (CameraFrames& f : streams.cameras) fit_frame_clock(f);
+  const PenTrack track = track_pen(streams, c.cal.rig.cam0, c.cal.rig.cam1, c.cal.time_offset_used_us, PenTrackOptions{});
+  CHECK(track.strokes == 3);
+  for (const InputEvent& e : pen_events(track))
+    if (e.kind == EventKind::Pen) REQUIRE(e.p.allFinite());
+  const Result<PenAccuracy> acc = evaluate_pen_accuracy(track, streams.cameras[0], truth, 0.25);
+  REQUIRE(acc.ok());
+  CHECK(acc->static_filtered.rms_mm < 1.0);
+  CHECK(acc->dynamic_filtered.rms_mm < 2.0);
+}

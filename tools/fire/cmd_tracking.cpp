@@ -1,0 +1,370 @@
+// fire simulate wand|sketch, fire calibrate, fire track: the stereo rig from device reports to pen
+// strokes, and the simulated rig that proves its accuracy (systems/tracking).
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "engine/input_log.hpp"
+#include "platform/files.hpp"
+#include "platform/obj.hpp"
+#include "systems/tracking/calibration.hpp"
+#include "systems/tracking/rig_io.hpp"
+#include "systems/tracking/simulate.hpp"
+#include "systems/tracking/track.hpp"
+#include "tools/fire/commands.hpp"
+
+#ifndef FIRE_DEFAULT_MESH
+#define FIRE_DEFAULT_MESH "../shared/data/meshes/pawn.obj"
+#endif
+
+namespace fire::cli {
+namespace {
+
+using nlohmann::ordered_json;
+using namespace fire::tracking;
+
+int fail(const std::string& command, const std::string& message) {
+  std::cerr << "fire " << command << ": " << message << "\n";
+  return 1;
+}
+
+// A number, or null where there is nothing to measure (JSON has no NaN).
+ordered_json number_or_null(double v, bool present = true) { return present && std::isfinite(v) ? ordered_json(v) : ordered_json(); }
+
+ordered_json report_counts_json(const ReportCounts& c, size_t truth_lines_rejected) {
+  return {{"ir", c.ir_reports},
+          {"not_ir", c.not_ir},
+          {"garbled", c.garbled},
+          {"bad_length", c.bad_length},
+          {"unknown_id", c.unknown_id},
+          {"unknown_device", c.unknown_device},
+          {"out_of_range_blobs", c.out_of_range_slots},
+          {"truth_lines_rejected", truth_lines_rejected}};
+}
+
+// --- simulate ---
+
+struct SimulateArgs {
+  RigOptions rig;
+  WandOptions wand;
+  SketchOptions sketch;
+  std::string out_path;
+  std::string mesh_path = FIRE_DEFAULT_MESH;
+};
+
+void add_rig_options(CLI::App* cmd, SimulateArgs& a) {
+  RigOptions& r = a.rig;
+  cmd->add_option("-o,--output", a.out_path, "input log to write (engine/INPUT_LOG.md)")->required();
+  cmd->add_option("--seed", r.seed, "seed of the noise, timing, motion, dropouts, stray blob and occlusions (same seeds and options, byte-identical log)")
+      ->capture_default_str();
+  cmd->add_option("--rig-seed", r.rig_seed,
+                  "seed of the true cameras; a sketch tracks with the rig calibrated from a wand log only if both share it")
+      ->capture_default_str();
+  cmd->add_option("--noise-px", r.noise_px, "Gaussian blob noise per coordinate, pixels, before rounding to integers")->capture_default_str();
+  cmd->add_option("--focal-error", r.focal_error,
+                  "fraction by which the nominal focal lengths calibration starts from are wrong (0.02: 2 % too long)")
+      ->capture_default_str();
+  cmd->add_option("--focal-px", r.focal_px, "mean true focal length, pixels (each camera differs by up to 1 %)")->capture_default_str();
+  cmd->add_option("--k1", r.k1, "radial distortion k1 of the true cameras (varies by 20 % per camera)")->capture_default_str();
+  cmd->add_option("--k2", r.k2, "radial distortion k2 of the true cameras (calibration keeps k2 at 0)")->capture_default_str();
+  cmd->add_option("--baseline", r.baseline_m, "distance between the cameras, metres")->capture_default_str();
+  cmd->add_option("--distance", r.target_distance_m, "distance to the point both cameras converge on, metres")->capture_default_str();
+  cmd->add_option("--rate-hz", r.rate_hz, "nominal report rate of each remote")->capture_default_str();
+  cmd->add_option("--drift-ppm", r.drift_ppm, "how much faster camera 1's frame clock runs than camera 0's, ppm")->capture_default_str();
+  cmd->add_option("--latency-ms", r.latency_ms, "camera 0's report latency, milliseconds")->capture_default_str();
+  cmd->add_option("--clock-offset-ms", r.clock_offset_ms,
+                  "camera 1's extra latency, milliseconds: its reports stamp each instant this much later")
+      ->capture_default_str();
+  cmd->add_option("--jitter-ms", r.jitter_ms, "standard deviation of the report arrival jitter, milliseconds")->capture_default_str();
+  cmd->add_option("--dropout", r.dropout, "probability that a report is lost")->capture_default_str();
+  cmd->add_option("--stray", r.stray, "fraction of the time camera 1 sees a stray reflection blob")->capture_default_str();
+  cmd->add_option("--occlusion", r.occlusion_per_s, "brief hand occlusions (50 to 300 ms) per second per camera")->capture_default_str();
+}
+
+ordered_json simulation_json(const char* scenario, const SimulateArgs& a, const SimulatedSession& s) {
+  const SimulationStats& st = s.stats;
+  ordered_json out;
+  out["scenario"] = scenario;
+  out["log"] = a.out_path;
+  out["seed"] = a.rig.seed;
+  out["rig_seed"] = a.rig.rig_seed;
+  out["duration_s"] = st.duration_s;
+  out["reports"] = {st.reports[0], st.reports[1]};
+  out["dropped"] = {st.dropped[0], st.dropped[1]};
+  out["led_images"] = st.led_images;
+  out["occluded"] = st.occluded;
+  out["out_of_view"] = st.out_of_view;
+  out["merged"] = st.merged;
+  out["stray_frames"] = st.stray_frames;
+  if (std::string(scenario) == "sketch") out["strokes"] = st.strokes;
+  return out;
+}
+
+int write_session(const char* scenario, const SimulateArgs& a, const Result<SimulatedSession>& s) {
+  const std::string command = std::string("simulate ") + scenario;
+  if (!s) return fail(command, s.error());
+  if (Status w = write_file_atomic(a.out_path, format_input_log(s->events)); !w) return fail(command, w.error);
+  std::cout << simulation_json(scenario, a, *s).dump() << "\n";
+  return 0;
+}
+
+int run_simulate_wand(const SimulateArgs& a) { return write_session("wand", a, simulate_wand(a.rig, a.wand)); }
+
+int run_simulate_sketch(const SimulateArgs& a) {
+  Result<PolygonMesh> mesh = read_obj(a.mesh_path);
+  if (!mesh) return fail("simulate sketch", mesh.error() + " (choose the object with --mesh)");
+  SketchOptions sketch = a.sketch;
+  sketch.mesh_name = a.mesh_path.substr(a.mesh_path.find_last_of('/') + 1);
+  const MeshView view{mesh->positions, mesh->face_offsets, mesh->face_vertices};
+  return write_session("sketch", a, simulate_sketch(a.rig, sketch, view));
+}
+
+// --- calibrate ---
+
+struct CalibrateArgs {
+  std::string log_path, out_path;
+  std::optional<double> wand_length_m;
+  int max_iterations = 100;
+};
+
+int run_calibrate(const CalibrateArgs& a) {
+  const std::string command = "calibrate";
+  Result<InputLog> log = read_input_log(a.log_path);
+  if (!log) return fail(command, log.error());
+  const SessionTruth truth = read_session_truth(log->events);
+  CalibrationOptions options;
+  options.nominal0 = truth.has_nominal[0] ? truth.nominal[0] : wiimote_nominal_intrinsics();
+  options.nominal1 = truth.has_nominal[1] ? truth.nominal[1] : wiimote_nominal_intrinsics();
+  options.wand_length_m = a.wand_length_m ? *a.wand_length_m : truth.has_wand_length ? truth.wand_length_m : 0.3;
+  options.max_iterations = a.max_iterations;
+  if (!std::isfinite(options.wand_length_m) || !(options.wand_length_m > 0))
+    return fail(command, "--wand-length must be a positive number of metres");
+  DeviceStreams streams = decode_device_streams(log->events);
+  const ReportCounts counts = streams.counts;
+  Result<WandCalibration> cal = calibrate_wand_streams(std::move(streams), options);
+  if (!cal) return fail(command, a.log_path + ": " + cal.error());
+  if (Status w = write_file_atomic(a.out_path, rig_to_json(cal->rig)); !w) return fail(command, w.error);
+
+  const CalibrationResult& r = cal->rig;
+  ordered_json out;
+  out["rig"] = a.out_path;
+  out["reprojection_rms_px"] = r.reprojection_rms_px;
+  out["reprojection_rms_2d_px"] = r.reprojection_rms_2d_px;
+  out["wand_length_error_mm"] = r.wand_length_error_mm;
+  out["wand_length_m"] = options.wand_length_m;
+  out["observations_used"] = r.observations_used;
+  out["observations_rejected"] = r.observations_rejected;
+  out["iterations"] = r.iterations;
+  out["calibrations"] = cal->calibrations;
+  out["time_offset_ms"] = cal->time_offset_used_us * 1e-3;
+  out["time_offset_observable"] = cal->time_offset.observable;
+  out["time_offset_samples"] = cal->time_offset.samples;
+  out["camera0_frames"] = cal->extraction.frames;
+  out["frames_without_two_blobs"] = cal->extraction.not_two_blobs;
+  out["frames_without_partner"] = cal->extraction.no_partner;
+  out["static_blobs_removed"] = cal->static_blobs_removed;
+  out["rejected_reports"] = counts.rejected_reports();
+  out["reports"] = report_counts_json(counts, truth.rejected_lines);
+  if (truth.has_cameras) {  // a simulated log: how far the rig is from the true cameras
+    const Result<RigErrors> e = compare_rig(r, truth);
+    out["rig_baseline_error_mm"] = e->baseline_error_mm;
+    out["rig_rotation_error_deg"] = e->rotation_error_deg;
+    out["rig_baseline_direction_error_deg"] = e->direction_error_deg;
+    out["rig_focal_error_px"] = {e->focal_error_px[0], e->focal_error_px[1]};
+    out["rig_principal_point_error_px"] = {e->principal_point_error_px[0], e->principal_point_error_px[1]};
+    out["rig_k1_error"] = {e->k1_error[0], e->k1_error[1]};
+  }
+  if (truth.has_clocks) out["true_time_offset_ms"] = (truth.latency_us[1] - truth.latency_us[0]) * 1e-3;
+  std::cout << out.dump() << "\n";
+  return 0;
+}
+
+// --- track ---
+
+struct TrackArgs {
+  std::string log_path, rig_path, out_path;
+  bool truth = false;
+  std::string method = "optimal";
+  std::optional<double> time_offset_ms;
+  PenTrackOptions options;
+  double max_gap_ms = static_cast<double>(PenTrackOptions{}.max_gap_us) * 1e-3;
+  double simplify_mm = 0, resample_mm = 0;
+  double settle_s = 0.25;
+};
+
+int run_track(const TrackArgs& a) {
+  const std::string command = "track";
+  TrackArgs args = a;
+  if (args.method == "thesis")
+    args.options.method = TriangulationMethod::ThesisLinear;
+  else if (args.method == "dlt")
+    args.options.method = TriangulationMethod::Dlt;
+  else if (args.method == "optimal")
+    args.options.method = TriangulationMethod::Optimal;
+  else
+    return fail(command, "unknown --method '" + args.method + "' (thesis, dlt or optimal)");
+  const OneEuroParams& f = args.options.filter;
+  for (auto [value, name] : {std::pair{args.options.max_reprojection_px, "--max-reprojection-px"}, {f.min_cutoff_hz, "--min-cutoff"},
+                             {f.derivative_cutoff_hz, "--dcutoff"}})
+    if (!std::isfinite(value) || !(value > 0)) return fail(command, std::string(name) + " must be a positive number");
+  for (auto [value, name] : {std::pair{f.beta, "--beta"}, {args.max_gap_ms, "--max-gap-ms"}, {args.simplify_mm, "--simplify-mm"},
+                             {args.resample_mm, "--resample-mm"}, {args.settle_s, "--settle-s"}})
+    if (!std::isfinite(value) || value < 0) return fail(command, std::string(name) + " must be a non-negative number");
+  if (args.time_offset_ms && !(std::abs(*args.time_offset_ms) < 1e6))
+    return fail(command, "--time-offset-ms must be a finite number of milliseconds");
+  args.options.max_gap_us = std::llround(args.max_gap_ms * 1e3);
+
+  Result<std::string> rig_text = read_text_file(args.rig_path);
+  if (!rig_text) return fail(command, rig_text.error());
+  Result<CalibrationResult> rig = rig_from_json(*rig_text, args.rig_path);
+  if (!rig) return fail(command, rig.error());
+  Result<InputLog> log = read_input_log(args.log_path);
+  if (!log) return fail(command, log.error());
+  const SessionTruth truth = read_session_truth(log->events);
+  if (args.truth && !truth.has_cameras)
+    return fail(command, args.log_path + ": --truth needs the simulator's truth lines (truth camera 0 and 1), and the log has none");
+
+  DeviceStreams streams = decode_device_streams(log->events);
+  for (CameraFrames& f : streams.cameras) fit_frame_clock(f);
+  TimeOffsetEstimate offset;
+  if (args.time_offset_ms) {
+    offset.offset_us = *args.time_offset_ms * 1e3;
+  } else {
+    offset = estimate_time_offset(streams, rig->cam0, rig->cam1);
+    if (!offset.observable) offset.offset_us = 0;  // a pen that never moved: no offset to see, none that matters
+  }
+  const PenTrack track = track_pen(streams, rig->cam0, rig->cam1, offset.offset_us, args.options);
+  std::vector<InputEvent> events =
+      pen_events(track, StrokeShaping{.simplify_tolerance = args.simplify_mm * 1e-3, .resample_spacing = args.resample_mm * 1e-3});
+  InputEvent source;
+  source.kind = EventKind::Meta;
+  source.t_us = events.empty() ? 0 : events.front().t_us;
+  source.name = "source";
+  source.text = "fire track " + args.log_path + " --rig " + args.rig_path + " --method " + args.method;
+  events.insert(events.begin(), source);
+  if (Status w = write_file_atomic(args.out_path, format_input_log(events)); !w) return fail(command, w.error);
+
+  ordered_json out;
+  out["pen_log"] = args.out_path;
+  out["method"] = args.method;
+  out["samples"] = track.samples.size();
+  out["strokes"] = track.strokes;
+  out["time_offset_ms"] = offset.offset_us * 1e-3;
+  out["time_offset_estimated"] = !args.time_offset_ms.has_value();
+  out["time_offset_observable"] = offset.observable;
+  out["time_offset_samples"] = offset.samples;
+  double reprojection = 0;
+  for (const PenSample& p : track.samples) reprojection += p.reprojection_px;
+  out["mean_reprojection_px"] = number_or_null(reprojection / static_cast<double>(track.samples.size()), !track.samples.empty());
+  out["frames_seen_by_both"] = track.frames_seen_by_both;
+  out["rejected_reprojection"] = track.rejected_reprojection;
+  out["rejected_jump"] = track.rejected_jump;
+  out["ambiguous"] = track.ambiguous;
+  out["rejected_filter"] = track.rejected_filter;
+  out["rejected_reports"] = streams.counts.rejected_reports();
+  out["reports"] = report_counts_json(streams.counts, truth.rejected_lines);
+  if (args.truth) {
+    const Result<PenAccuracy> acc = evaluate_pen_accuracy(track, streams.cameras[0], truth, args.settle_s);
+    if (!acc) return fail(command, args.log_path + ": " + acc.error());
+    auto put = [&](const std::string& name, const ErrorStats& e) {
+      out[name + "_rms_mm"] = number_or_null(e.rms_mm, e.samples > 0);
+      out[name + "_max_mm"] = number_or_null(e.max_mm, e.samples > 0);
+      out[name + "_samples"] = e.samples;
+    };
+    put("static", acc->static_filtered);
+    put("dynamic", acc->dynamic_filtered);
+    put("settling", acc->settling_filtered);
+    put("raw_static", acc->static_raw);
+    put("raw_dynamic", acc->dynamic_raw);
+    out["registration_points"] = acc->registration_points;
+    out["registration_residual_mm"] = number_or_null(acc->registration_rms_mm, acc->registered);
+    put("registered_static", acc->registered_static);
+    put("registered_dynamic", acc->registered_dynamic);
+    out["unmatched_samples"] = acc->unmatched;
+    out["phantom_samples"] = acc->phantom;
+    if (truth.has_clocks) out["true_time_offset_ms"] = (truth.latency_us[1] - truth.latency_us[0]) * 1e-3;
+  }
+  std::cout << out.dump() << "\n";
+  return 0;
+}
+
+}  // namespace
+
+void add_tracking_commands(CLI::App& app, Registry& registry) {
+  // simulate wand | sketch
+  CLI::App* simulate = app.add_subcommand("simulate", "Write a simulated stereo Wii Remote session as an input log");
+  simulate->require_subcommand(1);
+  simulate->footer(
+      "Two virtual Wii Remotes 0.5 m apart converge on a working volume 0.6 to 1.0 m away; blobs get Gaussian "
+      "noise and integer pixels; each remote runs on its own drifting clock with its own latency. The log holds the "
+      "exact mode 0x33 report bytes and the ground truth (truth lines) and rig facts (meta lines).");
+  auto wand = std::make_shared<SimulateArgs>();
+  CLI::App* w = simulate->add_subcommand("wand", "A two-LED wand waved through the working volume, for fire calibrate");
+  add_rig_options(w, *wand);
+  w->add_option("--duration-s", wand->wand.duration_s, "seconds of waving")->capture_default_str();
+  w->add_option("--wand-length", wand->wand.length_m, "distance between the wand's LEDs, metres")->capture_default_str();
+  w->footer("Prints one JSON line: reports written and dropped per camera, LED images, occluded, out of view, merged, stray frames.");
+  w->callback([wand, &registry] { registry.exit_code = run_simulate_wand(*wand); });
+
+  auto sketch = std::make_shared<SimulateArgs>();
+  CLI::App* s = simulate->add_subcommand(
+      "sketch", "A pen tracing curves on an object (pawn.obj scaled to 20 cm), with static holds, for fire track --truth");
+  add_rig_options(s, *sketch);
+  s->add_option("--duration-s", sketch->sketch.duration_s, "longest session, seconds (fewer strokes if it runs out)")->capture_default_str();
+  s->add_option("--strokes", sketch->sketch.strokes, "strokes to draw")->capture_default_str();
+  s->add_option("--speed", sketch->sketch.speed_m_s, "pen speed along a stroke, m/s")->capture_default_str();
+  s->add_option("--hold-s", sketch->sketch.hold_s, "seconds the lit pen rests at both ends of every stroke")->capture_default_str();
+  s->add_option("--height", sketch->sketch.height_m, "the object is scaled to this height, metres (its +z is up)")->capture_default_str();
+  s->add_option("--mesh", sketch->mesh_path, "the object, OBJ")->capture_default_str();
+  s->footer("Prints one JSON line: reports written and dropped per camera, LED images, occluded, out of view, merged, stray frames, strokes.");
+  s->callback([sketch, &registry] { registry.exit_code = run_simulate_sketch(*sketch); });
+
+  // calibrate
+  auto cal = std::make_shared<CalibrateArgs>();
+  CLI::App* c = app.add_subcommand("calibrate", "Calibrate the stereo rig from a logged wand session");
+  c->add_option("LOG", cal->log_path, "input log with the remotes' reports of a waved two-LED wand")->required();
+  c->add_option("-o,--output", cal->out_path, "rig file to write (systems/tracking/README.md)")->required();
+  c->add_option("--wand-length", cal->wand_length_m,
+                "distance between the wand's LEDs, metres (default: the log's meta wand_length_m, else 0.3)");
+  c->add_option("--max-iterations", cal->max_iterations, "Levenberg-Marquardt iterations per calibration")
+      ->check(CLI::Range(1, 10000))
+      ->capture_default_str();
+  c->footer(
+      "Starts from the log's meta nominal_intrinsics (else the Wii Remote's 1330 px, centre 512 x 384); estimates "
+      "the cameras' time offset from the rig and calibrates again until it settles. Prints one JSON line: "
+      "reprojection_rms_px (per coordinate), reprojection_rms_2d_px (per blob), wand_length_error_mm, observations "
+      "used and rejected, time_offset_ms, rejected report counts; for simulated logs also rig_* errors against the "
+      "true cameras and true_time_offset_ms.");
+  c->callback([cal, &registry] { registry.exit_code = run_calibrate(*cal); });
+
+  // track
+  auto tr = std::make_shared<TrackArgs>();
+  CLI::App* t = app.add_subcommand("track", "Track the pen in a logged session: pen samples and down/up events");
+  t->add_option("LOG", tr->log_path, "input log with the remotes' reports")->required();
+  t->add_option("--rig", tr->rig_path, "rig file from fire calibrate")->required();
+  t->add_option("-o,--output", tr->out_path, "pen log to write: down, pen x y z (metres, camera 0's frame), up")->required();
+  t->add_flag("--truth", tr->truth, "compare with the simulator's ground truth: static_rms_mm, dynamic_rms_mm");
+  t->add_option("--method", tr->method, "triangulation: thesis, dlt or optimal")->capture_default_str();
+  t->add_option("--max-reprojection-px", tr->options.max_reprojection_px, "reject a pen sample beyond this reprojection error")
+      ->capture_default_str();
+  t->add_option("--time-offset-ms", tr->time_offset_ms, "camera 1's latency minus camera 0's (default: estimated from the log)");
+  t->add_option("--min-cutoff", tr->options.filter.min_cutoff_hz, "One Euro filter: cutoff at rest, Hz")->capture_default_str();
+  t->add_option("--beta", tr->options.filter.beta, "One Euro filter: cutoff increase per m/s")->capture_default_str();
+  t->add_option("--dcutoff", tr->options.filter.derivative_cutoff_hz, "One Euro filter: cutoff of the speed estimate, Hz")
+      ->capture_default_str();
+  t->add_option("--max-gap-ms", tr->max_gap_ms, "the pen stays down through shorter losses of the LED")->capture_default_str();
+  t->add_option("--simplify-mm", tr->simplify_mm, "Ramer-Douglas-Peucker tolerance for the written strokes (0: off)")->capture_default_str();
+  t->add_option("--resample-mm", tr->resample_mm, "arc-length spacing of the written strokes, after simplifying (0: off)")
+      ->capture_default_str();
+  t->add_option("--settle-s", tr->settle_s, "--truth: a resting pen counts as static after this many seconds")->capture_default_str();
+  t->footer(
+      "Prints one JSON line: samples, strokes, time_offset_ms, rejected counts; with --truth static_rms_mm and "
+      "dynamic_rms_mm (filtered samples against the truth moved into camera 0's frame by camera 0's true pose), "
+      "the same before the filter (raw_*), while the pen settles (settling_*), and registered_* after registering "
+      "the hold points to the truth (register_rigid), as a user registers the object.");
+  t->callback([tr, &registry] { registry.exit_code = run_track(*tr); });
+}
+
+}  // namespace fire::cli
