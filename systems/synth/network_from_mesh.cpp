@@ -4,11 +4,15 @@
 #include <array>
 #include <cmath>
 #include <deque>
+#include <functional>
 #include <numbers>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <string>
 #include <unordered_map>
+
+#include "systems/subdivide/subdivide.hpp"
 
 namespace fire {
 
@@ -459,10 +463,17 @@ Result<Mesh> network_from_mesh(const PolygonMeshView& control, const UnrefineOpt
       }
   }
 
+  std::optional<LimitCurves> limit;
+  if (o.limit) {
+    auto built = LimitCurves::build(control, o.samples_per_edge);
+    if (!built) return fail(built.error());
+    limit = std::move(*built);
+  }
+
   Mesh mesh;
   std::vector<uint32_t> net_vertex(nv, kNone);
   for (uint32_t v = 0; v < nv; ++v)
-    if (survives[v]) net_vertex[v] = mesh.add_vertex(c.positions[v]);
+    if (survives[v]) net_vertex[v] = mesh.add_vertex(limit ? limit->vertex(v) : c.positions[v]);
 
   double total_length = 0;
   for (uint32_t e = 0; e < ne; ++e) total_length += (c.positions[c.edge_head(e)] - c.positions[c.edge_tail(e)]).norm();
@@ -473,7 +484,8 @@ Result<Mesh> network_from_mesh(const PolygonMeshView& control, const UnrefineOpt
   for (size_t k = 0; k < chains.size(); ++k) {
     const auto& cv = chains[k].vertices;
     line.clear();
-    sample_chain_linear(c.positions, cv, o.samples_per_edge, line);
+    if (!limit) sample_chain_linear(c.positions, cv, o.samples_per_edge, line);
+    else if (!limit->sample_chain(cv, line)) return fail(src + ": internal error: a chain leaves the control edges");
     if (sigma > 0)
       for (size_t i = 1; i + 1 < line.size(); ++i) {
         // Drawn one by one: the order of evaluation of constructor arguments is unspecified.
@@ -503,6 +515,71 @@ Result<Mesh> network_from_mesh(const PolygonMeshView& control, const UnrefineOpt
   }
   if (auto why = mesh.validate(); !why.empty()) return fail(src + ": internal error: the network is invalid: " + why);
   return mesh;
+}
+
+}  // namespace fire
+
+namespace fire {
+
+Result<LimitCurves> LimitCurves::build(const PolygonMeshView& control, uint32_t samples_per_edge) {
+  int levels = 0;
+  while ((1u << levels) < samples_per_edge) ++levels;
+  levels = std::max(levels, 1);
+  const subdivide::BaseTopology base{uint32_t(control.positions.size()), control.face_offsets, control.face_vertices, {}};
+  auto refinement = subdivide::build_refinement(base, {levels, true});
+  if (!refinement) return Result<LimitCurves>::failure(std::string(control.source) + ": " + refinement.error());
+  auto stencils = subdivide::build_limit_stencils(*refinement);
+  if (!stencils) return Result<LimitCurves>::failure(std::string(control.source) + ": " + stencils.error());
+  std::vector<Vec3> last, scratch, normals;
+  subdivide::evaluate(*refinement, control.positions, last, scratch);
+  LimitCurves curves;
+  subdivide::evaluate_limit(*stencils, last, curves.limit_, normals);
+
+  // A base edge's vertices on the last level, in order: at each level an edge e splits at its edge point
+  // V + F + e into child edges C + 2e + k, k naming the end edge_vertices[2e + k] they keep (subdivide.hpp).
+  const auto& lv = refinement->levels;
+  std::function<void(size_t, uint32_t, uint32_t, uint32_t, std::vector<uint32_t>&)> walk =
+      [&](size_t l, uint32_t e, uint32_t from, uint32_t to, std::vector<uint32_t>& out) {
+        if (l + 1 == lv.size()) {
+          out.push_back(from);
+          return;
+        }
+        const subdivide::Level& L = lv[l];
+        const uint32_t mid = L.vertex_count + L.face_count() + e;
+        const uint32_t child_base = L.corner_count() + 2 * e;
+        const uint32_t k_from = L.edge_vertices[2 * e] == from ? 0 : 1;
+        walk(l + 1, child_base + k_from, from, mid, out);
+        walk(l + 1, child_base + 1 - k_from, mid, to, out);
+      };
+  const subdivide::Level& L0 = lv[0];
+  curves.base_edge_vertices_ = L0.edge_vertices;
+  curves.along_.resize(L0.edge_count());
+  for (uint32_t e = 0; e < L0.edge_count(); ++e) {
+    const uint32_t a = L0.edge_vertices[2 * e], b = L0.edge_vertices[2 * e + 1];
+    walk(0, e, a, b, curves.along_[e]);
+    curves.edge_by_ends_.emplace_back(uint64_t(std::min(a, b)) << 32 | std::max(a, b), e);
+  }
+  std::sort(curves.edge_by_ends_.begin(), curves.edge_by_ends_.end());
+  return curves;
+}
+
+bool LimitCurves::sample_chain(std::span<const uint32_t> chain, std::vector<Vec3>& out) const {
+  for (size_t i = 0; i + 1 < chain.size(); ++i) {
+    const uint32_t a = chain[i], b = chain[i + 1];
+    const uint64_t key = uint64_t(std::min(a, b)) << 32 | std::max(a, b);
+    auto it = std::lower_bound(edge_by_ends_.begin(), edge_by_ends_.end(), std::make_pair(key, 0u));
+    if (it == edge_by_ends_.end() || it->first != key) return false;
+    const auto& ids = along_[it->second];
+    if (base_edge_vertices_[2 * it->second] == a)
+      for (uint32_t id : ids) out.push_back(limit_[id]);
+    else {
+      // Walked from b: the reverse of [b .. a) is (a .. b], so start at a and drop b.
+      out.push_back(limit_[a]);
+      for (size_t k = ids.size(); k-- > 1;) out.push_back(limit_[ids[k]]);
+    }
+  }
+  out.push_back(limit_[chain.back()]);
+  return true;
 }
 
 }  // namespace fire

@@ -25,6 +25,10 @@ struct UnrefineOptions {
   double noise_percent = 0;       // Gaussian sigma, in percent of the mean control edge length
   uint64_t seed = 0;              // seeds the noise
   uint32_t samples_per_edge = 8;  // polyline points each control edge contributes (at least 8)
+  // Sample the control mesh's Catmull-Clark limit surface instead of its straight edges: vertices sit at
+  // their limit positions and each control edge contributes the limit positions of the level-L vertices
+  // on it, 2^L >= samples_per_edge (so the network lies exactly on its ground truth).
+  bool limit = false;
 };
 
 inline constexpr uint32_t kMinSamplesPerEdge = 8;
@@ -39,5 +43,27 @@ Result<Mesh> network_from_mesh(const PolygonMeshView& control, const UnrefineOpt
 // Appends chain_size-1 times samples_per_edge plus one points to `out`.
 void sample_chain_linear(std::span<const Vec3> positions, std::span<const uint32_t> chain,
                          uint32_t samples_per_edge, std::vector<Vec3>& out);
+
+}  // namespace fire
+
+namespace fire {
+
+// Points along every control edge on the Catmull-Clark limit surface (EdgeAndCorner boundaries).
+class LimitCurves {
+ public:
+  // samples_per_edge is rounded up to a power of two 2^L; the control mesh is refined L levels.
+  static Result<LimitCurves> build(const PolygonMeshView& control, uint32_t samples_per_edge);
+  // Limit position of control vertex v.
+  const Vec3& vertex(uint32_t v) const { return limit_[v]; }
+  // Like sample_chain_linear, on the limit surface: 2^L points per control edge, then the last vertex.
+  // Returns false if two consecutive chain vertices are not joined by a control edge.
+  bool sample_chain(std::span<const uint32_t> chain, std::vector<Vec3>& out) const;
+
+ private:
+  std::vector<Vec3> limit_;                     // limit positions of the last level's vertices
+  std::vector<std::vector<uint32_t>> along_;    // per base edge: last-level vertices from its first to second vertex (exclusive)
+  std::vector<std::pair<uint64_t, uint32_t>> edge_by_ends_;  // sorted (min << 32 | max) -> base edge
+  std::vector<uint32_t> base_edge_vertices_;
+};
 
 }  // namespace fire

@@ -1,10 +1,13 @@
 // network_from_mesh: synthetic curve networks from the shared control meshes and hand-made ones.
 #include <catch2/catch.hpp>
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <string>
 
 #include "platform/obj.hpp"
+#include "systems/subdivide/subdivide.hpp"
 #include "systems/synth/network_from_mesh.hpp"
 
 using namespace fire;
@@ -353,4 +356,41 @@ TEST_CASE("bad views and options are refused, naming the source", "[synth]") {
   faceless.face_vertices.clear();
   faceless.face_offsets = {0};
   CHECK_THAT(network(faceless, 1).error(), Catch::Contains("no faces"));
+}
+
+TEST_CASE("limit sampling: every polyline point lies on the control mesh's Catmull-Clark limit surface", "[synth][limit]") {
+  for (const char* name : {"torus.obj", "pawn.obj", "rook.obj"}) {
+    INFO(name);
+    PolygonMesh pm = load(name);
+    UnrefineOptions o;
+    o.unrefine = 2;
+    o.limit = true;
+    auto net = network_from_mesh(view_of(pm, name), o);
+    REQUIRE(net.ok());
+    REQUIRE(net->validate() == "");
+    // The same topology as the linear network, only the points move.
+    auto linear = network(pm, 2);
+    REQUIRE(linear.ok());
+    CHECK(net->face_count() == linear->face_count());
+    CHECK(net->edge_count() == linear->edge_count());
+    CHECK(net->live_point_count() == linear->live_point_count());
+    // Ground truth straight from the subdivision library: limit positions of the level-3 vertices.
+    auto truth = subdivide::subdivide({pm.positions, pm.face_offsets, pm.face_vertices, {}}, 3);
+    REQUIRE(truth.ok());
+    std::vector<std::array<double, 3>> on_surface;
+    for (const Vec3& p : truth->limit_positions) on_surface.push_back({p.x(), p.y(), p.z()});
+    std::sort(on_surface.begin(), on_surface.end());
+    size_t found = 0, total = 0;
+    for (uint32_t e = 0; e < net->edge_slots(); ++e)
+      for (const Vec3& p : net->polyline(e)) {
+        ++total;
+        found += std::binary_search(on_surface.begin(), on_surface.end(), std::array<double, 3>{p.x(), p.y(), p.z()});
+      }
+    CHECK(found == total);
+    // Network vertices are the control vertices' limit positions (a base vertex keeps its index).
+    for (uint32_t v = 0; v < net->vertex_slots(); ++v) {
+      const Vec3& p = net->vertices.position[v];
+      CHECK(std::binary_search(on_surface.begin(), on_surface.end(), std::array<double, 3>{p.x(), p.y(), p.z()}));
+    }
+  }
 }

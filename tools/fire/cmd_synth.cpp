@@ -58,7 +58,7 @@ void add_synth_commands(CLI::App& app, Registry& registry) {
                                      "Build a synthetic curve network from a manifold OBJ control mesh (thesis chapter 7)");
   cmd->footer(
       "Keeps every K-th edge loop (the border always), makes each chain of kept edges one polyline edge sampled "
-      "linearly on the control edges, collapses interior vertices of valence 2 and adds seeded Gaussian noise. "
+      "linearly on the control edges (or on the limit surface, --limit), collapses interior vertices of valence 2 and adds seeded Gaussian noise. "
       "Prints one JSON line: vertices, edges, faces, points and the number of faces of each size.");
   cmd->add_option("MESH", a->mesh_path, "control mesh, OBJ (v and f lines); must be manifold and consistently oriented")
       ->required();
@@ -76,6 +76,10 @@ void add_synth_commands(CLI::App& app, Registry& registry) {
                   "polyline points per control-mesh edge (at least 8), placed linearly along it")
       ->check(CLI::Range(kMinSamplesPerEdge, 65536u))
       ->capture_default_str();
+  cmd->add_flag("--limit", a->options.limit,
+               "sample the control mesh's Catmull-Clark limit surface instead of its straight edges: vertices at their "
+               "limit positions, each control edge sampled at the limit positions of its vertices after L subdivision "
+               "levels (2^L >= --samples), so the network lies exactly on the limit surface");
   cmd->add_option("-o,--output", a->out_path, "curve network file to write (format: engine/NETWORK_FORMAT.md)")
       ->required();
   cmd->callback([a, &registry] { registry.exit_code = run_network_from_mesh(*a); });

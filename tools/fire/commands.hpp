@@ -16,4 +16,7 @@ void add_synth_commands(CLI::App& app, Registry& registry);
 // simulate wand|sketch, calibrate, track (stereo tracking, systems/tracking)
 void add_tracking_commands(CLI::App& app, Registry& registry);
 
+// eval (surface distance to a reference limit surface, systems/evaluate)
+void add_eval_commands(CLI::App& app, Registry& registry);
+
 }  // namespace fire::cli

@@ -1,0 +1,61 @@
+// Sampled two-sided surface distances and the reference limit surface.
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "systems/evaluate/evaluate.hpp"
+#include "systems/subdivide/subdivide.hpp"
+
+namespace fire::evaluate {
+
+double OneSided::rms() const { return samples == 0 ? 0 : std::sqrt(sum_squared / static_cast<double>(samples)); }
+
+OneSided distances_to(std::span<const Vec3> points, const TriangleBvh& target) {
+  OneSided out;
+  uint32_t hint = kNoTriangle;  // samples come in surface order, so the last hit is usually near the next
+  for (const Vec3& p : points) {
+    const TriangleBvh::Hit hit = target.closest(p, hint);
+    hint = hit.triangle;
+    out.sum_squared += hit.distance_squared;
+    out.max = std::max(out.max, std::sqrt(hit.distance_squared));
+    ++out.samples;
+  }
+  return out;
+}
+
+SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleBvh& a_bvh, const TriangleMesh& b,
+                                 const TriangleBvh& b_bvh, double spacing, double scale) {
+  SurfaceDistance out;
+  out.a_to_b = distances_to(sample_triangles(a, spacing), b_bvh);
+  out.b_to_a = distances_to(sample_triangles(b, spacing), a_bvh);
+  const double samples = static_cast<double>(out.a_to_b.samples + out.b_to_a.samples);
+  out.rms = samples == 0 ? 0 : std::sqrt((out.a_to_b.sum_squared + out.b_to_a.sum_squared) / samples) / scale;
+  out.hausdorff = std::max(out.a_to_b.max, out.b_to_a.max) / scale;
+  return out;
+}
+
+Result<TriangleMesh> reference_limit_surface(std::span<const Vec3> positions, std::span<const uint32_t> face_offsets,
+                                             std::span<const uint32_t> face_vertices, int levels) {
+  using R = Result<TriangleMesh>;
+  auto sub = subdivide::subdivide({positions, face_offsets, face_vertices, {}}, levels);
+  if (!sub) return R::failure(sub.error());
+  TriangleMesh mesh;
+  mesh.positions = std::move(sub->limit_positions);
+  for (size_t v = 0; v < mesh.positions.size(); ++v)
+    if (!is_finite(mesh.positions[v]))
+      return R::failure("limit position " + std::to_string(v) + " is not finite");
+  const std::vector<uint32_t>& q = sub->quads;
+  mesh.triangles.reserve(q.size() / 4 * 6);
+  for (size_t f = 0; f + 3 < q.size(); f += 4) {
+    const Vec3 &p0 = mesh.positions[q[f]], &p1 = mesh.positions[q[f + 1]], &p2 = mesh.positions[q[f + 2]],
+               &p3 = mesh.positions[q[f + 3]];
+    // The shorter diagonal keeps the piecewise-linear reference closer to the curved limit surface.
+    if ((p2 - p0).squaredNorm() <= (p3 - p1).squaredNorm())
+      mesh.triangles.insert(mesh.triangles.end(), {q[f], q[f + 1], q[f + 2], q[f], q[f + 2], q[f + 3]});
+    else
+      mesh.triangles.insert(mesh.triangles.end(), {q[f], q[f + 1], q[f + 3], q[f + 1], q[f + 2], q[f + 3]});
+  }
+  return mesh;
+}
+
+}  // namespace fire::evaluate

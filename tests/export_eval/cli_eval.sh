@@ -1,0 +1,66 @@
+#!/usr/bin/env bash
+# `fire eval` as a user runs it: good input prints exactly one JSON line with rms and hausdorff (and
+# network_max with --network); bad input exits 1 with a message naming the file and prints nothing.
+set -u
+fire="$1"; meshes="$2"
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+fail=0
+check() { if eval "$2"; then echo "ok: $1"; else echo "FAILED: $1"; fail=1; fi; }
+# field NAME: the number after "NAME": in $tmp/out
+field() { sed -n "s/.*\"$1\":\([-+0-9.eE]*\).*/\1/p" "$tmp/out"; }
+expect_error() {  # NAME PATTERN CMD...: exit 1, stderr matching PATTERN, nothing on stdout
+  local name="$1" pattern="$2"; shift 2
+  "$@" >"$tmp/out" 2>"$tmp/err"; local rc=$?
+  if [ $rc -eq 1 ] && grep -q -- "$pattern" "$tmp/err" && [ ! -s "$tmp/out" ]; then
+    echo "ok: $name"; else echo "FAILED: $name (exit $rc)"; cat "$tmp/err"; fail=1; fi
+}
+
+# The control mesh is a coarse polygon around its own limit surface: small but clearly non-zero distances.
+"$fire" eval "$meshes/torus.obj" --reference "$meshes/torus.obj" --spacing 0.01 >"$tmp/out" 2>"$tmp/err"
+check "eval exits 0" "[ $? -eq 0 ]"
+check "exactly one line on stdout" "[ \$(wc -l <'$tmp/out') -eq 1 ]"
+check "nothing on stderr" "[ ! -s '$tmp/err' ]"
+check "the line is a JSON object with rms and hausdorff" "grep -q '^{\"rms\":[0-9.e-]*,\"hausdorff\":[0-9.e-]*,.*}$' '$tmp/out'"
+rms=$(field rms); hausdorff=$(field hausdorff)
+check "0.005 < rms < hausdorff < 0.2 (rms $rms, hausdorff $hausdorff)" \
+  "awk -v r='$rms' -v h='$hausdorff' 'BEGIN { exit !(r > 0.005 && r < h && h < 0.2) }'"
+check "no network_max without --network" "! grep -q network_max '$tmp/out'"
+
+# A network sampled on the control mesh's edges lies on that mesh: network_max is 0 up to rounding.
+"$fire" network-from-mesh "$meshes/torus.obj" --unrefine 2 -o "$tmp/torus.fnet" >/dev/null
+"$fire" eval "$meshes/torus.obj" --reference "$meshes/torus.obj" --network "$tmp/torus.fnet" --spacing 0.01 >"$tmp/out"
+network_max=$(field network_max)
+check "network on the surface: network_max ~ 0 ($network_max)" \
+  "[ -n '$network_max' ] && awk -v n='$network_max' 'BEGIN { exit !(n >= 0 && n < 1e-12) }'"
+# Noise moves the polyline points off the surface.
+"$fire" network-from-mesh "$meshes/torus.obj" --unrefine 2 --noise 5 -o "$tmp/noisy.fnet" >/dev/null
+"$fire" eval "$meshes/torus.obj" --reference "$meshes/torus.obj" --network "$tmp/noisy.fnet" --spacing 0.01 >"$tmp/out"
+noisy_max=$(field network_max)
+check "noisy network: network_max > 0.001 ($noisy_max)" "awk -v n='$noisy_max' 'BEGIN { exit !(n > 0.001) }'"
+
+expect_error "non-manifold reference fan.obj" \
+  "fire eval: .*fan.obj: reference mesh cannot be subdivided: .*shared by more than 2 faces" \
+  "$fire" eval "$meshes/cube.obj" --reference "$meshes/fan.obj"
+sed '3s/^v .*/v 0.0 nan 1.0/' "$meshes/cube.obj" >"$tmp/nan.obj"
+expect_error "NaN in the surface" "fire eval: .*nan.obj:3: vertex coordinate is not finite" \
+  "$fire" eval "$tmp/nan.obj" --reference "$meshes/cube.obj"
+expect_error "NaN in the reference" "fire eval: .*nan.obj:3: vertex coordinate is not finite" \
+  "$fire" eval "$meshes/cube.obj" --reference "$tmp/nan.obj"
+expect_error "missing surface" "fire eval: .*missing.obj: cannot open" \
+  "$fire" eval "$tmp/missing.obj" --reference "$meshes/cube.obj"
+expect_error "missing reference" "fire eval: .*missing.obj: cannot open" \
+  "$fire" eval "$meshes/cube.obj" --reference "$tmp/missing.obj"
+cp "$meshes/cube.obj" "$tmp/cube.xyz"
+expect_error "unknown surface format" "fire eval: .*cube.xyz: unknown surface format 'xyz'" \
+  "$fire" eval "$tmp/cube.xyz" --reference "$meshes/cube.obj"
+printf 'ply\nformat ascii 1.0\nend_header\n' >"$tmp/ascii.ply"
+expect_error "unsupported PLY" "fire eval: .*ascii.ply: unsupported PLY layout" \
+  "$fire" eval "$tmp/ascii.ply" --reference "$meshes/cube.obj"
+head -c 300 "$tmp/torus.fnet" >"$tmp/truncated.fnet"
+expect_error "truncated network" "fire eval: .*truncated.fnet" \
+  "$fire" eval "$meshes/cube.obj" --reference "$meshes/cube.obj" --network "$tmp/truncated.fnet"
+"$fire" eval "$meshes/cube.obj" --reference "$meshes/cube.obj" --reference-levels 4 >/dev/null 2>&1
+check "reference levels below 5 refused" "[ $? -ne 0 ]"
+"$fire" eval "$meshes/cube.obj" --reference "$meshes/cube.obj" --spacing 0 >/dev/null 2>&1
+check "spacing 0 refused" "[ $? -ne 0 ]"
+exit $fail

@@ -1,0 +1,248 @@
+// Surface distances: closest points against brute force, the BVH against a linear scan, analytic
+// two-sided distances, a surface against itself, and the reference limit surface's refusals.
+#include <catch2/catch.hpp>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <random>
+#include <unistd.h>
+
+#include "platform/obj.hpp"
+#include "platform/surface_io.hpp"
+#include "systems/evaluate/evaluate.hpp"
+
+using namespace fire;
+using namespace fire::evaluate;
+using Catch::Matchers::Contains;
+
+namespace {
+
+const std::string kMeshes = std::string(FIRE_SHARED_DIR) + "/data/meshes/";
+
+// An independent closest point: the projection onto the plane when it falls inside (signed areas),
+// else the nearest of the three edges.
+Vec3 brute_closest(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  auto on_segment = [&](const Vec3& s, const Vec3& t) {
+    const double len2 = (t - s).squaredNorm();
+    double u = len2 > 0 ? (p - s).dot(t - s) / len2 : 0;
+    u = u < 0 ? 0 : (u > 1 ? 1 : u);
+    return Vec3(s + u * (t - s));
+  };
+  std::vector<Vec3> candidates = {on_segment(a, b), on_segment(b, c), on_segment(c, a)};
+  const Vec3 n = (b - a).cross(c - a);
+  if (n.squaredNorm() > 0) {
+    const Vec3 q = p - n * ((p - a).dot(n) / n.squaredNorm());
+    if ((b - a).cross(q - a).dot(n) >= 0 && (c - b).cross(q - b).dot(n) >= 0 && (a - c).cross(q - c).dot(n) >= 0)
+      candidates.push_back(q);
+  }
+  Vec3 best = candidates[0];
+  for (const Vec3& q : candidates)
+    if ((q - p).squaredNorm() < (best - p).squaredNorm()) best = q;
+  return best;
+}
+
+TriangleMesh square(double z, double width = 1) {
+  TriangleMesh m;
+  m.positions = {{0, 0, z}, {width, 0, z}, {width, 1, z}, {0, 1, z}};
+  m.triangles = {0, 1, 2, 0, 2, 3};
+  return m;
+}
+
+TriangleMesh triangulated_obj(const std::string& name) {
+  auto obj = read_obj(kMeshes + name);
+  REQUIRE(obj.ok());
+  auto mesh = triangulate(obj->positions, obj->face_offsets, obj->face_vertices);
+  REQUIRE(mesh.ok());
+  return *mesh;
+}
+
+Result<TriangleMesh> reference_of(const std::string& name, int levels) {
+  auto obj = read_obj(kMeshes + name);
+  REQUIRE(obj.ok());
+  return reference_limit_surface(obj->positions, obj->face_offsets, obj->face_vertices, levels);
+}
+
+}  // namespace
+
+TEST_CASE("closest point on a triangle in each of the seven Voronoi regions", "[evaluate][closest]") {
+  const Vec3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  struct Case {
+    const char* region;
+    Vec3 p, expected;
+  };
+  const Case cases[] = {
+      {"vertex a", {-1, -1, 0.3}, a},
+      {"vertex b", {2, -0.5, 0.2}, b},
+      {"vertex c", {-0.5, 2, -0.4}, c},
+      {"edge ab", {0.5, -1, 0.5}, {0.5, 0, 0}},
+      {"edge ac", {-1, 0.5, 0.1}, {0, 0.5, 0}},
+      {"edge bc", {1, 1, 0.2}, {0.5, 0.5, 0}},
+      {"face", {0.2, 0.3, 0.7}, {0.2, 0.3, 0}},
+  };
+  for (const Case& k : cases) {
+    INFO(k.region);
+    CHECK((closest_point_on_triangle(k.p, a, b, c) - k.expected).norm() < 1e-15);
+    CHECK((brute_closest(k.p, a, b, c) - k.expected).norm() < 1e-15);
+    // The corner order must not matter.
+    CHECK((closest_point_on_triangle(k.p, c, a, b) - k.expected).norm() < 1e-15);
+  }
+}
+
+TEST_CASE("closest point on random triangles agrees with brute force", "[evaluate][closest]") {
+  std::mt19937_64 rng(12345);
+  std::normal_distribution<double> g(0, 1);
+  auto random_point = [&] { return Vec3(g(rng), g(rng), g(rng)); };
+  int regions_seen[7] = {0};
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3 a = random_point(), b = random_point(), c = random_point(), p = 2 * random_point();
+    const Vec3 q = closest_point_on_triangle(p, a, b, c);
+    const Vec3 r = brute_closest(p, a, b, c);
+    REQUIRE((q - p).norm() == Approx((r - p).norm()).margin(1e-12));
+    REQUIRE((q - r).norm() < 1e-9);
+    // Which region: count how many barycentric coordinates are zero.
+    const Eigen::Matrix<double, 3, 2> e = (Eigen::Matrix<double, 3, 2>() << b - a, c - a).finished();
+    const Eigen::Vector2d uv = e.colPivHouseholderQr().solve(q - a);
+    const int zeros = (std::abs(uv[0]) < 1e-12) + (std::abs(uv[1]) < 1e-12) + (std::abs(1 - uv[0] - uv[1]) < 1e-12);
+    ++regions_seen[zeros];
+  }
+  CHECK(regions_seen[0] > 100);  // face
+  CHECK(regions_seen[1] > 100);  // edges
+  CHECK(regions_seen[2] > 100);  // vertices
+}
+
+TEST_CASE("degenerate triangles are their edges", "[evaluate][closest]") {
+  const Vec3 p(0.3, 1, 0.2);
+  const Vec3 q = closest_point_on_triangle(p, {0, 0, 0}, {1, 0, 0}, {2, 0, 0});  // collinear
+  CHECK((q - Vec3(0.3, 0, 0)).norm() < 1e-15);
+  const Vec3 r = closest_point_on_triangle(p, {1, 1, 1}, {1, 1, 1}, {1, 1, 1});  // one point
+  CHECK(r == Vec3(1, 1, 1));
+  const Vec3 s = closest_point_on_triangle(p, {0, 0, 0}, {0, 0, 0}, {0, 2, 0});  // two corners equal
+  CHECK((s - Vec3(0, 1, 0)).norm() < 1e-15);
+}
+
+TEST_CASE("BVH closest points equal a linear scan over every triangle", "[evaluate][bvh]") {
+  const TriangleMesh mesh = triangulated_obj("pawn.obj");
+  const TriangleBvh bvh(mesh);
+  CHECK(bvh.node_count() > 100);
+  std::mt19937_64 rng(7);
+  Vec3 lo = mesh.positions[0], hi = lo;
+  for (const Vec3& p : mesh.positions) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  std::uniform_real_distribution<double> u(-0.2, 1.2);
+  std::uniform_int_distribution<uint32_t> any_triangle(0, static_cast<uint32_t>(mesh.triangle_count() - 1));
+  for (int i = 0; i < 500; ++i) {
+    const Vec3 p = lo + Vec3(u(rng), u(rng), u(rng)).cwiseProduct(hi - lo);
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+      const Vec3 q = closest_point_on_triangle(p, mesh.positions[mesh.triangles[3 * t]],
+                                               mesh.positions[mesh.triangles[3 * t + 1]],
+                                               mesh.positions[mesh.triangles[3 * t + 2]]);
+      best = std::min(best, (q - p).squaredNorm());
+    }
+    const TriangleBvh::Hit hit = bvh.closest(p);
+    // Equal up to the last bit of a point on an edge two triangles share, computed from either side.
+    REQUIRE(hit.distance_squared == Approx(best).epsilon(1e-13));
+    REQUIRE((hit.point - p).squaredNorm() == Approx(best).epsilon(1e-13));
+    REQUIRE(bvh.closest(p, any_triangle(rng)).distance_squared == Approx(best).epsilon(1e-13));  // any hint
+  }
+}
+
+TEST_CASE("a square against itself moved 0.1 along its normal", "[evaluate][analytic]") {
+  const TriangleMesh a = square(0), b = square(0.1);
+  const TriangleBvh a_bvh(a), b_bvh(b);
+  const double diagonal = bounding_box_diagonal(b.positions);
+  CHECK(diagonal == Approx(std::sqrt(2.0)));
+  const SurfaceDistance d = surface_distance(a, a_bvh, b, b_bvh, 0.05, diagonal);
+  // Every sample's nearest point is straight above or below it.
+  CHECK(d.rms == Approx(0.1 / diagonal).epsilon(1e-12));
+  CHECK(d.hausdorff == Approx(0.1 / diagonal).epsilon(1e-12));
+  // 4 vertices plus n*n centroids per triangle, n = ceil(sqrt(2) / 0.05) = 29.
+  CHECK(d.a_to_b.samples == 4 + 2 * 29 * 29);
+  CHECK(d.b_to_a.samples == d.a_to_b.samples);
+}
+
+TEST_CASE("two-sided distance sees what one side misses", "[evaluate][analytic]") {
+  // a is the left half of b, in the same plane: a -> b is 0 everywhere, b -> a is max(0, x - 1).
+  const TriangleMesh a = square(0), b = square(0, 2);
+  const TriangleBvh a_bvh(a), b_bvh(b);
+  const double spacing = 0.1;
+  const SurfaceDistance d = surface_distance(a, a_bvh, b, b_bvh, spacing, 2.0);
+  CHECK(d.a_to_b.max < 1e-15);  // rounding in the closest point of a coplanar sample
+  CHECK(d.b_to_a.max == Approx(1).epsilon(1e-15));  // the corners at x = 2
+  CHECK(d.hausdorff == Approx(0.5).epsilon(1e-15));
+  double sum = 0;
+  const std::vector<Vec3> b_samples = sample_triangles(b, spacing);
+  for (const Vec3& p : b_samples) sum += std::pow(std::max(0.0, p.x() - 1), 2);
+  const double all = static_cast<double>(d.a_to_b.samples + b_samples.size());
+  CHECK(d.rms == Approx(std::sqrt(sum / all) / 2.0).epsilon(1e-12));
+}
+
+TEST_CASE("samples cover each triangle evenly", "[evaluate][sampling]") {
+  TriangleMesh t;
+  t.positions = {{0, 0, 0}, {3, 0, 0}, {0.5, 2, 1}, {9, 9, 9}};  // the last vertex is unused
+  t.triangles = {0, 1, 2};
+  const std::vector<Vec3> s = sample_triangles(t, 0.5);
+  const double longest = std::max({(t.positions[1] - t.positions[0]).norm(), (t.positions[2] - t.positions[1]).norm(),
+                                   (t.positions[0] - t.positions[2]).norm()});
+  const int n = static_cast<int>(std::ceil(longest / 0.5));
+  CHECK(n == 7);
+  REQUIRE(s.size() == 3 + static_cast<size_t>(n * n));
+  Vec3 mean = Vec3::Zero();
+  for (size_t k = 3; k < s.size(); ++k) {
+    mean += s[k];
+    CHECK((closest_point_on_triangle(s[k], t.positions[0], t.positions[1], t.positions[2]) - s[k]).norm() < 1e-12);
+  }
+  mean /= static_cast<double>(n * n);
+  // Equal-area sub-triangles: their centroids average to the triangle's centroid.
+  CHECK((mean - (t.positions[0] + t.positions[1] + t.positions[2]) / 3).norm() < 1e-12);
+}
+
+TEST_CASE("a limit surface exported and read back is at distance 0 from itself", "[evaluate][export]") {
+  auto reference = reference_of("torus.obj", 5);
+  REQUIRE(reference.ok());
+  CHECK(reference->triangle_count() == 32 * 1024 * 2);
+  SurfaceMesh s;
+  s.positions = reference->positions;
+  s.face_vertices = reference->triangles;
+  for (size_t t = 1; t <= reference->triangle_count(); ++t) s.face_offsets.push_back(static_cast<uint32_t>(3 * t));
+  const std::string path = (std::filesystem::temp_directory_path() / ("fire_eval_self_" + std::to_string(::getpid()) + ".obj")).string();
+  REQUIRE(write_surface(s, path).ok());
+  auto back = read_surface(path);
+  std::filesystem::remove(path);
+  REQUIRE(back.ok());
+  auto out = triangulate(back->positions, back->face_offsets, back->face_vertices);
+  REQUIRE(out.ok());
+  const double diagonal = bounding_box_diagonal(reference->positions);
+  const TriangleBvh out_bvh(*out), ref_bvh(*reference);
+  const SurfaceDistance d = surface_distance(*out, out_bvh, *reference, ref_bvh, 0.01 * diagonal, diagonal);
+  CHECK(d.rms < 1e-14);
+  CHECK(d.hausdorff < 1e-14);
+  // The control mesh is a coarse polygon around the limit torus: clearly not at distance 0.
+  const TriangleMesh control = triangulated_obj("torus.obj");
+  const TriangleBvh control_bvh(control);
+  const SurfaceDistance far = surface_distance(control, control_bvh, *reference, ref_bvh, 0.01 * diagonal, diagonal);
+  CHECK(far.rms > 0.005);
+  CHECK(far.hausdorff > far.rms);
+}
+
+TEST_CASE("the reference limit surface refuses what cannot be subdivided", "[evaluate][reject]") {
+  auto fan = reference_of("fan.obj", 5);
+  REQUIRE_FALSE(fan.ok());
+  CHECK_THAT(fan.error(), Contains("shared by more than 2 faces"));
+  const std::vector<Vec3> nan_points = {{0, 0, 0}, {1, 0, 0}, {1, std::nan(""), 0}, {0, 1, 0}};
+  const std::vector<uint32_t> offsets = {0, 4}, quad = {0, 1, 2, 3};
+  auto nan = reference_limit_surface(nan_points, offsets, quad, 5);
+  REQUIRE_FALSE(nan.ok());
+  CHECK_THAT(nan.error(), Contains("non-finite"));
+  auto bad = triangulate(nan_points, offsets, std::vector<uint32_t>{0, 1, 9, 3});
+  REQUIRE_FALSE(bad.ok());
+  CHECK_THAT(bad.error(), Contains("vertex 2 has a non-finite coordinate"));
+  const std::vector<Vec3> ok_points = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  auto out_of_range = triangulate(ok_points, offsets, std::vector<uint32_t>{0, 1, 9, 3});
+  REQUIRE_FALSE(out_of_range.ok());
+  CHECK_THAT(out_of_range.error(), Contains("face 0 refers to vertex 9 of 4"));
+}

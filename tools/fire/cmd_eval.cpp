@@ -1,0 +1,102 @@
+// fire eval: distance of a reconstructed surface to the limit surface of its control mesh (issue 3, item 6).
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "platform/network_file.hpp"
+#include "platform/obj.hpp"
+#include "platform/surface_io.hpp"
+#include "systems/evaluate/evaluate.hpp"
+#include "tools/fire/commands.hpp"
+
+namespace fire::cli {
+
+namespace {
+
+struct EvalArgs {
+  std::string surface_path, reference_path, network_path;
+  int reference_levels = 5;
+  double spacing = 0.002;  // sample spacing, a fraction of the reference diagonal
+};
+
+int fail(const std::string& message) {
+  std::cerr << "fire eval: " << message << "\n";
+  return 1;
+}
+
+int run_eval(const EvalArgs& a) {
+  auto surface = read_surface(a.surface_path);
+  if (!surface) return fail(surface.error());
+  auto out_mesh = evaluate::triangulate(surface->positions, surface->face_offsets, surface->face_vertices);
+  if (!out_mesh) return fail(a.surface_path + ": " + out_mesh.error());
+
+  auto control = read_obj(a.reference_path);
+  if (!control) return fail(control.error());
+  auto reference = evaluate::reference_limit_surface(control->positions, control->face_offsets, control->face_vertices,
+                                                     a.reference_levels);
+  if (!reference) return fail(a.reference_path + ": reference mesh cannot be subdivided: " + reference.error());
+  const double diagonal = evaluate::bounding_box_diagonal(reference->positions);
+  if (!(diagonal > 0) || !std::isfinite(diagonal))
+    return fail(a.reference_path + ": the reference limit surface has no extent (bounding-box diagonal " +
+                std::to_string(diagonal) + ")");
+
+  std::vector<Vec3> network_points;
+  if (!a.network_path.empty()) {
+    auto network = load_network(a.network_path);
+    if (!network) return fail(network.error());
+    for (uint32_t e = 0; e < network->edge_slots(); ++e)
+      if (network->edge_alive(e))
+        for (const Vec3& p : network->polyline(e)) network_points.push_back(p);
+    if (network_points.empty()) return fail(a.network_path + ": the network has no polyline points");
+  }
+
+  const evaluate::TriangleBvh out_bvh(*out_mesh), reference_bvh(*reference);
+  const evaluate::SurfaceDistance d =
+      evaluate::surface_distance(*out_mesh, out_bvh, *reference, reference_bvh, a.spacing * diagonal, diagonal);
+  if (!std::isfinite(d.rms) || !std::isfinite(d.hausdorff))
+    return fail(a.surface_path + ": distances are not finite (rms " + std::to_string(d.rms) + ", hausdorff " +
+                std::to_string(d.hausdorff) + ")");
+
+  nlohmann::ordered_json out;
+  out["rms"] = d.rms;
+  out["hausdorff"] = d.hausdorff;
+  if (!network_points.empty()) {
+    const double network_max = evaluate::distances_to(network_points, out_bvh).max / diagonal;
+    if (!std::isfinite(network_max)) return fail(a.network_path + ": network distance is not finite");
+    out["network_max"] = network_max;
+  }
+  out["diagonal"] = diagonal;
+  out["samples"] = d.a_to_b.samples + d.b_to_a.samples;
+  std::cout << out.dump() << "\n";
+  return 0;
+}
+
+}  // namespace
+
+void add_eval_commands(CLI::App& app, Registry& registry) {
+  auto a = std::make_shared<EvalArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "eval",
+      "Measure a surface against the Catmull-Clark limit surface of a control mesh. Both are sampled densely "
+      "(vertices plus sub-triangle centroids); each sample's exact distance to the other surface is divided by the "
+      "bounding-box diagonal of the reference limit surface. Prints one JSON line: rms (square root of the mean "
+      "squared distance over the samples of both directions), hausdorff (largest distance, both directions), with "
+      "--network network_max (largest distance from a polyline point to the surface), diagonal, samples.");
+  cmd->add_option("SURFACE", a->surface_path, "surface to measure: .obj, .ply, .stl or .glb as `fire reconstruct` writes")
+      ->required();
+  cmd->add_option("--reference", a->reference_path,
+                  "control mesh (OBJ) whose limit surface is the ground truth; must be manifold")
+      ->required();
+  cmd->add_option("--network", a->network_path, "curve network whose polyline points are measured to SURFACE");
+  cmd->add_option("--reference-levels", a->reference_levels,
+                  "Catmull-Clark levels before projecting the reference to its limit")
+      ->check(CLI::Range(5, 7))
+      ->capture_default_str();
+  cmd->add_option("--spacing", a->spacing, "sample spacing on both surfaces, as a fraction of the reference diagonal")
+      ->check(CLI::Range(0.0005, 0.1))
+      ->capture_default_str();
+  cmd->callback([a, &registry] { registry.exit_code = run_eval(*a); });
+}
+
+}  // namespace fire::cli
