@@ -1,5 +1,7 @@
 #include "engine/input_log.hpp"
 
+#include "engine/text.hpp"
+
 #include <charconv>
 #include <fstream>
 #include <sstream>
@@ -13,19 +15,6 @@ std::string format_double(double v) {
 }
 
 namespace {
-
-std::vector<std::string_view> split_fields(std::string_view line) {
-  std::vector<std::string_view> out;
-  size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
-    size_t j = i;
-    while (j < line.size() && line[j] != ' ' && line[j] != '\t' && line[j] != '\r') ++j;
-    if (j > i) out.push_back(line.substr(i, j - i));
-    i = j;
-  }
-  return out;
-}
 
 bool parse_double(std::string_view s, double& out) {
   auto r = std::from_chars(s.data(), s.data() + s.size(), out);

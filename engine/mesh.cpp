@@ -16,48 +16,46 @@ void mark(std::vector<uint8_t>& dirty, uint32_t i) {
 
 }  // namespace
 
-// Visits every journaled column with the dirty tags of the pool it belongs to (nullptr for shared arrays).
+// Visits every journaled column.
 template <class F>
 void Mesh::for_each_column(F&& f) {
-  f(vertices.position, &vertices.dirty);
-  f(vertices.first_edge, &vertices.dirty);
-  f(vertices.generation, &vertices.dirty);
-  f(vertices.flags, &vertices.dirty);
-  f(vertices.free_list, nullptr);
-  f(edges.vertex, &edges.dirty);
-  f(edges.face, &edges.dirty);
-  f(edges.next, &edges.dirty);
-  f(edges.point_offset, &edges.dirty);
-  f(edges.point_count, &edges.dirty);
-  f(edges.generation, &edges.dirty);
-  f(edges.flags, &edges.dirty);
-  f(edges.free_list, nullptr);
-  f(faces.edge_offset, &faces.dirty);
-  f(faces.edge_count, &faces.dirty);
-  f(faces.generation, &faces.dirty);
-  f(faces.flags, &faces.dirty);
-  f(faces.free_list, nullptr);
-  f(points, nullptr);
-  f(face_edges, nullptr);
+  f(vertices.position);
+  f(vertices.first_edge);
+  f(vertices.generation);
+  f(vertices.flags);
+  f(vertices.free_list);
+  f(edges.vertex);
+  f(edges.face);
+  f(edges.next);
+  f(edges.point_offset);
+  f(edges.point_count);
+  f(edges.generation);
+  f(edges.flags);
+  f(edges.free_list);
+  f(faces.edge_offset);
+  f(faces.edge_count);
+  f(faces.generation);
+  f(faces.flags);
+  f(faces.free_list);
+  f(points);
+  f(face_edges);
 }
 
 template <class F>
 void Mesh::for_each_column(F&& f) const {
-  const_cast<Mesh*>(this)->for_each_column([&](auto& column, std::vector<uint8_t>*) { f(std::as_const(column)); });
+  const_cast<Mesh*>(this)->for_each_column([&](auto& column) { f(std::as_const(column)); });
 }
 
-size_t Mesh::vertex_count() const {
-  return static_cast<size_t>(std::count_if(vertices.flags.values().begin(), vertices.flags.values().end(),
-                                           [](uint8_t f) { return f & kAlive; }));
+namespace {
+size_t count_alive(const Column<uint8_t>& flags) {
+  return static_cast<size_t>(
+      std::count_if(flags.values().begin(), flags.values().end(), [](uint8_t f) { return f & kAlive; }));
 }
-size_t Mesh::edge_count() const {
-  return static_cast<size_t>(std::count_if(edges.flags.values().begin(), edges.flags.values().end(),
-                                           [](uint8_t f) { return f & kAlive; }));
-}
-size_t Mesh::face_count() const {
-  return static_cast<size_t>(std::count_if(faces.flags.values().begin(), faces.flags.values().end(),
-                                           [](uint8_t f) { return f & kAlive; }));
-}
+}  // namespace
+
+size_t Mesh::vertex_count() const { return count_alive(vertices.flags); }
+size_t Mesh::edge_count() const { return count_alive(edges.flags); }
+size_t Mesh::face_count() const { return count_alive(faces.flags); }
 size_t Mesh::live_point_count() const {
   size_t n = 0;
   for (uint32_t e = 0; e < edge_slots(); ++e)
@@ -280,20 +278,19 @@ void Mesh::move_vertex(uint32_t v, const Vec3& p) {
 
 MeshMark Mesh::begin_transaction() {
   MeshMark m;
-  for_each_column([&](auto& column, std::vector<uint8_t>*) { m.columns.push_back(column.begin()); });
+  for_each_column([&](auto& column) { m.columns.push_back(column.begin()); });
   return m;
 }
 
 void Mesh::end_transaction() {
-  for_each_column([](auto& column, std::vector<uint8_t>*) { column.end(); });
+  for_each_column([](auto& column) { column.end(); });
 }
 
 void Mesh::rollback(const MeshMark& m) {
   size_t k = 0;
-  for_each_column([&](auto& column, std::vector<uint8_t>* dirty) {
+  for_each_column([&](auto& column) {
     column.end();
     column.rollback(m.columns[k++]);
-    (void)dirty;
   });
   // Everything that survived the rollback may have changed: tag it all for consumers to re-read.
   vertices.dirty.assign(vertex_slots(), 1);
@@ -302,7 +299,7 @@ void Mesh::rollback(const MeshMark& m) {
 }
 
 void Mesh::forget_history() {
-  for_each_column([](auto& column, std::vector<uint8_t>*) { column.forget_journal(); });
+  for_each_column([](auto& column) { column.forget_journal(); });
 }
 
 CompactionMap Mesh::compact() {

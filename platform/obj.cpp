@@ -2,26 +2,11 @@
 
 #include <charconv>
 
+#include "engine/text.hpp"
 #include "platform/files.hpp"
 
 namespace fire {
 
-namespace {
-
-std::vector<std::string_view> fields(std::string_view line) {
-  std::vector<std::string_view> out;
-  size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
-    size_t j = i;
-    while (j < line.size() && line[j] != ' ' && line[j] != '\t' && line[j] != '\r') ++j;
-    if (j > i) out.push_back(line.substr(i, j - i));
-    i = j;
-  }
-  return out;
-}
-
-}  // namespace
 
 Result<PolygonMesh> parse_obj(std::string_view text, const std::string& source) {
   PolygonMesh mesh;
@@ -35,7 +20,7 @@ Result<PolygonMesh> parse_obj(std::string_view text, const std::string& source) 
     std::string_view line = text.substr(pos, end - pos);
     pos = end + 1;
     ++line_no;
-    auto f = fields(line);
+    auto f = split_fields(line);
     if (f.empty() || f[0][0] == '#') continue;
     if (f[0] == "v") {
       if (f.size() < 4) return fail(line_no, "vertex needs three coordinates");
