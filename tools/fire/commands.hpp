@@ -19,4 +19,7 @@ void add_tracking_commands(CLI::App& app, Registry& registry);
 // eval (surface distance to a reference limit surface, systems/evaluate)
 void add_eval_commands(CLI::App& app, Registry& registry);
 
+// reconstruct (curve network to smooth surface, systems/reconstruct)
+void add_reconstruct_commands(CLI::App& app, Registry& registry);
+
 }  // namespace fire::cli

@@ -1,0 +1,72 @@
+#pragma once
+// The per-edge and per-face stages of reconstruction. Each is a pure function of one network edge or
+// one network face (its loop and its edges' polylines), which is what lets an edit recompute only the
+// faces it touched: both faces of an edge split it identically because the split is computed on the
+// edge's stored polyline, never on a face's view of it.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "engine/mesh.hpp"
+#include "systems/reconstruct/geometry.hpp"
+
+namespace fire::reconstruct {
+
+enum class Method : uint8_t { thesis, fire };
+
+// A base-mesh vertex before global numbering: a network vertex (index = vertex slot), a split point of a
+// network edge (index = edge slot, sub = 1 .. 2^N - 1 along the edge's stored direction), or a vertex made
+// inside a face (index = its position in FacePatch::interior).
+enum class RefKind : uint8_t { network_vertex, edge_point, interior };
+struct VertexRef {
+  RefKind kind = RefKind::network_vertex;
+  uint32_t index = 0;
+  uint32_t sub = 0;
+  friend bool operator==(const VertexRef&, const VertexRef&) = default;
+};
+
+// A network edge's polyline split recursively at middle samples, `depth` times. Heap order: node 1 is the
+// whole polyline, the halves of node k are 2k and 2k+1, and the leaves 2^depth .. 2^(depth+1)-1 are the
+// base edges along the network edge, in its stored direction.
+struct EdgeSplits {
+  uint32_t depth = 0;
+  std::vector<std::vector<Vec3>> nodes;
+  std::span<const Vec3> node(uint32_t k) const { return nodes[k]; }
+  uint32_t leaf_count() const { return 1u << depth; }
+  std::span<const Vec3> leaf(uint32_t i) const { return nodes[leaf_count() + i]; }
+};
+EdgeSplits split_network_edge(std::span<const Vec3> line, uint32_t depth);
+
+struct FaceSettings {
+  Method method = Method::fire;
+  uint32_t coons_steps = 1;
+  Planarity planarity = Planarity::least_squares;
+};
+
+// What one network face contributes to the base mesh.
+struct FacePatch {
+  std::vector<Vec3> interior;       // positions of the vertices made inside the face
+  std::vector<VertexRef> quads;     // 4 per base quad, in the face's winding
+  // Base edges inside the face (triquadrification cuts, spokes) with the polylines they carry: straight
+  // (thesis) or sampled from the transfinite patch (FIRE). 2 ends per curve.
+  std::vector<VertexRef> curve_ends;
+  std::vector<uint32_t> curve_offsets{0};
+  std::vector<Vec3> curve_points;
+  uint32_t quad_count() const { return static_cast<uint32_t>(quads.size() / 4); }
+  uint32_t curve_count() const { return static_cast<uint32_t>(curve_offsets.size() - 1); }
+  std::span<const Vec3> curve(uint32_t c) const {
+    return std::span<const Vec3>(curve_points).subspan(curve_offsets[c], curve_offsets[c + 1] - curve_offsets[c]);
+  }
+  // Sizes of the faces the first stage made: the triquadrification's triangles and quads (thesis), or
+  // the face itself (FIRE).
+  std::vector<uint32_t> first_stage_sizes;
+};
+
+// `splits[k]` is the split of the edge at loop position k (depth = coons_steps). A face with 2 edges is
+// the degenerate quad whose other two sides are its corners: 2 quads around the centre of the ruled
+// surface between its two curves (FIRE's rule; the thesis has none, and check_reconstruction_input
+// rejects such faces for it).
+FacePatch build_face_patch(const Mesh& net, uint32_t face, std::span<const EdgeSplits* const> splits,
+                           const FaceSettings& settings);
+
+}  // namespace fire::reconstruct

@@ -1,0 +1,294 @@
+#include "systems/reconstruct/fit.hpp"
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <unordered_map>
+
+namespace fire::reconstruct {
+
+namespace {
+
+using SparseRows = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+using Sparse = Eigen::SparseMatrix<double>;
+
+// The level-`last` vertices along edge `edge` of level `level`, walking from its end `from`, without the
+// far end (children keep their parent vertex's index; fire_subdivide's numbering, see subdivide.hpp).
+void collect_chain(const subdivide::Refinement& r, uint32_t level, uint32_t edge, uint32_t from, uint32_t last,
+                   std::vector<uint32_t>& out) {
+  if (level == last) {
+    out.push_back(from);
+    return;
+  }
+  const subdivide::Level& lv = r.levels[level];
+  const uint32_t k = lv.edge_vertices[2 * edge] == from ? 0u : 1u;
+  const uint32_t mid = lv.vertex_count + lv.face_count() + edge;
+  const uint32_t children = lv.corner_count() + 2 * edge;
+  collect_chain(r, level + 1, children + k, from, last, out);
+  collect_chain(r, level + 1, children + (1 - k), mid, last, out);
+}
+
+double bounding_diagonal(const std::vector<Vec3>& points) {
+  if (points.empty()) return 0;
+  Vec3 lo = points[0], hi = points[0];
+  for (const Vec3& p : points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  return (hi - lo).norm();
+}
+
+// The umbrella operator of the base mesh: each vertex minus the mean of its neighbours. On the border
+// only the neighbours along the border count and corners (border vertices of one face) are left out,
+// as Catmull-Clark treats them, so that a flat grid costs nothing up to its border.
+Sparse umbrella(const BaseMesh& base) {
+  const uint32_t n = base.vertex_count();
+  std::unordered_map<uint64_t, uint32_t> sides;  // faces per undirected edge
+  auto key = [](uint32_t a, uint32_t b) { return uint64_t(std::min(a, b)) << 32 | std::max(a, b); };
+  std::vector<uint32_t> faces(n, 0);
+  for (uint32_t f = 0; f < base.face_count(); ++f)
+    for (uint32_t c = base.face_offsets[f]; c < base.face_offsets[f + 1]; ++c) {
+      const uint32_t next = c + 1 == base.face_offsets[f + 1] ? base.face_offsets[f] : c + 1;
+      ++sides[key(base.face_vertices[c], base.face_vertices[next])];
+      ++faces[base.face_vertices[c]];
+    }
+  std::vector<std::vector<uint32_t>> all(n), border(n);
+  for (uint32_t c = 0; c < base.curve_count(); ++c) {
+    const uint32_t a = base.curve_ends[2 * c], b = base.curve_ends[2 * c + 1];
+    all[a].push_back(b);
+    all[b].push_back(a);
+    if (sides[key(a, b)] == 1) {
+      border[a].push_back(b);
+      border[b].push_back(a);
+    }
+  }
+  std::vector<Eigen::Triplet<double>> entries;
+  for (uint32_t v = 0; v < n; ++v) {
+    const std::vector<uint32_t>& ring = border[v].empty() ? all[v] : border[v];
+    if (!border[v].empty() && faces[v] < 2) continue;
+    entries.emplace_back(int(v), int(v), 1.0);
+    for (uint32_t u : ring) entries.emplace_back(int(v), int(u), -1.0 / double(ring.size()));
+  }
+  Sparse op(n, n);
+  op.setFromTriplets(entries.begin(), entries.end());
+  return op;
+}
+
+}  // namespace
+
+struct LimitFit::Impl {
+  FitWeights settings;
+  uint32_t base_vertices = 0;
+  SparseRows rows;  // limit positions of the selected level-L vertices, from base points
+  // Per network edge, its rows in order along it (ends included) and its curves (pieces).
+  std::vector<std::vector<Eigen::Index>> paths;
+  std::vector<uint32_t> path_first_curve;
+  std::vector<Eigen::Index> vertex_row;  // row of each drawn base vertex (-1 for the others)
+  double ridge = 0;
+  Eigen::SimplicialLDLT<Sparse> solver;
+};
+
+LimitFit::LimitFit() = default;
+LimitFit::~LimitFit() = default;
+LimitFit::LimitFit(LimitFit&&) noexcept = default;
+LimitFit& LimitFit::operator=(LimitFit&&) noexcept = default;
+
+Result<LimitFit> LimitFit::build(const subdivide::Refinement& refinement, const subdivide::LimitStencils& limit,
+                                 const BaseMesh& base, const FitWeights& settings) {
+  const uint32_t last = static_cast<uint32_t>(refinement.levels.size() - 1);
+  const subdivide::Level& level0 = refinement.levels[0];
+  const uint32_t nb = base.vertex_count();
+  auto impl = std::make_unique<Impl>();
+  impl->settings = settings;
+  impl->base_vertices = nb;
+
+  std::unordered_map<uint64_t, uint32_t> edge_of_pair;
+  for (uint32_t e = 0; e < level0.edge_count(); ++e) {
+    const uint32_t a = level0.edge_vertices[2 * e], b = level0.edge_vertices[2 * e + 1];
+    edge_of_pair[uint64_t(std::min(a, b)) << 32 | std::max(a, b)] = e;
+  }
+  // Rows: the drawn base vertices (a child keeps its parent's index), then the inner level-L vertices of
+  // every drawn curve, network edge by network edge.
+  std::vector<uint32_t> selected;
+  impl->vertex_row.assign(nb, -1);
+  for (uint32_t v = 0; v < nb; ++v)
+    if (base.vertex_drawn[v]) {
+      impl->vertex_row[v] = Eigen::Index(selected.size());
+      selected.push_back(v);
+    }
+  std::vector<uint32_t> chain;
+  for (uint32_t c = 0; c < base.curve_count() && base.curve_drawn[c]; ++c) {
+    const uint32_t a = base.curve_ends[2 * c], b = base.curve_ends[2 * c + 1];
+    if (c % base.pieces_per_edge == 0) {
+      impl->paths.push_back({impl->vertex_row[a]});
+      impl->path_first_curve.push_back(c);
+    }
+    auto it = edge_of_pair.find(uint64_t(std::min(a, b)) << 32 | std::max(a, b));
+    if (it == edge_of_pair.end())
+      return Result<LimitFit>::failure("internal error: curve " + std::to_string(c) + " is not a base edge");
+    chain.clear();
+    collect_chain(refinement, 0, it->second, a, last, chain);
+    for (size_t k = 1; k < chain.size(); ++k) {
+      impl->paths.back().push_back(Eigen::Index(selected.size()));
+      selected.push_back(chain[k]);
+    }
+    impl->paths.back().push_back(impl->vertex_row[b]);
+  }
+
+  subdivide::StencilTable table;
+  for (uint32_t v : selected) {
+    for (uint32_t k = limit.offsets[v]; k < limit.offsets[v + 1]; ++k) {
+      table.sources.push_back(limit.sources[k]);
+      table.weights.push_back(limit.position[k]);
+    }
+    table.offsets.push_back(static_cast<uint32_t>(table.sources.size()));
+  }
+  for (uint32_t l = last; l-- > 0;) table = subdivide::compose(table, subdivide::stencil_table(refinement, l));
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(table.sources.size());
+  for (uint32_t r = 0; r < table.row_count(); ++r)
+    for (uint32_t k = table.offsets[r]; k < table.offsets[r + 1]; ++k)
+      triplets.emplace_back(static_cast<int>(r), static_cast<int>(table.sources[k]), table.weights[k]);
+  impl->rows.resize(Eigen::Index(selected.size()), nb);
+  impl->rows.setFromTriplets(triplets.begin(), triplets.end());
+
+  Sparse normal = Sparse(impl->rows.transpose()) * impl->rows;
+  const double data_scale = normal.diagonal().mean();
+  const Sparse laplacian = umbrella(base);
+  const Sparse bilaplacian = laplacian * laplacian;
+  const Sparse fairness = Sparse(bilaplacian.transpose()) * bilaplacian;
+  normal += (settings.fairness * data_scale / fairness.diagonal().mean()) * fairness;
+  impl->ridge = settings.ridge * data_scale;
+  for (Eigen::Index v = 0; v < normal.cols(); ++v) normal.coeffRef(v, v) += impl->ridge;
+  impl->solver.compute(normal);
+  if (impl->solver.info() != Eigen::Success)
+    return Result<LimitFit>::failure("the limit fit's normal matrix could not be factored");
+  LimitFit fit;
+  fit.impl_ = std::move(impl);
+  return fit;
+}
+
+namespace {
+
+// A stretch of a network polyline whose two ends are fixed targets, and the rows in between whose
+// targets slide along it.
+struct Span {
+  std::vector<Vec3> line;
+  std::vector<double> params;
+  std::vector<Eigen::Index> rows;  // in order along the line, ends included
+};
+
+Span make_span(std::span<const Vec3> line, std::vector<Eigen::Index> rows) {
+  Span s{std::vector<Vec3>(line.begin(), line.end()), {}, std::move(rows)};
+  s.params = arc_parameters(s.line);
+  return s;
+}
+
+// Re-places the inner targets of a span at the arc-length fractions its fitted limit points have along
+// it; returns the largest move.
+double slide(const Span& span, const Eigen::MatrixX3d& fitted, Eigen::MatrixX3d& targets, std::vector<double>& length) {
+  const std::vector<Eigen::Index>& rows = span.rows;
+  length.assign(rows.size(), 0.0);
+  for (size_t k = 1; k < rows.size(); ++k) length[k] = length[k - 1] + (fitted.row(rows[k]) - fitted.row(rows[k - 1])).norm();
+  const double total = length.back();
+  double largest = 0;
+  if (!(total > 0)) return largest;
+  for (size_t k = 1; k + 1 < rows.size(); ++k) {
+    const Vec3 target = sample_polyline(span.line, span.params, length[k] / total, Sampling::linear);
+    largest = std::max(largest, (target - Vec3(targets.row(rows[k]).transpose())).norm());
+    targets.row(rows[k]) = target.transpose();
+  }
+  return largest;
+}
+
+// Splits a whole network edge's span at the polyline samples nearest to its split points' targets, which
+// then become those samples exactly; keeps it whole when they would not be distinct, ordered samples.
+void snap_split_points(Span& whole, uint32_t pieces, Eigen::MatrixX3d& targets, std::vector<Span>& out) {
+  const size_t steps = (whole.rows.size() - 1) / pieces, last = whole.line.size() - 1;
+  std::vector<size_t> at{0};
+  for (uint32_t i = 1; i < pieces; ++i) {
+    const Vec3 target = targets.row(whole.rows[i * steps]).transpose();
+    size_t best = 0;
+    for (size_t j = 1; j < last; ++j)
+      if ((whole.line[j] - target).squaredNorm() < (whole.line[best] - target).squaredNorm()) best = j;
+    if (best <= at.back()) {
+      out.push_back(std::move(whole));
+      return;
+    }
+    at.push_back(best);
+  }
+  at.push_back(last);
+  for (uint32_t i = 0; i < pieces; ++i) {
+    if (i > 0) targets.row(whole.rows[i * steps]) = whole.line[at[i]].transpose();
+    std::vector<Eigen::Index> rows(whole.rows.begin() + i * steps, whole.rows.begin() + (i + 1) * steps + 1);
+    out.push_back(make_span(std::span<const Vec3>(whole.line).subspan(at[i], at[i + 1] - at[i] + 1), std::move(rows)));
+  }
+}
+
+}  // namespace
+
+LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points) const {
+  const Impl& m = *impl_;
+  const uint32_t nb = m.base_vertices, pieces = base.pieces_per_edge;
+  Eigen::MatrixX3d targets(m.rows.rows(), 3), initial(nb, 3);
+  for (uint32_t v = 0; v < nb; ++v) {
+    initial.row(v) = base.positions[v].transpose();
+    if (m.vertex_row[v] >= 0) targets.row(m.vertex_row[v]) = base.positions[v].transpose();
+  }
+  // First targets: equal arc-length steps along each piece of each network edge.
+  std::vector<Span> spans;
+  std::vector<Vec3> line;
+  for (size_t p = 0; p < m.paths.size(); ++p) {
+    const std::vector<Eigen::Index>& rows = m.paths[p];
+    const size_t steps = (rows.size() - 1) / pieces;
+    line.clear();
+    for (uint32_t i = 0; i < pieces; ++i) {
+      auto piece = base.curve(m.path_first_curve[p] + i);
+      line.insert(line.end(), piece.begin() + (i == 0 ? 0 : 1), piece.end());
+      const std::vector<double> t = arc_parameters(piece);
+      for (size_t k = 1; k < steps; ++k)
+        targets.row(rows[i * steps + k]) = sample_polyline(piece, t, double(k) / double(steps), Sampling::linear).transpose();
+    }
+    spans.push_back(make_span(line, rows));
+  }
+  const double tolerance = m.settings.tolerance * std::max(bounding_diagonal(base.positions), 1e-300);
+
+  Report report;
+  Eigen::MatrixX3d solution, fitted;
+  auto solve_once = [&] {
+    const Eigen::MatrixX3d rhs = Eigen::MatrixX3d(m.rows.transpose() * targets) + m.ridge * initial;
+    solution = m.solver.solve(rhs);
+    fitted = m.rows * solution;
+    ++report.iterations;
+  };
+  std::vector<double> scratch;
+  solve_once();
+  // Phase 1: the split points slide too, to where the fitted surface puts them along the whole edge.
+  for (uint32_t round = 0; round < m.settings.slide_iterations; ++round) {
+    double move = 0;
+    for (const Span& span : spans) move = std::max(move, slide(span, fitted, targets, scratch));
+    solve_once();
+    if (move <= tolerance) break;
+  }
+  // Phase 2: the split points settle on polyline samples, and each piece is fitted between them.
+  if (pieces > 1) {
+    std::vector<Span> split;
+    for (Span& span : spans) snap_split_points(span, pieces, targets, split);
+    spans = std::move(split);
+    solve_once();
+  }
+  while (report.iterations < m.settings.max_iterations) {
+    double move = 0;
+    for (const Span& span : spans) move = std::max(move, slide(span, fitted, targets, scratch));
+    if (move <= tolerance) break;
+    solve_once();
+  }
+  points.resize(nb);
+  for (uint32_t v = 0; v < nb; ++v) points[v] = solution.row(v).transpose();
+  report.rms = m.rows.rows() ? std::sqrt((fitted - targets).squaredNorm() / double(m.rows.rows())) : 0.0;
+  return report;
+}
+
+}  // namespace fire::reconstruct

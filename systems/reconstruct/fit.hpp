@@ -1,0 +1,62 @@
+#pragma once
+// The FIRE pipeline's last step: base points whose Catmull-Clark limit surface passes through the
+// drawn polylines.
+//
+// The limit position of every level-L vertex is a fixed linear combination of the base points (each
+// level's subdivision stencils composed with the last level's limit masks, all from fire_subdivide).
+// Along every network edge lie 2^(N+L) + 1 level-L vertices (N Coons steps, L levels); the fit asks
+// their limit positions to meet the edge's polyline, in the least-squares sense. Curves alone leave
+// each face's interior free (on a regular grid about one bulge mode per face: moving a face's centre
+// and its edge midpoints in a way no limit curve along the edges sees), so a small fairness term, the
+// squared bi-Laplacian (umbrella operator applied twice) of the base points, picks the smoothest
+// surface among those that fit; a tiny ridge towards the initial base points (from the transfinite
+// patches) keeps the matrix definite. The normal matrix A^T A + fairness + ridge depends on topology
+// alone: it is factored once (sparse LDL^T) and a change of the points costs back-substitutions.
+//
+// The targets start at equal arc-length steps along each piece of a network edge. A limit curve is not
+// parameterized by arc length, so after each solve the targets inside every network edge (the split
+// points included; the network vertices stay) are re-placed at the arc-length fractions the fitted limit
+// points actually have along the edge, and the system is solved again: the surface then passes through
+// the polyline rather than being pulled along it. This converges linearly (about a factor 6 per solve on
+// smooth data); it stops when no target moves more than `tolerance` times the base mesh's size.
+#include <memory>
+#include <vector>
+
+#include "systems/reconstruct/reconstruct.hpp"
+#include "systems/subdivide/subdivide.hpp"
+
+namespace fire::reconstruct {
+
+struct FitWeights {
+  // Weight of the bi-Laplacian fairness, relative to the data (both measured by the mean diagonal of
+  // their normal matrices); Options::fairness.
+  double fairness = 1e-3;
+  double ridge = 1e-9;  // same scale, towards the initial base points
+  uint32_t slide_iterations = 10;  // solves while the split points slide (phase 1)
+  uint32_t max_iterations = 40;
+  double tolerance = 1e-11;
+};
+
+class LimitFit {
+ public:
+  LimitFit();
+  ~LimitFit();
+  LimitFit(LimitFit&&) noexcept;
+  LimitFit& operator=(LimitFit&&) noexcept;
+
+  // Rows and factorization for this topology (`refinement` of `base`, with last-level adjacency).
+  static Result<LimitFit> build(const subdivide::Refinement& refinement, const subdivide::LimitStencils& limit,
+                                const BaseMesh& base, const FitWeights& weights);
+  struct Report {
+    uint32_t iterations = 0;  // solves (back-substitutions)
+    double rms = 0;           // rms distance of the fitted limit points to their final targets
+  };
+  // The fitted base points for base's polylines, from its initial positions.
+  Report solve(const BaseMesh& base, std::vector<Vec3>& points) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace fire::reconstruct

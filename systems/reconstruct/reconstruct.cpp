@@ -1,0 +1,285 @@
+#include "systems/reconstruct/reconstruct.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include "systems/reconstruct/fit.hpp"
+#include "systems/subdivide/subdivide.hpp"
+
+namespace fire::reconstruct {
+
+struct ReconstructionCache {
+  bool built = false;
+  Options options;
+  // Per element slot of the network; valid[] says whether the entry holds the element's current result.
+  std::vector<EdgeSplits> edges;
+  std::vector<uint8_t> edge_valid;
+  std::vector<FacePatch> faces;
+  std::vector<uint8_t> face_valid;
+  BaseMesh base;
+  // What depends on the base mesh's topology alone.
+  bool have_topology = false;
+  std::vector<uint32_t> key_face_offsets, key_face_vertices, key_sharp, key_curve_ends;
+  std::vector<uint8_t> key_curve_drawn, key_vertex_drawn;
+  uint32_t key_vertex_count = 0;
+  subdivide::Refinement refinement;
+  subdivide::LimitStencils limit;
+  LimitFit fit;
+  UpdateStats stats;
+  std::vector<Vec3> scratch;
+};
+
+ReconstructionState::ReconstructionState() : cache_(std::make_unique<ReconstructionCache>()) {}
+ReconstructionState::~ReconstructionState() = default;
+ReconstructionState::ReconstructionState(ReconstructionState&&) noexcept = default;
+ReconstructionState& ReconstructionState::operator=(ReconstructionState&&) noexcept = default;
+const UpdateStats& ReconstructionState::last_update() const { return cache_->stats; }
+const BaseMesh& ReconstructionState::base() const { return cache_->base; }
+
+namespace {
+
+bool used_by_face(const Mesh& net, uint32_t e) {
+  return net.edges.face[e][0] != kNone || net.edges.face[e][1] != kNone;
+}
+
+// A slot beyond the tag array was never tagged clean.
+bool tagged(const std::vector<uint8_t>& dirty, uint32_t i) { return i >= dirty.size() || dirty[i]; }
+
+}  // namespace
+
+Status check_reconstruction_input(const Mesh& net, const Options& options) {
+  if (options.coons_steps < 1 || options.coons_steps > kMaxCoonsSteps)
+    return Status::failure("the number of Coons steps must be 1 to " + std::to_string(kMaxCoonsSteps) + ", not " +
+                           std::to_string(options.coons_steps));
+  if (options.levels < 1 || options.levels > kMaxLevels)
+    return Status::failure("the subdivision level must be 1 to " + std::to_string(kMaxLevels) + ", not " +
+                           std::to_string(options.levels));
+  if (!(options.fairness >= 0 && options.fairness <= 1))
+    return Status::failure("the fairness weight must be 0 to 1, not " + std::to_string(options.fairness));
+  if (std::string problem = net.validate(); !problem.empty()) return Status::failure("invalid network: " + problem);
+  if (net.face_count() == 0) return Status::failure("the network has no faces");
+  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+    if (!net.edge_alive(e) || !used_by_face(net, e)) continue;
+    auto line = net.polyline(e);
+    if (std::all_of(line.begin(), line.end(), [&](const Vec3& p) { return p == line.front(); }))
+      return Status::failure("edge " + std::to_string(e) + "'s polyline has zero length");
+    for (size_t i = 1; i < line.size(); ++i)
+      if (line[i] == line[i - 1])
+        return Status::failure("edge " + std::to_string(e) + "'s polyline has coincident consecutive points " +
+                               std::to_string(i - 1) + " and " + std::to_string(i));
+  }
+  for (uint32_t f = 0; f < net.face_slots(); ++f) {
+    if (!net.face_alive(f)) continue;
+    auto loop = net.face_loop(f);
+    if (options.method == Method::thesis && loop.size() < 3)
+      return Status::failure("face " + std::to_string(f) + " has " + std::to_string(loop.size()) +
+                             " edges; the thesis method needs at least 3 (use --method fire)");
+    for (size_t i = 0; i < loop.size(); ++i)
+      for (size_t j = i + 1; j < loop.size(); ++j) {
+        const uint32_t a = net.tail(loop[i]), b = net.tail(loop[j]);
+        if (net.vertices.position[a] == net.vertices.position[b])
+          return Status::failure("face " + std::to_string(f) + " has coincident corners: vertices " +
+                                 std::to_string(a) + " and " + std::to_string(b) + " lie at the same point");
+      }
+  }
+  return Status::success();
+}
+
+namespace {
+
+// The per-edge and per-face stages, for the elements whose tags say they may have changed.
+void update_elements(const Mesh& net, const Options& options, ReconstructionCache& c, bool everything) {
+  c.edges.resize(net.edge_slots());
+  c.edge_valid.resize(net.edge_slots(), 0);
+  c.faces.resize(net.face_slots());
+  c.face_valid.resize(net.face_slots(), 0);
+  c.stats = {};
+  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+    if (!net.edge_alive(e) || !used_by_face(net, e)) {
+      c.edges[e] = {};
+      c.edge_valid[e] = 0;
+      continue;
+    }
+    if (!everything && c.edge_valid[e] && !tagged(net.edges.dirty, e)) continue;
+    c.edges[e] = split_network_edge(net.polyline(e), options.coons_steps);
+    c.edge_valid[e] = 1;
+    ++c.stats.edges_recomputed;
+  }
+  const FaceSettings settings{options.method, options.coons_steps, options.planarity};
+  std::vector<const EdgeSplits*> splits;
+  for (uint32_t f = 0; f < net.face_slots(); ++f) {
+    if (!net.face_alive(f)) {
+      c.faces[f] = {};
+      c.face_valid[f] = 0;
+      continue;
+    }
+    auto loop = net.face_loop(f);
+    bool stale = everything || !c.face_valid[f] || tagged(net.faces.dirty, f);
+    for (uint32_t oe : loop) stale = stale || tagged(net.edges.dirty, edge_of(oe));
+    if (!stale) continue;
+    splits.clear();
+    for (uint32_t oe : loop) splits.push_back(&c.edges[edge_of(oe)]);
+    c.faces[f] = build_face_patch(net, f, splits, settings);
+    c.face_valid[f] = 1;
+    ++c.stats.faces_recomputed;
+  }
+}
+
+// Global numbering, in slot order: network vertices used by faces, then the split points of each edge,
+// then the vertices made inside each face.
+BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionCache& c) {
+  BaseMesh base;
+  const uint32_t pieces = 1u << options.coons_steps;
+  base.pieces_per_edge = pieces;
+  std::vector<uint32_t> vertex_id(net.vertex_slots(), kNone), edge_first(net.edge_slots(), kNone),
+      face_first(net.face_slots(), kNone);
+  for (uint32_t f = 0; f < net.face_slots(); ++f)
+    if (net.face_alive(f))
+      for (uint32_t oe : net.face_loop(f)) vertex_id[net.tail(oe)] = 0;
+  for (uint32_t v = 0; v < net.vertex_slots(); ++v)
+    if (vertex_id[v] != kNone) {
+      vertex_id[v] = base.vertex_count();
+      base.positions.push_back(net.vertices.position[v]);
+      base.vertex_drawn.push_back(1);
+    }
+  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+    if (!c.edge_valid[e]) continue;
+    edge_first[e] = base.vertex_count();
+    for (uint32_t i = 1; i < pieces; ++i) {
+      base.positions.push_back(c.edges[e].leaf(i).front());
+      base.vertex_drawn.push_back(1);
+    }
+  }
+  for (uint32_t f = 0; f < net.face_slots(); ++f) {
+    if (!net.face_alive(f)) continue;
+    face_first[f] = base.vertex_count();
+    base.positions.insert(base.positions.end(), c.faces[f].interior.begin(), c.faces[f].interior.end());
+    base.vertex_drawn.resize(base.positions.size(), 0);
+  }
+  auto id = [&](const VertexRef& r, uint32_t face) -> uint32_t {
+    switch (r.kind) {
+      case RefKind::network_vertex: return vertex_id[r.index];
+      case RefKind::edge_point: return edge_first[r.index] + r.sub - 1;
+      case RefKind::interior: return face_first[face] + r.index;
+    }
+    return kNone;
+  };
+  for (uint32_t f = 0; f < net.face_slots(); ++f) {
+    if (!net.face_alive(f)) continue;
+    for (const VertexRef& r : c.faces[f].quads) {
+      base.face_vertices.push_back(id(r, f));
+      if (base.face_vertices.size() % 4 == 0) base.face_offsets.push_back(static_cast<uint32_t>(base.face_vertices.size()));
+    }
+  }
+  // Drawn curves: the pieces of each network edge, between its vertices and split points.
+  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+    if (!c.edge_valid[e]) continue;
+    const bool sharp = (net.edges.flags[e] & kSharpEdge) != 0;
+    for (uint32_t i = 0; i < pieces; ++i) {
+      const uint32_t a = i == 0 ? vertex_id[net.edges.vertex[e][0]] : edge_first[e] + i - 1;
+      const uint32_t b = i + 1 == pieces ? vertex_id[net.edges.vertex[e][1]] : edge_first[e] + i;
+      base.curve_ends.push_back(a);
+      base.curve_ends.push_back(b);
+      auto leaf = c.edges[e].leaf(i);
+      base.curve_points.insert(base.curve_points.end(), leaf.begin(), leaf.end());
+      base.curve_offsets.push_back(static_cast<uint32_t>(base.curve_points.size()));
+      base.curve_drawn.push_back(1);
+      if (sharp) {
+        base.sharp_edges.push_back(a);
+        base.sharp_edges.push_back(b);
+      }
+    }
+  }
+  for (uint32_t f = 0; f < net.face_slots(); ++f) {
+    if (!net.face_alive(f)) continue;
+    const FacePatch& p = c.faces[f];
+    for (uint32_t k = 0; k < p.curve_count(); ++k) {
+      base.curve_ends.push_back(id(p.curve_ends[2 * k], f));
+      base.curve_ends.push_back(id(p.curve_ends[2 * k + 1], f));
+      auto line = p.curve(k);
+      base.curve_points.insert(base.curve_points.end(), line.begin(), line.end());
+      base.curve_offsets.push_back(static_cast<uint32_t>(base.curve_points.size()));
+      base.curve_drawn.push_back(0);
+    }
+  }
+  return base;
+}
+
+bool same_topology(const ReconstructionCache& c, const BaseMesh& b) {
+  return c.have_topology && c.key_vertex_count == b.vertex_count() && c.key_face_offsets == b.face_offsets &&
+         c.key_face_vertices == b.face_vertices && c.key_sharp == b.sharp_edges && c.key_curve_ends == b.curve_ends &&
+         c.key_curve_drawn == b.curve_drawn && c.key_vertex_drawn == b.vertex_drawn;
+}
+
+Status rebuild_topology(const Options& options, ReconstructionCache& c) {
+  const BaseMesh& b = c.base;
+  c.have_topology = false;
+  subdivide::BaseTopology topology{b.vertex_count(), b.face_offsets, b.face_vertices, b.sharp_edges};
+  auto refinement = subdivide::build_refinement(topology, {static_cast<int>(options.levels), true});
+  if (!refinement) return Status::failure("the base mesh cannot be subdivided: " + refinement.error());
+  auto limit = subdivide::build_limit_stencils(*refinement);
+  if (!limit) return Status::failure("internal error: " + limit.error());
+  if (options.method == Method::fire) {
+    FitWeights weights;
+    weights.fairness = options.fairness;
+    auto fit = LimitFit::build(*refinement, *limit, b, weights);
+    if (!fit) return Status::failure(fit.error());
+    c.fit = std::move(*fit);
+  }
+  c.refinement = std::move(*refinement);
+  c.limit = std::move(*limit);
+  c.key_vertex_count = b.vertex_count();
+  c.key_face_offsets = b.face_offsets;
+  c.key_face_vertices = b.face_vertices;
+  c.key_sharp = b.sharp_edges;
+  c.key_curve_ends = b.curve_ends;
+  c.key_curve_drawn = b.curve_drawn;
+  c.key_vertex_drawn = b.vertex_drawn;
+  c.have_topology = true;
+  return Status::success();
+}
+
+Status run_update(const Mesh& net, const Options& options, ReconstructionCache& c, SurfaceMesh& surface) {
+  if (auto s = check_reconstruction_input(net, options); !s) return s;
+  const bool everything = !c.built || !(c.options == options);
+  c.built = false;
+  c.options = options;
+  update_elements(net, options, c, everything);
+  c.base = assemble(net, options, c);
+  if (everything || !same_topology(c, c.base)) {
+    if (auto s = rebuild_topology(options, c); !s) return s;
+    c.stats.topology_rebuilt = true;
+  }
+  std::vector<Vec3> base_points = c.base.positions;
+  if (options.method == Method::fire) {
+    const LimitFit::Report report = c.fit.solve(c.base, base_points);
+    c.stats.fit_iterations = report.iterations;
+    c.stats.fit_rms = report.rms;
+  }
+  std::vector<Vec3> last_level;
+  subdivide::evaluate(c.refinement, base_points, last_level, c.scratch);
+  SurfaceMesh out;
+  subdivide::evaluate_limit(c.limit, last_level, out.positions, out.normals);
+  out.face_offsets = c.refinement.last().face_offsets;
+  out.face_vertices = c.refinement.last().face_vertices;
+  surface = std::move(out);
+  c.built = true;
+  return Status::success();
+}
+
+}  // namespace
+
+Status reconstruct_update(const Mesh& net, const Options& options, ReconstructionState& state, SurfaceMesh& surface) {
+  Status s = run_update(net, options, state.cache(), surface);
+  if (!s) state.cache() = ReconstructionCache{};
+  return s;
+}
+
+Result<SurfaceMesh> reconstruct_surface(const Mesh& net, const Options& options) {
+  ReconstructionState state;
+  SurfaceMesh surface;
+  if (auto s = reconstruct_update(net, options, state, surface); !s) return Result<SurfaceMesh>::failure(s.error);
+  return surface;
+}
+
+}  // namespace fire::reconstruct

@@ -1,0 +1,110 @@
+#pragma once
+// Reconstruction: from the polyline mesh (the curve network) to a smooth surface.
+//
+//   thesis (chapter 6): triquadrification of faces with more than 4 sides (greedy, by a planarity
+//     measure; cuts get straight polylines), N steps of Coons refinement (bilinearly blended Coons
+//     patches over the polylines, nearest samples; triangles by the centroid of their edge midpoints),
+//     then Catmull-Clark to level L. The surface follows the base mesh, not the drawn curves.
+//   fire (default): every face with n sides becomes n quads around a centre, the centre and the spokes
+//     sampled from an n-sided transfinite patch over the face's polylines (systems/reconstruct/
+//     geometry.hpp); N-1 further Coons steps (linear sampling); a 2-sided face gives 2 quads; then the
+//     base points are fitted so that the Catmull-Clark limit surface passes through the drawn
+//     polylines (least squares with a fairness term, systems/reconstruct/fit.hpp).
+//
+// Both write a SurfaceMesh: the level-L quads with their vertices' limit positions and limit normals.
+// The network is read, never written. Incremental use: reconstruct_update() keeps the per-edge and
+// per-face results of the previous call in a ReconstructionState and recomputes only the edges whose
+// dirty tag is set and the faces whose tag, or one of whose edges' tags, is set; its result equals a
+// fresh reconstruction of the same network bit for bit. What stays global: numbering the base mesh,
+// Catmull-Clark (its topology and, for FIRE, the fit's factorization are rebuilt only when the base
+// mesh's topology changed) and the fit's solves (back-substitutions over the whole base mesh).
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "engine/mesh.hpp"
+#include "engine/surface.hpp"
+#include "systems/reconstruct/face.hpp"
+
+namespace fire::reconstruct {
+
+inline constexpr uint32_t kMaxCoonsSteps = 5;
+inline constexpr uint32_t kMaxLevels = 6;
+
+struct Options {
+  Method method = Method::fire;
+  uint32_t coons_steps = 1;                        // N, 1 .. kMaxCoonsSteps
+  uint32_t levels = 3;                             // L, 1 .. kMaxLevels
+  Planarity planarity = Planarity::least_squares;  // the thesis's triquadrification measure
+  // FIRE: weight of the fit's fairness term (systems/reconstruct/fit.hpp), 0 to 1. It chooses the face
+  // interiors the curves leave open; larger is smoother, smaller follows exactly representable data
+  // more closely.
+  double fairness = 1e-3;
+  friend bool operator==(const Options&, const Options&) = default;
+};
+
+// The quad base mesh handed to subdivision, and the polylines the fit follows along its edges.
+struct BaseMesh {
+  std::vector<Vec3> positions;
+  std::vector<uint32_t> face_offsets{0};
+  std::vector<uint32_t> face_vertices;
+  std::vector<uint32_t> sharp_edges;  // vertex pairs along network edges marked sharp
+  // One curve per base edge, from curve_ends[2c] to curve_ends[2c+1]: a piece of a network polyline
+  // (drawn) or a polyline made inside a face (a triquadrification cut or a spoke).
+  std::vector<uint32_t> curve_ends;
+  std::vector<uint32_t> curve_offsets{0};
+  std::vector<Vec3> curve_points;
+  std::vector<uint8_t> curve_drawn;
+  std::vector<uint8_t> vertex_drawn;  // the vertex is a network vertex or a sample of a network polyline
+  // The drawn curves come first, `pieces_per_edge` consecutive ones per network edge, from its first
+  // vertex to its last.
+  uint32_t pieces_per_edge = 1;
+  uint32_t vertex_count() const { return static_cast<uint32_t>(positions.size()); }
+  uint32_t face_count() const { return static_cast<uint32_t>(face_offsets.size() - 1); }
+  uint32_t curve_count() const { return static_cast<uint32_t>(curve_offsets.size() - 1); }
+  std::span<const Vec3> curve(uint32_t c) const {
+    return std::span<const Vec3>(curve_points).subspan(curve_offsets[c], curve_offsets[c + 1] - curve_offsets[c]);
+  }
+};
+
+// What the last reconstruct_update() did.
+struct UpdateStats {
+  size_t edges_recomputed = 0;
+  size_t faces_recomputed = 0;
+  bool topology_rebuilt = false;  // subdivision topology and (fire) the fit's factorization were rebuilt
+  uint32_t fit_iterations = 0;    // solves of the fit (fire), each a back-substitution
+  double fit_rms = 0;             // fire: rms distance of the fitted limit points to their targets on drawn curves
+};
+
+struct ReconstructionCache;
+
+// The results of the previous reconstruction, for incremental updates.
+class ReconstructionState {
+ public:
+  ReconstructionState();
+  ~ReconstructionState();
+  ReconstructionState(ReconstructionState&&) noexcept;
+  ReconstructionState& operator=(ReconstructionState&&) noexcept;
+  const UpdateStats& last_update() const;
+  const BaseMesh& base() const;  // the base mesh of the last successful update
+  ReconstructionCache& cache() { return *cache_; }
+
+ private:
+  std::unique_ptr<ReconstructionCache> cache_;
+};
+
+// Rejects, with the element and the problem named: options out of range, a network that breaks its
+// invariants (non-finite coordinates included), no faces, a face with fewer than 3 edges (thesis), a
+// polyline of zero length, two consecutive polyline points that coincide, two corners of a face that
+// coincide.
+Status check_reconstruction_input(const Mesh& net, const Options& options);
+
+// Reconstructs `net` into `surface`, reusing what `state` holds from the previous call where the dirty
+// tags say nothing changed (the caller clears the tags, e.g. at the end of the frame). On failure
+// `surface` is left as it was and `state` is emptied, so the next call rebuilds everything.
+Status reconstruct_update(const Mesh& net, const Options& options, ReconstructionState& state, SurfaceMesh& surface);
+
+// One reconstruction from scratch.
+Result<SurfaceMesh> reconstruct_surface(const Mesh& net, const Options& options);
+
+}  // namespace fire::reconstruct

@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# `fire reconstruct` as a user runs it: a good network prints one JSON line and writes the surface in
+# the extension's format; bad input exits 1 with a message naming the file and the problem, and writes
+# nothing.
+set -u
+fire="$1"
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+fail=0
+check() { if eval "$2"; then echo "ok: $1"; else echo "FAILED: $1"; fail=1; fi; }
+# expect_error NAME PATTERN OUT CMD...: exit code 1, stderr matching PATTERN, nothing on stdout, no OUT
+expect_error() {
+  local name="$1" pattern="$2" out="$3"; shift 3
+  "$@" >"$tmp/stdout" 2>"$tmp/err"; local rc=$?
+  if [ $rc -eq 1 ] && grep -q -- "$pattern" "$tmp/err" && [ ! -e "$out" ] && [ ! -s "$tmp/stdout" ]; then
+    echo "ok: $name"; else echo "FAILED: $name (exit $rc)"; cat "$tmp/err"; fail=1; fi
+}
+network() {  # NAME VERTICES EDGES FACES: writes $tmp/NAME.fnet
+  printf '{"format":"fire-network","version":1,"vertices":[%s],"edges":[%s],"faces":[%s]}\n' "$2" "$3" "$4" >"$tmp/$1.fnet"
+}
+v() { printf '{"p":[%s],"split":false}' "$1"; }
+e() { printf '{"v":[%s],"sharp":false,"points":[%s]}' "$1" "$2"; }
+
+# A square with curved sides.
+network square "$(v 0,0,0),$(v 1,0,0),$(v 1,1,0),$(v 0,1,0)" \
+  "$(e 0,1 '[0,0,0],[0.25,0,0.1],[0.5,0,0.15],[0.75,0,0.1],[1,0,0]'),$(e 1,2 '[1,0,0],[1,0.5,0.2],[1,1,0]'),$(e 3,2 '[0,1,0],[0.5,1,0.3],[1,1,0]'),$(e 0,3 '[0,0,0],[0,0.5,0.1],[0,1,0]')" \
+  '{"edges":[0,1,2,3],"reversed":[false,false,true,true]}'
+out=$("$fire" reconstruct "$tmp/square.fnet" -o "$tmp/square.obj")
+check "prints one JSON line with the counts" "echo '$out' | grep -q '^{\"method\":\"fire\",\"coons_steps\":1,\"levels\":3,\"base_faces\":4,\"faces\":256,\"vertices\":289,\"seconds\":[0-9.e-]*}$'"
+check "writes the OBJ: 289 vertices with normals, 256 faces" "[ \$(grep -c '^v ' '$tmp/square.obj') -eq 289 ] && [ \$(grep -c '^vn ' '$tmp/square.obj') -eq 289 ] && [ \$(grep -c '^f ' '$tmp/square.obj') -eq 256 ]"
+out=$("$fire" reconstruct "$tmp/square.fnet" -o "$tmp/square.glb" --method thesis --coons-steps 2 --levels 1 --planarity hough)
+check "thesis, 2 Coons steps, level 1" "echo '$out' | grep -q '\"method\":\"thesis\",\"coons_steps\":2,\"levels\":1,\"base_faces\":16,\"faces\":64,\"vertices\":81'"
+for ext in ply stl glb; do
+  "$fire" reconstruct "$tmp/square.fnet" -o "$tmp/s.$ext" --levels 2 >/dev/null
+  check "writes .$ext" "[ -s '$tmp/s.$ext' ]"
+done
+
+# A face of 2 curves: FIRE makes 2 quads; the thesis needs triangles and quads.
+network digon "$(v 0,0,0),$(v 1,0,0)" "$(e 0,1 '[0,0,0],[0.5,0.3,0],[1,0,0]'),$(e 1,0 '[1,0,0],[0.5,-0.3,0.1],[0,0,0]')" \
+  '{"edges":[0,1],"reversed":[false,false]}'
+check "fire reconstructs a 2-sided face" "'$fire' reconstruct '$tmp/digon.fnet' -o '$tmp/digon.obj' | grep -q '\"base_faces\":2,'"
+expect_error "thesis rejects a 2-sided face" "fire reconstruct: .*digon.fnet: face 0 has 2 edges; the thesis method needs at least 3" \
+  "$tmp/digon2.obj" "$fire" reconstruct "$tmp/digon.fnet" -o "$tmp/digon2.obj" --method thesis
+
+network zero "$(v 0,0,0),$(v 1,0,0),$(v 0,0,0)" \
+  "$(e 0,1 '[0,0,0],[1,0,0]'),$(e 1,2 '[1,0,0],[0.5,0.5,0],[0,0,0]'),$(e 2,0 '[0,0,0],[0,0,0]')" \
+  '{"edges":[0,1,2],"reversed":[false,false,false]}'
+expect_error "zero-length polyline" "zero.fnet: edge 2's polyline has zero length" "$tmp/zero.obj" \
+  "$fire" reconstruct "$tmp/zero.fnet" -o "$tmp/zero.obj"
+network pinched "$(v 0,0,0),$(v 1,0,0),$(v 0,0,0)" \
+  "$(e 0,1 '[0,0,0],[1,0,0]'),$(e 1,2 '[1,0,0],[0.5,0.5,0],[0,0,0]'),$(e 2,0 '[0,0,0],[-0.2,-0.2,0],[0,0,0]')" \
+  '{"edges":[0,1,2],"reversed":[false,false,false]}'
+expect_error "coincident corners" "pinched.fnet: face 0 has coincident corners: vertices 0 and 2" "$tmp/pinched.obj" \
+  "$fire" reconstruct "$tmp/pinched.fnet" -o "$tmp/pinched.obj"
+network repeated "$(v 0,0,0),$(v 1,0,0),$(v 0,1,0)" \
+  "$(e 0,1 '[0,0,0],[0.5,0,0],[0.5,0,0],[1,0,0]'),$(e 1,2 '[1,0,0],[0,1,0]'),$(e 2,0 '[0,1,0],[0,0,0]')" \
+  '{"edges":[0,1,2],"reversed":[false,false,false]}'
+expect_error "coincident consecutive points" "repeated.fnet: edge 0's polyline has coincident consecutive points 1 and 2" \
+  "$tmp/repeated.obj" "$fire" reconstruct "$tmp/repeated.fnet" -o "$tmp/repeated.obj"
+sed 's/\[0.5,0.5,0\]/[0.5,NaN,0]/' "$tmp/zero.fnet" >"$tmp/nan.fnet"
+expect_error "NaN coordinate" "fire reconstruct: .*nan.fnet" "$tmp/nan.obj" "$fire" reconstruct "$tmp/nan.fnet" -o "$tmp/nan.obj"
+expect_error "missing network" "fire reconstruct: .*missing.fnet" "$tmp/missing.obj" \
+  "$fire" reconstruct "$tmp/missing.fnet" -o "$tmp/missing.obj"
+expect_error "unwritable output" "fire reconstruct: .*$tmp/no/such/dir/out.obj" "$tmp/no/such/dir/out.obj" \
+  "$fire" reconstruct "$tmp/square.fnet" -o "$tmp/no/such/dir/out.obj"
+expect_error "unknown output format" "fire reconstruct: .*out.xyz" "$tmp/out.xyz" "$fire" reconstruct "$tmp/square.fnet" -o "$tmp/out.xyz"
+expect_error "level out of range" "fire reconstruct: .*subdivision level must be 1 to 6, not 9" "$tmp/l9.obj" \
+  "$fire" reconstruct "$tmp/square.fnet" -o "$tmp/l9.obj" --levels 9
+expect_error "unknown method" "fire reconstruct: --method must be thesis or fire, not 'magic'" "$tmp/m.obj" \
+  "$fire" reconstruct "$tmp/square.fnet" -o "$tmp/m.obj" --method magic
+check "nothing else was left in the folder" "[ -z \"\$(ls '$tmp' | grep -v -e '\\.fnet\$' -e '^square\\.' -e '^s\\.' -e '^digon\\.obj\$' -e '^stdout\$' -e '^err\$')\" ]"
+exit $fail

@@ -1,0 +1,28 @@
+#pragma once
+// Hand-made curve networks for the reconstruction tests.
+#include <functional>
+#include <vector>
+
+#include "engine/mesh.hpp"
+
+namespace fire::test {
+
+using Height = std::function<double(double, double)>;
+
+// One face with n sides (n >= 2): corners on the unit circle at angles 2 pi k / n, each side the arc
+// of the circle between its corners lifted to z = 0.2 cos(2 angle), with `samples` points.
+Mesh polygon_network(uint32_t n, uint32_t samples = 9);
+
+// A grid of nx by ny square faces over [0, nx] x [0, ny], every curve on the surface z = height(x, y)
+// with `samples` points; faces counter-clockwise seen from +z, numbered row by row (face j*nx + i).
+// Horizontal edge (i, j) -> (i+1, j) is edge j*nx + i; vertical edge (i, j) -> (i, j+1) is edge
+// (ny+1)*nx + j*(nx+1) + i.
+Mesh grid_network(uint32_t nx, uint32_t ny, uint32_t samples, const Height& height);
+
+// The network a control grid of 2m x 2m quads over [0, 2m]^2 (control point (i, j) lifted to
+// height(i, j)) leaves when every second grid line is kept: m x m faces whose curves are the
+// Catmull-Clark limit curves of the kept lines, sampled at the limit positions of their level-`levels`
+// vertices (2^levels samples per control edge). Its FIRE base mesh has the control grid's topology.
+Mesh limit_grid_network(uint32_t m, uint32_t levels, const Height& height);
+
+}  // namespace fire::test

@@ -1,0 +1,107 @@
+// Incremental reconstruction: an edit recomputes only the faces it touched and their neighbours, and
+// the result equals a reconstruction from scratch bit for bit.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstring>
+
+#include "networks.hpp"
+#include "systems/reconstruct/reconstruct.hpp"
+#include "systems/split/edit.hpp"
+
+using namespace fire;
+using namespace fire::reconstruct;
+using namespace fire::test;
+
+namespace {
+
+double height(double x, double y) { return 0.6 * std::sin(0.4 * x) * std::cos(0.5 * y) + 0.03 * x * y; }
+
+template <class T>
+bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+void check_equals_full_rebuild(const Mesh& net, const Options& options, const SurfaceMesh& incremental) {
+  auto full = reconstruct_surface(net, options);
+  REQUIRE(full.ok());
+  CHECK(same_bytes(incremental.positions, full->positions));
+  CHECK(same_bytes(incremental.normals, full->normals));
+  CHECK(same_bytes(incremental.face_offsets, full->face_offsets));
+  CHECK(same_bytes(incremental.face_vertices, full->face_vertices));
+}
+
+void update(const Mesh& net, const Options& options, ReconstructionState& state, SurfaceMesh& surface) {
+  Status s = reconstruct_update(net, options, state, surface);
+  INFO(s.error);
+  REQUIRE(s.ok());
+}
+
+}  // namespace
+
+TEST_CASE("adding, moving and deleting a curve on a 200-face network", "[reconstruct][incremental]") {
+  const uint32_t nx = 20, ny = 10;
+  for (Method method : {Method::fire, Method::thesis}) {
+    INFO((method == Method::fire ? "fire" : "thesis"));
+    const Options options{method, 1, 2, Planarity::least_squares};
+    Mesh net = grid_network(nx, ny, 9, height);
+    REQUIRE(net.face_count() == 200);
+    ReconstructionState state;
+    SurfaceMesh surface;
+    update(net, options, state, surface);
+    CHECK(state.last_update().faces_recomputed == 200);
+    net.clear_dirty();
+
+    // Nothing changed: nothing is recomputed and the surface is the same.
+    const SurfaceMesh before = surface;
+    update(net, options, state, surface);
+    CHECK(state.last_update().faces_recomputed == 0);
+    CHECK(state.last_update().edges_recomputed == 0);
+    CHECK_FALSE(state.last_update().topology_rebuilt);
+    CHECK(same_bytes(surface.positions, before.positions));
+
+    // A curve across face (7, 4) from the middle of its bottom edge to the middle of its top edge.
+    const uint32_t i = 7, j = 4, face = j * nx + i;
+    EditCommand add;
+    add.kind = EditKind::SplitFace;
+    add.face = face;
+    add.start = {j * nx + i, 4};
+    add.end = {(j + 1) * nx + i, 4};
+    for (int k = 0; k <= 8; ++k) add.points.emplace_back(i + 0.5, j + k / 8.0, height(i + 0.5, j + k / 8.0));
+    REQUIRE(execute_edit(net, add).ok);
+    REQUIRE(net.face_count() == 201);
+    update(net, options, state, surface);
+    // Touched: the split face's two halves and the faces below and above it, whose edges were split (4).
+    // Their edges are tagged, so the faces across them are recomputed too: left and right of each of the
+    // three faces in the column (6), below the one below and above the one above (2).
+    CHECK(state.last_update().faces_recomputed == 4 + 6 + 2);
+    CHECK(state.last_update().topology_rebuilt);
+    check_equals_full_rebuild(net, options, surface);
+    net.clear_dirty();
+
+    // Moving an interior vertex: its four faces, a back-substitution for the FIRE fit.
+    const uint32_t v = 3 * (nx + 1) + 12;
+    net.move_vertex(v, net.vertices.position[v] + Vec3(0, 0, 0.05));
+    update(net, options, state, surface);
+    CHECK(state.last_update().faces_recomputed == 4);
+    CHECK(state.last_update().edges_recomputed == 4);
+    CHECK_FALSE(state.last_update().topology_rebuilt);
+    check_equals_full_rebuild(net, options, surface);
+    net.clear_dirty();
+
+    // Deleting the curve again.
+    uint32_t curve = kNone;
+    for (uint32_t e = 0; e < net.edge_slots(); ++e)
+      if (net.edge_alive(e) && net.polyline(e).front().x() == i + 0.5 && net.polyline(e).back().x() == i + 0.5) curve = e;
+    REQUIRE(curve != kNone);
+    EditCommand remove;
+    remove.kind = EditKind::DeleteCurve;
+    remove.edge = curve;
+    REQUIRE(execute_edit(net, remove).ok);
+    REQUIRE(net.face_count() == 200);
+    update(net, options, state, surface);
+    // The merged face and the two faces whose split edges were joined again (3), and across their
+    // tagged edges: left and right of each (6), below the lower one and above the upper one (2).
+    CHECK(state.last_update().faces_recomputed == 3 + 6 + 2);
+    check_equals_full_rebuild(net, options, surface);
+  }
+}

@@ -1,0 +1,181 @@
+// The two pipelines on tiny hand-made networks: exact counts, the Coons centre, the FIRE fit passing
+// through the drawn samples, and rejected input.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <limits>
+
+#include "networks.hpp"
+#include "systems/reconstruct/reconstruct.hpp"
+
+using namespace fire;
+using namespace fire::reconstruct;
+using namespace fire::test;
+
+namespace {
+
+FacePatch patch_of(const Mesh& net, uint32_t face, const FaceSettings& settings, std::vector<EdgeSplits>& splits) {
+  splits.clear();
+  for (uint32_t oe : net.face_loop(face)) splits.push_back(split_network_edge(net.polyline(edge_of(oe)), settings.coons_steps));
+  std::vector<const EdgeSplits*> pointers;
+  for (const EdgeSplits& s : splits) pointers.push_back(&s);
+  return build_face_patch(net, face, pointers, settings);
+}
+
+BaseMesh base_of(const Mesh& net, const Options& options) {
+  ReconstructionState state;
+  SurfaceMesh surface;
+  Status s = reconstruct_update(net, options, state, surface);
+  INFO(s.error);
+  REQUIRE(s.ok());
+  return state.base();
+}
+
+// Every base edge carries exactly one curve and the base mesh is a disk: V - E + F = 1.
+void check_disk(const BaseMesh& b) {
+  CHECK(int64_t(b.vertex_count()) - int64_t(b.curve_count()) + int64_t(b.face_count()) == 1);
+  for (uint32_t f = 0; f < b.face_count(); ++f) CHECK(b.face_offsets[f + 1] - b.face_offsets[f] == 4);
+}
+
+double nearest_distance(const std::vector<Vec3>& points, const Vec3& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Vec3& q : points) best = std::min(best, (q - p).norm());
+  return best;
+}
+
+}  // namespace
+
+TEST_CASE("thesis: a pentagon triquadrifies into a quad and a triangle, then 7 quads", "[reconstruct][thesis]") {
+  const Mesh net = polygon_network(5);
+  std::vector<EdgeSplits> splits;
+  const FacePatch p = patch_of(net, 0, {Method::thesis, 1, Planarity::least_squares}, splits);
+  CHECK(p.first_stage_sizes == std::vector<uint32_t>{4, 3});
+  CHECK(p.quad_count() == 7);
+  CHECK(p.interior.size() == 3);  // the cut's midpoint and the two centres
+  const BaseMesh b = base_of(net, {Method::thesis, 1, 2, Planarity::least_squares});
+  CHECK(b.vertex_count() == 13);  // 5 corners, 5 edge midpoints, 3 inside
+  CHECK(b.face_count() == 7);
+  CHECK(b.curve_count() == 19);   // 10 halves of the sides, 2 of the cut, 4 + 3 spokes
+  check_disk(b);
+  // The cut is straight (thesis) and sampled like the sides: its two halves are the only inner curves
+  // with more than 2 points (one Coons step makes spokes of 2 points), and they lie on one line.
+  std::vector<uint32_t> sampled;
+  for (uint32_t c = 0; c < b.curve_count(); ++c)
+    if (!b.curve_drawn[c] && b.curve(c).size() > 2) sampled.push_back(c);
+  REQUIRE(sampled.size() == 2);
+  const Vec3 from = b.curve(sampled[0]).front(), d = (b.curve(sampled[0]).back() - from).normalized();
+  for (uint32_t c : sampled) {
+    for (const Vec3& q : b.curve(c)) CHECK(((q - from) - d * d.dot(q - from)).norm() < 1e-12);
+  }
+}
+
+TEST_CASE("thesis: the centre of a 4-sided face is its Coons point x(1/2, 1/2)", "[reconstruct][thesis]") {
+  const Mesh net = polygon_network(4, 11);
+  std::vector<EdgeSplits> splits;
+  const FacePatch p = patch_of(net, 0, {Method::thesis, 1, Planarity::least_squares}, splits);
+  REQUIRE(p.interior.size() == 1);
+  std::vector<std::vector<double>> params;
+  std::vector<Side> sides;
+  for (uint32_t oe : net.face_loop(0)) params.push_back(arc_parameters(net.polyline(edge_of(oe))));
+  for (uint32_t k = 0; k < 4; ++k) sides.push_back({net.polyline(edge_of(net.face_loop(0)[k])), params[k], false});
+  CHECK(p.interior[0] == coons_point(sides, 0.5, 0.5, Sampling::nearest));
+  // Two steps: a 5 x 5 grid of base vertices.
+  const BaseMesh b = base_of(net, {Method::thesis, 2, 1, Planarity::least_squares});
+  CHECK(b.vertex_count() == 25);
+  CHECK(b.face_count() == 16);
+  check_disk(b);
+}
+
+TEST_CASE("FIRE: an n-sided face becomes n quads around its centre", "[reconstruct][fire]") {
+  for (uint32_t n : {2u, 3u, 4u, 5u, 6u}) {
+    const Mesh net = polygon_network(n);
+    const BaseMesh b = base_of(net, {Method::fire, 1, 2, Planarity::least_squares});
+    INFO("n = " << n);
+    CHECK(b.vertex_count() == 2 * n + 1);
+    CHECK(b.face_count() == n);
+    CHECK(b.curve_count() == 3 * n);
+    check_disk(b);
+    const uint32_t centre = 2 * n;  // corners, then edge midpoints, then the face's vertex
+    for (uint32_t f = 0; f < n; ++f) CHECK(b.face_vertices[4 * f + 2] == centre);
+    // Corner k's quad: P_k, M_k, C, M_k-1, where M_k is the middle sample of side k.
+    for (uint32_t k = 0; k < n; ++k) {
+      CHECK(b.face_vertices[4 * k] == k);
+      const auto line = net.polyline(k);
+      CHECK(b.positions[b.face_vertices[4 * k + 1]] == line[middle_sample(arc_parameters(line))]);
+    }
+    // The surface: n * 4^2 quads.
+    auto s = reconstruct_surface(net, {Method::fire, 1, 2, Planarity::least_squares});
+    REQUIRE(s.ok());
+    CHECK(s->face_count() == 16 * n);
+    CHECK(s->normals.size() == s->positions.size());
+  }
+}
+
+TEST_CASE("FIRE: the fitted limit surface passes through the drawn samples", "[reconstruct][fire][fit]") {
+  // Curves sampled on the limit surface of a 4 x 4 control grid at its level-3 vertices: the FIRE base
+  // mesh has the grid's topology, so a surface through every sample exists.
+  const Mesh net = limit_grid_network(2, 3, [](double x, double y) {
+    return 0.12 * (x - 2) * (x - 2) - 0.08 * (y - 1.5) * (y - 1.5) + 0.05 * x * y;
+  });
+  auto worst_distance = [&](const SurfaceMesh& s) {
+    double worst = 0;
+    for (const Vec3& p : net.points.values()) worst = std::max(worst, nearest_distance(s.positions, p));
+    return worst;
+  };
+  Options exact;
+  exact.fairness = 1e-6;  // the fairness only chooses among the surfaces the curves allow
+  ReconstructionState state;
+  SurfaceMesh s;
+  REQUIRE(reconstruct_update(net, exact, state, s).ok());
+  CHECK(state.base().vertex_count() == 25);
+  CHECK(state.base().face_count() == 16);
+  CHECK(worst_distance(s) < 1e-6);
+  CHECK(state.last_update().fit_rms < 1e-7);
+  // The default fairness trades a little of that for smooth interiors where curves say little; the
+  // model is 4 units wide.
+  auto smooth = reconstruct_surface(net, Options{});
+  REQUIRE(smooth.ok());
+  CHECK(worst_distance(*smooth) < 1e-4);
+  // The thesis pipeline does not pass through them: Catmull-Clark shrinks the base mesh.
+  auto thesis = reconstruct_surface(net, {Method::thesis, 1, 3, Planarity::least_squares});
+  REQUIRE(thesis.ok());
+  CHECK(worst_distance(*thesis) > 1e-2);
+}
+
+TEST_CASE("bad networks and options are rejected with the element named", "[reconstruct][errors]") {
+  auto error_of = [](const Mesh& net, Options o) {
+    auto r = reconstruct_surface(net, o);
+    REQUIRE_FALSE(r.ok());
+    return r.error();
+  };
+  const Options thesis{Method::thesis, 1, 3, Planarity::least_squares}, fire{};
+  CHECK_THAT(error_of(polygon_network(2), thesis), Catch::Contains("face 0 has 2 edges"));
+  CHECK(reconstruct_surface(polygon_network(2), fire).ok());
+  CHECK_THAT(error_of(polygon_network(4), {Method::fire, 0, 3, Planarity::least_squares}), Catch::Contains("Coons steps"));
+  CHECK_THAT(error_of(polygon_network(4), {Method::fire, 1, 9, Planarity::least_squares}), Catch::Contains("subdivision level"));
+  CHECK_THAT(error_of(Mesh{}, fire), Catch::Contains("no faces"));
+  Options unfair;
+  unfair.fairness = std::nan("");
+  CHECK_THAT(error_of(polygon_network(4), unfair), Catch::Contains("fairness weight"));
+
+  // Coincident consecutive points.
+  Mesh repeated = polygon_network(3);
+  repeated.points.set(repeated.edges.point_offset[1] + 3, repeated.polyline(1)[2]);
+  CHECK_THAT(error_of(repeated, fire), Catch::Contains("edge 1's polyline has coincident consecutive points 2 and 3"));
+
+  // NaN.
+  Mesh nan = polygon_network(3);
+  nan.points.set(nan.edges.point_offset[2] + 4, Vec3(0, std::nan(""), 0));
+  CHECK_THAT(error_of(nan, fire), Catch::Contains("edge 2 has a non-finite polyline point 4"));
+
+  // Two corners at one point; and a polyline of zero length between them.
+  Mesh pinched;
+  const uint32_t a = pinched.add_vertex({0, 0, 0}), b = pinched.add_vertex({1, 0, 0}), c = pinched.add_vertex({0, 0, 0});
+  const uint32_t e0 = pinched.add_edge(a, b, std::vector<Vec3>{{0, 0, 0}, {1, 0, 0}});
+  const uint32_t e1 = pinched.add_edge(b, c, std::vector<Vec3>{{1, 0, 0}, {0.5, 0.5, 0}, {0, 0, 0}});
+  const uint32_t e2 = pinched.add_edge(c, a, std::vector<Vec3>{{0, 0, 0}, {-0.5, -0.5, 0}, {0, 0, 0}});
+  REQUIRE(pinched.add_face(std::vector<uint32_t>{make_oriented(e0, false), make_oriented(e1, false), make_oriented(e2, false)}) != kNone);
+  CHECK_THAT(error_of(pinched, fire), Catch::Contains("face 0 has coincident corners: vertices 0 and 2"));
+  Mesh flat = pinched;
+  for (uint32_t k = 0; k < 3; ++k) flat.points.set(flat.edges.point_offset[e2] + k, Vec3(0, 0, 0));
+  CHECK_THAT(error_of(flat, fire), Catch::Contains("edge 2's polyline has zero length"));
+}
