@@ -25,6 +25,22 @@ Nearest nearest_on_face(const Mesh& m, uint32_t f, const Vec3& p) {
   return best;
 }
 
+// Moves a stroke so that it starts at `start` and ends at `end`, spreading each end's correction along the
+// stroke by arc length: snapping then bends the whole curve a little instead of kinking its last sample,
+// and a surface that passes through the curve shows no fold there.
+void blend_ends(std::vector<Vec3>& stroke, const Vec3& start, const Vec3& end) {
+  std::vector<double> arc(stroke.size(), 0.0);
+  for (size_t i = 1; i < stroke.size(); ++i) arc[i] = arc[i - 1] + (stroke[i] - stroke[i - 1]).norm();
+  const double total = arc.back();
+  const Vec3 d0 = start - stroke.front(), d1 = end - stroke.back();
+  for (size_t i = 0; i < stroke.size(); ++i) {
+    const double t = total > 0 ? arc[i] / total : double(i) / double(stroke.size() - 1);
+    stroke[i] += (1.0 - t) * d0 + t * d1;
+  }
+  stroke.front() = start;
+  stroke.back() = end;
+}
+
 bool border_open(const Mesh& m) { return m.edge_count() > 0 && m.face_count() == 0; }
 
 // The open border's first and last vertices (the first is the start of the first edge drawn).
@@ -119,10 +135,12 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           r.command.kind = EditKind::StartBorder;
         } else if (border_open(mesh)) {
           auto [first, last] = border_ends(mesh);
-          (void)last;
-          double gap = (r.command.points.back() - mesh.vertices.position[first]).norm();
+          const Vec3& first_position = mesh.vertices.position[first];
+          double gap = (r.command.points.back() - first_position).norm();
           r.command.kind = gap <= settings.snap_distance ? EditKind::CloseBorder : EditKind::AppendBorder;
           r.command.snap_distance = settings.snap_distance;
+          blend_ends(r.command.points, mesh.vertices.position[last],
+                     r.command.kind == EditKind::CloseBorder ? first_position : r.command.points.back());
         } else {
           Snap s = snap_to_face(mesh, r.command.points.front(), r.command.points.back(), settings.snap_distance);
           if (s.face == kNone) {
@@ -134,6 +152,7 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           r.command.face = s.face;
           r.command.start = s.start;
           r.command.end = s.end;
+          blend_ends(r.command.points, mesh.polyline(s.start.edge)[s.start.point], mesh.polyline(s.end.edge)[s.end.point]);
         }
         requests.push_back(std::move(r));
         break;

@@ -24,7 +24,7 @@ check "replay hash is stable ($h1)" "[ -n '$h1' ] && [ '$h1' = '$h2' ]"
 golden=$(cat "$src/tests/engine/demo.hash")
 check "replay hash matches the recorded one ($golden)" "[ '$h1' = '$golden' ]"
 check "replay writes the network" "'$fire' replay '$src/tools/demo/sketch.log' -o '$tmp/demo.fnet' 2>/dev/null && [ -s '$tmp/demo.fnet' ]"
-check "export-network writes one l per edge" "'$fire' export-network '$tmp/demo.fnet' -o '$tmp/demo.obj' && [ \$(grep -c '^l ' '$tmp/demo.obj') -eq 33 ]"
+check "export-network writes one l per edge" "'$fire' export-network '$tmp/demo.fnet' -o '$tmp/demo.obj' && [ \$(grep -c '^l ' '$tmp/demo.obj') -eq 32 ]"
 
 printf 'FIRE-LOG 1\n0 down\n10 pen 1 2' >"$tmp/trunc.log"
 expect_error "truncated log" "trunc.log:3: truncated" "$fire" replay "$tmp/trunc.log"

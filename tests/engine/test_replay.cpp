@@ -1,6 +1,9 @@
 // Replaying a log through the frame systems: deterministic, and bad strokes rejected without loss.
 #include <catch2/catch.hpp>
 
+#include <map>
+
+#include "systems/split/split_system.hpp"
 #include "tools/fire/session.hpp"
 
 using namespace fire;
@@ -94,4 +97,60 @@ TEST_CASE("a stroke with NaN or ends on two faces is rejected and nothing drawn 
   CHECK_THAT(w->rejections[1].reason, Catch::Matchers::Contains("does not start and end"));
   CHECK(w->rejections[0].line > 0);
   CHECK(w->mesh.same_pools(clean->mesh));
+}
+
+TEST_CASE("snapping bends the whole stroke instead of kinking its end", "[replay]") {
+  int64_t t = 0;
+  std::string text = "FIRE-LOG 1\n";
+  text += stroke(t, {{0, 0, 0}, {0.05, 0, 0}, {0.1, 0, 0}});
+  text += stroke(t, {{0.1, 0, 0}, {0.1, 0.05, 0}, {0.1, 0.1, 0}});
+  text += stroke(t, {{0.1, 0.1, 0}, {0.05, 0.1, 0}, {0, 0.1, 0}});
+  text += stroke(t, {{0, 0.1, 0}, {0, 0.05, 0}, {0, 0, 0}});
+  // Starts exactly on the bottom edge's middle point, ends 4 mm right of the top edge's middle point.
+  text += stroke(t, {{0.05, 0, 0}, {0.05, 0.05, 0.01}, {0.054, 0.1, 0}});
+  auto w = replay_text(text);
+  REQUIRE(w->mesh.face_count() == 2);
+  uint32_t curve = kNone;
+  for (uint32_t e = 0; e < w->mesh.edge_slots(); ++e)
+    if (w->mesh.edge_alive(e) && !w->mesh.is_border_edge(e)) curve = e;
+  REQUIRE(curve != kNone);
+  auto line = w->mesh.polyline(curve);
+  REQUIRE(line.size() == 3);
+  CHECK(line[2] == Vec3(0.05, 0.1, 0));
+  // The middle sample took the share of the end's correction that its arc length gives it.
+  const double a = Vec3(0, 0.05, 0.01).norm(), b = Vec3(0.004, 0.05, -0.01).norm();
+  CHECK(line[1].x() == Approx(0.05 - 0.004 * a / (a + b)).margin(1e-12));
+  CHECK(line[1].y() == Approx(0.05).margin(1e-9));
+}
+
+TEST_CASE("the demo log exercises every split case, an undo, a redo and a delete", "[replay]") {
+  auto log = read_input_log(FIRE_SOURCE_DIR "/tools/demo/sketch.log");
+  REQUIRE(log.ok());
+  auto w = std::make_unique<World>();
+  w->log = std::move(*log);
+  // The session's systems, with a probe between sketch and split that classifies each applied split's ends
+  // on the mesh as the split finds it.
+  std::map<std::string, int> seen;
+  auto end_kind = [&](const CurveEnd& end) {
+    const uint32_t count = w->mesh.edges.point_count[end.edge];
+    return end.point == 0 || end.point + 1 == count ? std::string("vertex") : std::string("edge");
+  };
+  Scheduler s(fake_clock);
+  s.add("input", [&] { input_system(w->log, w->frame, w->cursor, w->frame_events); });
+  s.add("sketch", [&] { sketch_system(w->frame_events, w->mesh, w->sketch_settings, w->sketch, w->requests, w->rejections); });
+  s.add("probe", [&] {
+    for (const EditRequest& r : w->requests) {
+      if (r.kind == RequestKind::Undo) ++seen["undo"];
+      else if (r.kind == RequestKind::Redo) ++seen["redo"];
+      else if (r.command.kind == EditKind::DeleteCurve) ++seen["delete"];
+      else if (r.command.kind == EditKind::SplitFace) ++seen[end_kind(r.command.start) + "-" + end_kind(r.command.end)];
+    }
+  });
+  s.add("split", [&] { split_system(w->requests, w->mesh, w->history, w->rejections); });
+  replay_headless(*w, s);
+  REQUIRE(w->rejections.size() == 1);  // the one stroke meant to be rejected
+  for (const char* kind : {"edge-edge", "edge-vertex", "vertex-edge", "vertex-vertex", "undo", "redo", "delete"}) {
+    INFO(kind);
+    CHECK(seen[kind] >= 1);
+  }
 }
