@@ -2,6 +2,7 @@
 // Types every part of FIRE shares: the point type and a checked result for the boundaries.
 #include <Eigen/Core>
 #include <optional>
+#include <span>
 #include <string>
 #include <utility>
 
@@ -46,5 +47,17 @@ struct Status {
 };
 
 inline bool is_finite(const Vec3& p) { return p.allFinite(); }
+
+// Length of the diagonal of the axis-aligned box around the points (0 for none): the scale that
+// tolerances and error figures are relative to.
+inline double bounding_box_diagonal(std::span<const Vec3> points) {
+  if (points.empty()) return 0;
+  Vec3 lo = points[0], hi = points[0];
+  for (const Vec3& p : points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  return (hi - lo).norm();
+}
 
 }  // namespace fire

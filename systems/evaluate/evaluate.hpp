@@ -85,8 +85,6 @@ struct SurfaceDistance {
 SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleBvh& a_bvh, const TriangleMesh& b,
                                  const TriangleBvh& b_bvh, double spacing, double scale);
 
-double bounding_box_diagonal(std::span<const Vec3> points);
-
 // The ground truth of a control mesh: Catmull-Clark (fire_subdivide, EdgeAndCorner) to `levels` and the
 // last level's vertices projected to their limit positions, each quad split along its shorter diagonal.
 // Errors are fire_subdivide's (non-manifold edge or vertex, bad faces, non-finite positions, size).

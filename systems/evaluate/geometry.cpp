@@ -101,14 +101,4 @@ std::vector<Vec3> sample_triangles(const TriangleMesh& mesh, double spacing) {
   return samples;
 }
 
-double bounding_box_diagonal(std::span<const Vec3> points) {
-  if (points.empty()) return 0;
-  Vec3 lo = points[0], hi = points[0];
-  for (const Vec3& p : points) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  return (hi - lo).norm();
-}
-
 }  // namespace fire::evaluate

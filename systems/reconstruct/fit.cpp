@@ -14,31 +14,6 @@ namespace {
 using SparseRows = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 using Sparse = Eigen::SparseMatrix<double>;
 
-// The level-`last` vertices along edge `edge` of level `level`, walking from its end `from`, without the
-// far end (children keep their parent vertex's index; fire_subdivide's numbering, see subdivide.hpp).
-void collect_chain(const subdivide::Refinement& r, uint32_t level, uint32_t edge, uint32_t from, uint32_t last,
-                   std::vector<uint32_t>& out) {
-  if (level == last) {
-    out.push_back(from);
-    return;
-  }
-  const subdivide::Level& lv = r.levels[level];
-  const uint32_t k = lv.edge_vertices[2 * edge] == from ? 0u : 1u;
-  const uint32_t mid = lv.vertex_count + lv.face_count() + edge;
-  const uint32_t children = lv.corner_count() + 2 * edge;
-  collect_chain(r, level + 1, children + k, from, last, out);
-  collect_chain(r, level + 1, children + (1 - k), mid, last, out);
-}
-
-double bounding_diagonal(const std::vector<Vec3>& points) {
-  if (points.empty()) return 0;
-  Vec3 lo = points[0], hi = points[0];
-  for (const Vec3& p : points) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  return (hi - lo).norm();
-}
 
 // The umbrella operator of the base mesh: each vertex minus the mean of its neighbours. On the border
 // only the neighbours along the border count and corners (border vertices of one face) are left out,
@@ -129,7 +104,7 @@ Result<LimitFit> LimitFit::build(const subdivide::Refinement& refinement, const 
     if (it == edge_of_pair.end())
       return Result<LimitFit>::failure("internal error: curve " + std::to_string(c) + " is not a base edge");
     chain.clear();
-    collect_chain(refinement, 0, it->second, a, last, chain);
+    subdivide::vertices_along_edge(refinement, 0, it->second, a, chain);
     for (size_t k = 1; k < chain.size(); ++k) {
       impl->paths.back().push_back(Eigen::Index(selected.size()));
       selected.push_back(chain[k]);
@@ -253,7 +228,7 @@ LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points
     }
     spans.push_back(make_span(line, rows));
   }
-  const double tolerance = m.settings.tolerance * std::max(bounding_diagonal(base.positions), 1e-300);
+  const double tolerance = m.settings.tolerance * std::max(bounding_box_diagonal(base.positions), 1e-300);
 
   Report report;
   Eigen::MatrixX3d solution, fitted;

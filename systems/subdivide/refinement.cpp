@@ -430,4 +430,17 @@ Result<Refinement> build_refinement(const BaseTopology& base, const RefinementOp
   return refinement;
 }
 
+void vertices_along_edge(const Refinement& r, size_t level, uint32_t edge, uint32_t from, std::vector<uint32_t>& out) {
+  if (level + 1 == r.levels.size()) {
+    out.push_back(from);
+    return;
+  }
+  const Level& lv = r.levels[level];
+  const uint32_t k = lv.edge_vertices[2 * edge] == from ? 0u : 1u;
+  const uint32_t mid = lv.vertex_count + lv.face_count() + edge;
+  const uint32_t children = lv.corner_count() + 2 * edge;
+  vertices_along_edge(r, level + 1, children + k, from, out);
+  vertices_along_edge(r, level + 1, children + (1 - k), mid, out);
+}
+
 }  // namespace fire::subdivide

@@ -152,6 +152,11 @@ Result<LimitStencils> build_limit_stencils(const Refinement& refinement);
 void evaluate_limit(const LimitStencils& limit, std::span<const Vec3> last_level_points, std::vector<Vec3>& positions,
                     std::vector<Vec3>& normals);
 
+// The last-level vertices lying on edge `edge` of level `level`, in order from its end `from`, without the
+// far end (child vertices keep their parent's index, so this follows the child-edge numbering above).
+void vertices_along_edge(const Refinement& refinement, size_t level, uint32_t edge, uint32_t from,
+                         std::vector<uint32_t>& out);
+
 // One call from a polygon mesh to its subdivided quads and limit surface samples.
 struct SubdivisionInput {
   std::span<const Vec3> positions;

@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <deque>
-#include <functional>
 #include <numbers>
 #include <numeric>
 #include <optional>
@@ -535,28 +534,12 @@ Result<LimitCurves> LimitCurves::build(const PolygonMeshView& control, uint32_t 
   LimitCurves curves;
   subdivide::evaluate_limit(*stencils, last, curves.limit_, normals);
 
-  // A base edge's vertices on the last level, in order: at each level an edge e splits at its edge point
-  // V + F + e into child edges C + 2e + k, k naming the end edge_vertices[2e + k] they keep (subdivide.hpp).
-  const auto& lv = refinement->levels;
-  std::function<void(size_t, uint32_t, uint32_t, uint32_t, std::vector<uint32_t>&)> walk =
-      [&](size_t l, uint32_t e, uint32_t from, uint32_t to, std::vector<uint32_t>& out) {
-        if (l + 1 == lv.size()) {
-          out.push_back(from);
-          return;
-        }
-        const subdivide::Level& L = lv[l];
-        const uint32_t mid = L.vertex_count + L.face_count() + e;
-        const uint32_t child_base = L.corner_count() + 2 * e;
-        const uint32_t k_from = L.edge_vertices[2 * e] == from ? 0 : 1;
-        walk(l + 1, child_base + k_from, from, mid, out);
-        walk(l + 1, child_base + 1 - k_from, mid, to, out);
-      };
-  const subdivide::Level& L0 = lv[0];
+  const subdivide::Level& L0 = refinement->levels[0];
   curves.base_edge_vertices_ = L0.edge_vertices;
   curves.along_.resize(L0.edge_count());
   for (uint32_t e = 0; e < L0.edge_count(); ++e) {
     const uint32_t a = L0.edge_vertices[2 * e], b = L0.edge_vertices[2 * e + 1];
-    walk(0, e, a, b, curves.along_[e]);
+    subdivide::vertices_along_edge(*refinement, 0, e, a, curves.along_[e]);
     curves.edge_by_ends_.emplace_back(uint64_t(std::min(a, b)) << 32 | std::max(a, b), e);
   }
   std::sort(curves.edge_by_ends_.begin(), curves.edge_by_ends_.end());

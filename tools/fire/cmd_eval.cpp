@@ -36,7 +36,7 @@ int run_eval(const EvalArgs& a) {
   auto reference = evaluate::reference_limit_surface(control->positions, control->face_offsets, control->face_vertices,
                                                      a.reference_levels);
   if (!reference) return fail(a.reference_path + ": reference mesh cannot be subdivided: " + reference.error());
-  const double diagonal = evaluate::bounding_box_diagonal(reference->positions);
+  const double diagonal = bounding_box_diagonal(reference->positions);
   if (!(diagonal > 0) || !std::isfinite(diagonal))
     return fail(a.reference_path + ": the reference limit surface has no extent (bounding-box diagonal " +
                 std::to_string(diagonal) + ")");
