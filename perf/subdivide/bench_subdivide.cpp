@@ -22,23 +22,18 @@
 
 #include "platform/obj.hpp"
 #include "systems/subdivide/subdivide.hpp"
+#include "tests/subdivide/osd_reference.hpp"
 
 namespace {
 
 namespace Far = OpenSubdiv::Far;
 namespace Sdc = OpenSubdiv::Sdc;
 namespace sd = fire::subdivide;
+// The oracle test's OpenSubdiv setup: the same vertex type and the options we claim to match.
+using fire::osd_reference::catmark_options;
+using fire::osd_reference::Point;
+using fire::osd_reference::to_points;
 using fire::Vec3;
-
-struct Point {
-  double xyz[3];
-  void Clear(void* = nullptr) { xyz[0] = xyz[1] = xyz[2] = 0.0; }
-  void AddWithWeight(const Point& src, double weight) {
-    xyz[0] += weight * src.xyz[0];
-    xyz[1] += weight * src.xyz[1];
-    xyz[2] += weight * src.xyz[2];
-  }
-};
 
 // Times variants in thread CPU time: the machine is shared, and time spent preempted by other
 // processes is not ours (page faults, charged to the thread, are counted). Interleaved (A B C A B C
@@ -100,23 +95,15 @@ struct OsdInput {
     descriptor.vertIndicesPerFace = indices.data();
   }
   std::unique_ptr<Far::TopologyRefiner> refine(int levels, bool full_last_level) const {
-    Sdc::Options options;
-    options.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER);
     using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
     std::unique_ptr<Far::TopologyRefiner> refiner(
-        Factory::Create(descriptor, Factory::Options(Sdc::SCHEME_CATMARK, options)));
+        Factory::Create(descriptor, Factory::Options(Sdc::SCHEME_CATMARK, catmark_options())));
     Far::TopologyRefiner::UniformOptions uniform(levels);
     uniform.fullTopologyInLastLevel = full_last_level;
     refiner->RefineUniform(uniform);
     return refiner;
   }
 };
-
-std::vector<Point> to_points(const std::vector<Vec3>& positions) {
-  std::vector<Point> points(positions.size());
-  for (size_t i = 0; i < positions.size(); ++i) points[i] = {{positions[i].x(), positions[i].y(), positions[i].z()}};
-  return points;
-}
 
 // Last-level points by Interpolate, level by level, into `levels` (resized once).
 const std::vector<Point>& osd_interpolate(const Far::TopologyRefiner& refiner, const std::vector<Point>& base,
