@@ -55,6 +55,8 @@ class Column {
       journal_.pop_back();
     }
   }
+  // Whether anything was written, grown or shrunk since `mark`.
+  bool changed_since(const ColumnMark& mark) const { return data_.size() != mark.size || journal_.size() != mark.journal; }
   // History older than this point can no longer be undone (after compaction, or when trimming history).
   void forget_journal() { journal_.clear(); }
   size_t journal_bytes() const { return journal_.capacity() * sizeof(std::pair<uint32_t, T>); }

@@ -288,10 +288,14 @@ void Mesh::end_transaction() {
 
 void Mesh::rollback(const MeshMark& m) {
   size_t k = 0;
+  bool changed = false;
   for_each_column([&](auto& column) {
     column.end();
+    changed = changed || column.changed_since(m.columns[k]);
     column.rollback(m.columns[k++]);
   });
+  // A rejected command wrote nothing: leave the tags alone, or consumers would recompute everything.
+  if (!changed) return;
   // Everything that survived the rollback may have changed: tag it all for consumers to re-read.
   vertices.dirty.assign(vertex_slots(), 1);
   edges.dirty.assign(edge_slots(), 1);

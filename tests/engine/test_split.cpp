@@ -341,3 +341,15 @@ TEST_CASE("border edits undo and redo like every other edit", "[split][undo]") {
   REQUIRE(h.apply(m, close).ok);
   CHECK(h.redo_depth() == 0);
 }
+
+TEST_CASE("a rejected edit leaves the dirty tags alone", "[pools]") {
+  EditHistory h;
+  Mesh m = square(&h);
+  m.clear_dirty();
+  REQUIRE_FALSE(h.apply(m, split(0, {0, 0}, {0, 0}, line({0, 0, 0}, {0, 0, 1}))).ok);
+  for (uint8_t d : m.faces.dirty) CHECK(d == 0);
+  for (uint8_t d : m.edges.dirty) CHECK(d == 0);
+  REQUIRE(h.undo(m).ok);  // a real rollback (here: reopening the border) still tags what it restores
+  REQUIRE(m.edges.dirty.size() == m.edge_slots());
+  CHECK(m.edges.dirty[0] == 1);
+}
