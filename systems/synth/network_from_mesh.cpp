@@ -460,6 +460,27 @@ Result<Mesh> network_from_mesh(const PolygonMeshView& control, const UnrefineOpt
         survives[chain.vertices[chain.vertices.size() / 2]] = 1;
         changed = true;
       }
+    // A face needs 3 sides for the thesis's reconstruction (it has no rule for 2-sided faces): where
+    // collapsing left fewer, the middle vertex of the longest collapsed run on its border stays.
+    for (uint32_t r = 0; r < nf && !changed; ++r) {
+      if (regions.find(r) != r) continue;
+      const auto& walk = border_walk[r];
+      size_t corners = 0;
+      for (uint32_t h : walk) corners += survives[c.tail(h)];
+      if (corners == 0 || corners >= 3 || walk.size() < 3) continue;
+      size_t start = 0;
+      while (!survives[c.tail(walk[start])]) ++start;
+      size_t best_first = 0, best_length = 0;
+      for (size_t i = 1, run = 0; i <= walk.size(); ++i) {
+        if (i < walk.size() && !survives[c.tail(walk[(start + i) % walk.size()])]) {
+          if (++run > best_length) best_length = run, best_first = i + 1 - run;
+        } else {
+          run = 0;
+        }
+      }
+      survives[c.tail(walk[(start + best_first + (best_length - 1) / 2) % walk.size()])] = 1;
+      changed = true;
+    }
   }
 
   std::optional<LimitCurves> limit;

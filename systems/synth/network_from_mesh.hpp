@@ -1,7 +1,8 @@
 #pragma once
 // Synthetic curve networks from a polygon control mesh (thesis chapter 7): unrefine the mesh by dropping
 // edge loops, turn each chain of kept edges into one polyline edge, collapse interior vertices of
-// valence 2 (thesis figure 63) and add seeded Gaussian noise to the polylines.
+// valence 2 (thesis figure 63; a vertex stays where collapsing it would leave a face with fewer than 3
+// sides, which the thesis's reconstruction cannot take) and add seeded Gaussian noise to the polylines.
 #include <cstdint>
 #include <span>
 #include <string_view>

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <set>
 #include <string>
 
 #include "platform/obj.hpp"
@@ -47,6 +48,13 @@ std::map<uint32_t, size_t> face_sizes(const Mesh& m) {
 bool on_border(const Mesh& m, uint32_t v) {
   for (uint32_t e : m.vertex_edges(v))
     if (m.is_border_edge(e)) return true;
+  return false;
+}
+
+bool on_triangle(const Mesh& m, uint32_t v) {
+  for (uint32_t e : m.vertex_edges(v))
+    for (uint32_t f : m.edges.face[e])
+      if (f != kNone && m.face_loop(f).size() == 3) return true;
   return false;
 }
 
@@ -103,7 +111,9 @@ TEST_CASE("exact counts on every shared manifold mesh for K = 1, 2, 3", "[synth]
   // extraordinary, so they have no loops to drop. The torus (8 x 4 loops) keeps 4 x 2, then 3 x 2 loops.
   // The pawn keeps every K-th of its 24 rings from the border and of its 24 meridians, plus the ring of
   // short loops around its valence-12 pole; border vertices of valence 2 stay (pentagons, hexagons at the
-  // border). The rook's 2-gons are triangles whose third corner was collapsed.
+  // border). Where collapsing would leave a rook face with 2 sides (a triangle of the control mesh whose
+  // third corner has valence 2), that corner stays: the face is a triangle, and its neighbour across the
+  // kept corner gains a side.
   struct Expected {
     const char* mesh;
     uint32_t k;
@@ -124,8 +134,8 @@ TEST_CASE("exact counts on every shared manifold mesh for K = 1, 2, 3", "[synth]
       {"pawn.obj", 2, 169, 324, 156, 5220, {{3, 12}, {4, 132}, {5, 12}}},
       {"pawn.obj", 3, 89, 156, 68, 3452, {{4, 60}, {6, 8}}},
       {"rook.obj", 1, 768, 1544, 777, 13896, {{3, 44}, {4, 733}}},
-      {"rook.obj", 2, 315, 617, 303, 7961, {{2, 5}, {3, 40}, {4, 212}, {5, 44}, {6, 2}}},
-      {"rook.obj", 3, 225, 435, 211, 6115, {{2, 7}, {3, 42}, {4, 122}, {5, 22}, {6, 18}}},
+      {"rook.obj", 2, 320, 622, 303, 7966, {{3, 45}, {4, 209}, {5, 46}, {6, 2}, {7, 1}}},
+      {"rook.obj", 3, 232, 442, 211, 6122, {{3, 49}, {4, 121}, {5, 20}, {6, 18}, {7, 3}}},
   };
   for (const Expected& x : table) {
     INFO(x.mesh << " K=" << x.k);
@@ -146,9 +156,10 @@ TEST_CASE("exact counts on every shared manifold mesh for K = 1, 2, 3", "[synth]
     // Unrefinement keeps the topology: V - E + F of a sphere, a torus, and a disk (pawn, rook).
     const std::map<std::string, long> euler = {{"cube.obj", 2}, {"pyramid.obj", 2}, {"torus.obj", 0}, {"pawn.obj", 1}, {"rook.obj", 1}};
     CHECK(long(x.vertices) - long(x.edges) + long(x.faces) == euler.at(x.mesh));
-    // Thesis figure 63: no interior vertex of valence 2 survives.
+    // Thesis figure 63: an interior vertex of valence 2 survives only as the third corner of a triangle.
+    for (uint32_t f = 0; f < m.face_slots(); ++f) CHECK(m.face_loop(f).size() >= 3);
     for (uint32_t v = 0; v < m.vertex_slots(); ++v)
-      if (!on_border(m, v)) CHECK(m.valence(v) >= 3);
+      if (!on_border(m, v) && m.valence(v) < 3) CHECK(on_triangle(m, v));
   }
 }
 
@@ -188,7 +199,7 @@ TEST_CASE("a 4 x 4 grid unrefined by 2 keeps its border and middle lines", "[syn
 
 TEST_CASE("a closed curve with no other vertex keeps two of its vertices", "[synth]") {
   // Two quads glued along their four edges: every vertex has valence 2, and an edge may not join a
-  // vertex to itself, so two vertices stay and each face is a 2-gon.
+  // vertex to itself, so two vertices stay; a third stays so that each face is a triangle, not a 2-gon.
   PolygonMesh pillow;
   pillow.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0)};
   pillow.face_vertices = {0, 1, 2, 3, 3, 2, 1, 0};
@@ -196,10 +207,13 @@ TEST_CASE("a closed curve with no other vertex keeps two of its vertices", "[syn
   auto net = network(pillow, 1);
   REQUIRE(net.ok());
   CHECK(net->validate().empty());
-  CHECK(net->vertex_count() == 2);
-  CHECK(net->edge_count() == 2);
-  CHECK(face_sizes(*net) == std::map<uint32_t, size_t>{{2, 2}});
-  for (uint32_t e = 0; e < net->edge_slots(); ++e) CHECK(net->edges.point_count[e] == 17);
+  CHECK(net->vertex_count() == 3);
+  CHECK(net->edge_count() == 3);
+  CHECK(face_sizes(*net) == std::map<uint32_t, size_t>{{3, 2}});
+  // The four control edges, 8 points each, in chains of 2, 1 and 1 edges: 17 + 9 + 9 points.
+  std::multiset<uint32_t> counts;
+  for (uint32_t e = 0; e < net->edge_slots(); ++e) counts.insert(net->edges.point_count[e]);
+  CHECK(counts == std::multiset<uint32_t>{9, 9, 17});
 }
 
 TEST_CASE("polylines sample the control edges linearly, at least 8 points per edge", "[synth]") {
