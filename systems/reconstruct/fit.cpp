@@ -1,9 +1,11 @@
 #include "systems/reconstruct/fit.hpp"
 
+#include <Eigen/QR>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <unordered_map>
 
@@ -153,11 +155,13 @@ struct Span {
   std::vector<Vec3> line;
   std::vector<double> params;
   std::vector<Eigen::Index> rows;  // in order along the line, ends included
+  double length = 0;
 };
 
 Span make_span(std::span<const Vec3> line, std::vector<Eigen::Index> rows) {
   Span s{std::vector<Vec3>(line.begin(), line.end()), {}, std::move(rows)};
   s.params = arc_parameters(s.line);
+  for (size_t j = 1; j < s.line.size(); ++j) s.length += (s.line[j] - s.line[j - 1]).norm();
   return s;
 }
 
@@ -202,6 +206,41 @@ void snap_split_points(Span& whole, uint32_t pieces, Eigen::MatrixX3d& targets, 
   }
 }
 
+// The arc-length fraction of the point of `span.line` closest to x, searched between fractions lo and hi
+// (the neighbouring rows' targets), so that the targets stay in order along the line.
+double foot_fraction(const Span& span, const Vec3& x, double lo, double hi) {
+  const auto& t = span.params;
+  size_t first = size_t(std::upper_bound(t.begin(), t.end(), lo) - t.begin());
+  size_t last = size_t(std::lower_bound(t.begin(), t.end(), hi) - t.begin());
+  first = first == 0 ? 0 : first - 1;
+  last = std::min(last, t.size() - 1);
+  double best = std::numeric_limits<double>::infinity(), best_t = 0.5 * (lo + hi);
+  for (size_t j = first; j < last; ++j) {
+    const Vec3 a = span.line[j], d = span.line[j + 1] - a;
+    const double squared = d.squaredNorm();
+    const double w = squared > 0 ? std::clamp((x - a).dot(d) / squared, 0.0, 1.0) : 0.0;
+    const double distance = (a + w * d - x).squaredNorm();
+    if (distance < best) {
+      best = distance;
+      best_t = std::clamp(t[j] + w * (t[j + 1] - t[j]), lo, hi);
+    }
+  }
+  return best_t;
+}
+
+// Inner-row fractions are stacked span after span; each span's must increase strictly inside (0, 1).
+bool ordered(const std::vector<Span>& spans, const Eigen::VectorXd& fractions) {
+  Eigen::Index i = 0;
+  for (const Span& span : spans) {
+    double previous = 0;
+    for (size_t k = 1; k + 1 < span.rows.size(); ++k, ++i) {
+      if (!(fractions[i] > previous && fractions[i] < 1)) return false;
+      previous = fractions[i];
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points) const {
@@ -228,6 +267,7 @@ LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points
     }
     spans.push_back(make_span(line, rows));
   }
+  const std::vector<Span> whole = spans;
   const double tolerance = m.settings.tolerance * std::max(bounding_box_diagonal(base.positions), 1e-300);
 
   Report report;
@@ -247,7 +287,75 @@ LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points
     solve_once();
     if (move <= tolerance) break;
   }
-  // Phase 2: the split points settle on polyline samples, and each piece is fitted between them.
+  // Phase 2: the targets become the foot points of the fitted limit points on the whole edges'
+  // polylines (fit.hpp says why); a mixed step that would reorder targets falls back to the plain one.
+  Eigen::Index inner = 0;
+  for (const Span& span : whole) inner += Eigen::Index(span.rows.size()) - 2;
+  Eigen::VectorXd x(inner), g(inner);
+  {
+    Eigen::Index i = 0;
+    for (const Span& span : whole) {
+      double previous = 0;
+      for (size_t k = 1; k + 1 < span.rows.size(); ++k, ++i)
+        previous = x[i] = foot_fraction(span, targets.row(span.rows[k]).transpose(), previous, 1.0);
+    }
+  }
+  auto place = [&](const Eigen::VectorXd& fractions) {
+    Eigen::Index i = 0;
+    for (const Span& span : whole)
+      for (size_t k = 1; k + 1 < span.rows.size(); ++k)
+        targets.row(span.rows[k]) = sample_polyline(span.line, span.params, fractions[i++], Sampling::linear).transpose();
+  };
+  // Each foot is searched between its neighbours' current targets, so that the targets stay in order.
+  auto feet = [&](const Eigen::VectorXd& current, Eigen::VectorXd& out) {
+    double largest_move = 0;
+    Eigen::Index i = 0;
+    for (const Span& span : whole) {
+      const Eigen::Index count = Eigen::Index(span.rows.size()) - 2;
+      for (Eigen::Index k = 0; k < count; ++k, ++i) {
+        const double lo = k == 0 ? 0.0 : current[i - 1], hi = k + 1 == count ? 1.0 : current[i + 1];
+        out[i] = foot_fraction(span, fitted.row(span.rows[size_t(k + 1)]).transpose(), lo, hi);
+        largest_move = std::max(largest_move, std::abs(out[i] - current[i]) * span.length);
+      }
+    }
+    return largest_move;
+  };
+  std::vector<Eigen::VectorXd> step_history, value_history;
+  Eigen::VectorXd previous_g, previous_f;
+  for (uint32_t round = 0; round < m.settings.feet_iterations; ++round) {
+    if (feet(x, g) <= tolerance) break;
+    const Eigen::VectorXd f = g - x;
+    if (previous_g.size() > 0) {
+      value_history.push_back(g - previous_g);
+      step_history.push_back(f - previous_f);
+      if (step_history.size() > m.settings.anderson_depth) {
+        value_history.erase(value_history.begin());
+        step_history.erase(step_history.begin());
+      }
+    }
+    previous_g = g;
+    previous_f = f;
+    Eigen::VectorXd next = g;
+    if (!step_history.empty()) {
+      Eigen::MatrixXd steps(inner, Eigen::Index(step_history.size()));
+      Eigen::MatrixXd values(inner, Eigen::Index(step_history.size()));
+      for (size_t j = 0; j < step_history.size(); ++j) {
+        steps.col(Eigen::Index(j)) = step_history[j];
+        values.col(Eigen::Index(j)) = value_history[j];
+      }
+      next = g - values * steps.colPivHouseholderQr().solve(f);
+    }
+    if (!ordered(whole, next)) {
+      next = g;
+      step_history.clear();
+      value_history.clear();
+      previous_g.resize(0);
+    }
+    x = next;
+    place(x);
+    solve_once();
+  }
+  // Phase 3: the split points settle on polyline samples, and each piece is fitted between them.
   if (pieces > 1) {
     std::vector<Span> split;
     for (Span& span : spans) snap_split_points(span, pieces, targets, split);
