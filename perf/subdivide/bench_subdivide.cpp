@@ -1,4 +1,5 @@
-// FIRE's Catmull-Clark against OpenSubdiv 3.5 (Debian libosd-dev), single thread, one process:
+// FIRE's Catmull-Clark against OpenSubdiv 3.5 (Debian libosd-dev), single thread, one process, on the pawn
+// control mesh and on the pawn's base mesh after one Coons step (thesis pipeline), to levels 3 and 4:
 //  (a) topology and positions from scratch: build_refinement + evaluate vs
 //      TopologyRefinerFactory::Create + RefineUniform + PrimvarRefiner::Interpolate;
 //  (b) positions only, topology fixed, points moved: evaluate (level by level, stencils applied from
@@ -20,8 +21,11 @@
 #include <string>
 #include <vector>
 
+#include "engine/surface.hpp"
 #include "platform/obj.hpp"
+#include "systems/reconstruct/reconstruct.hpp"
 #include "systems/subdivide/subdivide.hpp"
+#include "systems/synth/network_from_mesh.hpp"
 #include "tests/subdivide/osd_reference.hpp"
 
 namespace {
@@ -269,15 +273,27 @@ int main(int argc, char** argv) {
   }
   Mesh control{"pawn control mesh", pawn->positions, pawn->face_offsets, pawn->face_vertices};
 
-  // Stand-in for the pawn's base mesh after one Coons step: the control mesh refined once (same face
-  // count and topology as one Coons step would give, Catmull-Clark positions instead of Coons ones).
-  auto once = sd::subdivide({control.positions, control.face_offsets, control.face_vertices, {}}, 1);
-  if (!once) {
-    std::fprintf(stderr, "bench_subdivide: %s\n", once.error().c_str());
+  // The pawn's base mesh after one Coons step, as `fire network-from-mesh pawn.obj --unrefine 1 --limit`
+  // then `fire reconstruct --method thesis --coons-steps 1` build it (built once, not timed).
+  auto network = fire::network_from_mesh(
+      {control.positions, control.face_offsets, control.face_vertices, "pawn.obj"}, {.unrefine = 1, .limit = true});
+  if (!network) {
+    std::fprintf(stderr, "bench_subdivide: %s\n", network.error().c_str());
     return 1;
   }
-  Mesh refined{"pawn refined once (stand-in)", once->positions, {0}, once->quads};
-  for (size_t f = 1; f * 4 <= once->quads.size(); ++f) refined.face_offsets.push_back(uint32_t(4 * f));
+  fire::reconstruct::ReconstructionState state;
+  fire::SurfaceMesh surface;
+  const fire::reconstruct::Options thesis{.method = fire::reconstruct::Method::thesis, .coons_steps = 1};
+  if (fire::Status built = fire::reconstruct::reconstruct_update(*network, thesis, state, surface); !built) {
+    std::fprintf(stderr, "bench_subdivide: %s\n", built.error.c_str());
+    return 1;
+  }
+  const fire::reconstruct::BaseMesh& base = state.base();
+  if (!base.sharp_edges.empty()) {
+    std::fprintf(stderr, "bench_subdivide: the pawn's base mesh has sharp edges, which the OpenSubdiv setup omits\n");
+    return 1;
+  }
+  Mesh coons{"pawn after one Coons step", base.positions, base.face_offsets, base.face_vertices};
 
   std::printf("| base mesh | level | last-level vertices | (a) ours ms | (a) OSD ms | (a) OSD / ours | "
               "(a) ours, full last level ms | (a) OSD, full last level ms | (a) OSD / ours, full | "
@@ -285,7 +301,7 @@ int main(int argc, char** argv) {
               "(b) OSD last level factorized ms | (b) OSD level by level ms | (b) fastest OSD / fastest ours | "
               "max difference |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-  for (const Mesh* mesh : {&control, &refined})
+  for (const Mesh* mesh : {&control, &coons})
     for (int levels : {3, 4}) run_case(*mesh, levels, repetitions, order);
   return 0;
 }

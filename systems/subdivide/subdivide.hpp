@@ -11,7 +11,7 @@
 // evaluate() applies them level by level, so moving the base points re-evaluates every level without
 // touching topology. stencil_table() writes the same stencils out as explicit (source, weight) rows and
 // factorize() composes them into last-level-from-base rows (for solvers that need the matrix); applying
-// those is slower than evaluate() (about 2x level by level, 2.2-2.7x factorized: perf/RESULTS.md).
+// those is 2-5x slower than evaluate() (perf/RESULTS.md has the figures).
 //
 // Child components follow OpenSubdiv's uniform ordering (Vtr::Refinement with
 // orderVerticesFromFacesFirst = false), so level l of a Refinement has the same vertex, edge and
