@@ -79,7 +79,7 @@ void add_reconstruct_commands(CLI::App& app, Registry& registry) {
   cmd->add_option("--levels", a->levels, "L: Catmull-Clark levels (1 to 6)")->capture_default_str();
   cmd->add_option("--fairness", a->fairness,
                   "fire: weight of the fit's smoothness term, 0 to 1 (smaller follows the curves more closely, larger "
-                  "keeps face interiors smoother)")
+                  "keeps face interiors smoother; a hand-drawn network whose thin faces fold needs up to 1)")
       ->capture_default_str();
   cmd->add_option("--planarity", a->planarity,
                   "the thesis triquadrification's measure: least-squares, mean-normal or hough")
