@@ -58,7 +58,7 @@ void add_synth_commands(CLI::App& app, Registry& registry) {
                                      "Build a synthetic curve network from a manifold OBJ control mesh (thesis chapter 7)");
   cmd->footer(
       "Keeps every K-th edge loop (the border always), makes each chain of kept edges one polyline edge sampled "
-      "linearly on the control edges (or on the limit surface, --limit), collapses interior vertices of valence 2 and adds seeded Gaussian noise. "
+      "linearly on the control edges (or on the limit surface, --limit), collapses interior vertices of valence 2 (keeping one where a face would have fewer than 3 sides) and adds seeded Gaussian noise. "
       "Prints one JSON line: vertices, edges, faces, points and the number of faces of each size.");
   cmd->add_option("MESH", a->mesh_path, "control mesh, OBJ (v and f lines); must be manifold and consistently oriented")
       ->required();
