@@ -355,6 +355,18 @@ LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points
     place(x);
     solve_once();
   }
+  // The data term the fit minimizes: squared distances of the fitted points to their edges' polylines.
+  auto distance_to_curves = [&] {
+    double sum = 0;
+    for (const Span& span : whole)
+      for (size_t k = 1; k + 1 < span.rows.size(); ++k) {
+        const Vec3 x = fitted.row(span.rows[k]).transpose();
+        sum += (sample_polyline(span.line, span.params, foot_fraction(span, x, 0.0, 1.0), Sampling::linear) - x).squaredNorm();
+      }
+    return sum;
+  };
+  const Eigen::MatrixX3d feet_solution = solution, feet_fitted = fitted, feet_targets = targets;
+  const double feet_distance = distance_to_curves();
   // Phase 3: the split points settle on polyline samples, and each piece is fitted between them.
   if (pieces > 1) {
     std::vector<Span> split;
@@ -367,6 +379,11 @@ LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points
     for (const Span& span : spans) move = std::max(move, slide(span, fitted, targets, scratch));
     if (move <= tolerance) break;
     solve_once();
+  }
+  if (distance_to_curves() > feet_distance) {
+    solution = feet_solution;
+    fitted = feet_fitted;
+    targets = feet_targets;
   }
   points.resize(nb);
   for (uint32_t v = 0; v < nb; ++v) points[v] = solution.row(v).transpose();

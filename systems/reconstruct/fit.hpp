@@ -23,10 +23,11 @@
 //      Alternating with the solve creeps along the curves, so the last steps are Anderson-mixed;
 //   3. the split points settle on the polyline samples nearest to where phase 2 put them, and each
 //      piece slides alone as in phase 1. Where the curves are representable this converges fast (about
-//      a factor 6 per solve on smooth data) to a surface through every sample; phase 2 alone leaves the
-//      fitted points free to crowd where a curve is easy.
+//      a factor 6 per solve on smooth data) to a surface through every sample, which phase 2's creep
+//      does not reach (test_reconstruct's exact grid). The fit keeps phase 3's solution only if its
+//      fitted points lie closer to the polylines (sum of squared distances) than phase 2's.
 //   Without phase 2 the split points freeze where phase 1 left them: pawn K=2 network_max 9.7e-4; with
-//   it 1.7e-4 (perf/RESULTS.md).
+//   it 1.4e-4 (perf/RESULTS.md).
 // Each phase stops when no target moves more than `tolerance` times the base mesh's size.
 #include <memory>
 #include <vector>
