@@ -34,7 +34,6 @@ namespace Far = OpenSubdiv::Far;
 namespace Sdc = OpenSubdiv::Sdc;
 namespace sd = fire::subdivide;
 // The oracle test's OpenSubdiv setup: the same vertex type and the options we claim to match.
-using fire::osd_reference::catmark_options;
 using fire::osd_reference::Point;
 using fire::osd_reference::to_points;
 using fire::Vec3;
@@ -99,13 +98,7 @@ struct OsdInput {
     descriptor.vertIndicesPerFace = indices.data();
   }
   std::unique_ptr<Far::TopologyRefiner> refine(int levels, bool full_last_level) const {
-    using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
-    std::unique_ptr<Far::TopologyRefiner> refiner(
-        Factory::Create(descriptor, Factory::Options(Sdc::SCHEME_CATMARK, catmark_options())));
-    Far::TopologyRefiner::UniformOptions uniform(levels);
-    uniform.fullTopologyInLastLevel = full_last_level;
-    refiner->RefineUniform(uniform);
-    return refiner;
+    return fire::osd_reference::refine_uniform(descriptor, levels, full_last_level);
   }
 };
 

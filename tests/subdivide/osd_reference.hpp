@@ -39,6 +39,19 @@ inline Sdc::Options catmark_options() {
   return options;
 }
 
+// Catmark with our options, refined uniformly to `levels`; the full topology in the last level is what
+// Limit needs (OpenSubdiv's default builds only the last level's faces).
+inline std::unique_ptr<Far::TopologyRefiner> refine_uniform(const Far::TopologyDescriptor& descriptor, int levels,
+                                                            bool full_last_level) {
+  using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
+  std::unique_ptr<Far::TopologyRefiner> refiner(
+      Factory::Create(descriptor, Factory::Options(Sdc::SCHEME_CATMARK, catmark_options())));
+  Far::TopologyRefiner::UniformOptions uniform(levels);
+  uniform.fullTopologyInLastLevel = full_last_level;
+  refiner->RefineUniform(uniform);
+  return refiner;
+}
+
 // Refined uniformly to `levels` with the full topology in the last level (needed for Limit).
 inline std::unique_ptr<Far::TopologyRefiner> refine(uint32_t vertex_count, std::span<const uint32_t> face_offsets,
                                                     std::span<const uint32_t> face_vertices,
@@ -57,14 +70,7 @@ inline std::unique_ptr<Far::TopologyRefiner> refine(uint32_t vertex_count, std::
   descriptor.numCreases = int(crease_weights.size());
   descriptor.creaseVertexIndexPairs = crease_pairs.data();
   descriptor.creaseWeights = crease_weights.data();
-
-  using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
-  std::unique_ptr<Far::TopologyRefiner> refiner(
-      Factory::Create(descriptor, Factory::Options(Sdc::SCHEME_CATMARK, catmark_options())));
-  Far::TopologyRefiner::UniformOptions uniform(levels);
-  uniform.fullTopologyInLastLevel = true;
-  refiner->RefineUniform(uniform);
-  return refiner;
+  return refine_uniform(descriptor, levels, true);
 }
 
 // Points of every level, interpolated with double weights.
