@@ -32,6 +32,12 @@ inline P3 operator+(const P3& a, const P3& b) { return {a.xy + b.xy, a.z + b.z};
 inline P3 operator*(double s, const P3& a) { return {s * a.xy, s * a.z}; }
 inline P3& operator+=(P3& a, const P3& b) { return a = a + b; }
 
+// The edge point of edge ab: the midpoint on a crease, else the mean of the midpoint and the mean of the
+// edge's two face points (`half_faces`).
+inline P3 edge_point(const P3& a, const P3& b, const P3& half_faces, bool sharp) {
+  return sharp ? 0.5 * (a + b) : 0.5 * (0.5 * (a + b) + half_faces);
+}
+
 // The vertex point of parent vertex v, whose out slot holds its ring sum (the sum of its neighbours
 // plus the sum of its face points) when its rule is smooth or dart.
 inline void finish_vertex(const Level& p, uint32_t v, const double* in, double* out) {
@@ -106,7 +112,7 @@ void refine_any_level(const Level& p, const double* in, double* out) {
       run = P3{{0, 0}, 0};
     }
     double* sum_b = out + 3 * size_t{ib};
-    store(q, sharp[e] ? 0.5 * (a + b) : 0.5 * (0.5 * (a + b) + half_faces));
+    store(q, edge_point(a, b, half_faces, sharp[e]));
     run += b + half_faces;
     store(sum_b, load(sum_b) + (a + half_faces));
   }
@@ -215,7 +221,7 @@ void refine_by_blocks(const Level& grand, const Level& p, const double* in, doub
       const P3 f0 = load(face_points + 3 * size_t{ec[2 * edge] >> 2});
       const P3 half_faces = 0.5 * (f0 + load(face_points + 3 * size_t{c1 >> 2}));
       double* x_sum = out + 3 * size_t{ix};
-      store(q, sharp ? 0.5 * (m + x) : 0.5 * (0.5 * (m + x) + half_faces));
+      store(q, edge_point(m, x, half_faces, sharp));
       m_sum += x + half_faces;
       store(x_sum, load(x_sum) + (m + half_faces));
     }
