@@ -184,7 +184,7 @@ double slide(const Span& span, const Eigen::MatrixX3d& fitted, Eigen::MatrixX3d&
 
 // Splits a whole network edge's span at the polyline samples nearest to its split points' targets, which
 // then become those samples exactly; keeps it whole when they would not be distinct, ordered samples.
-void snap_split_points(Span& whole, uint32_t pieces, Eigen::MatrixX3d& targets, std::vector<Span>& out) {
+void snap_split_points(const Span& whole, uint32_t pieces, Eigen::MatrixX3d& targets, std::vector<Span>& out) {
   const size_t steps = (whole.rows.size() - 1) / pieces, last = whole.line.size() - 1;
   std::vector<size_t> at{0};
   for (uint32_t i = 1; i < pieces; ++i) {
@@ -193,7 +193,7 @@ void snap_split_points(Span& whole, uint32_t pieces, Eigen::MatrixX3d& targets, 
     for (size_t j = 1; j < last; ++j)
       if ((whole.line[j] - target).squaredNorm() < (whole.line[best] - target).squaredNorm()) best = j;
     if (best <= at.back()) {
-      out.push_back(std::move(whole));
+      out.push_back(whole);
       return;
     }
     at.push_back(best);
@@ -252,7 +252,7 @@ LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points
     if (m.vertex_row[v] >= 0) targets.row(m.vertex_row[v]) = base.positions[v].transpose();
   }
   // First targets: equal arc-length steps along each piece of each network edge.
-  std::vector<Span> spans;
+  std::vector<Span> whole;  // one per network edge
   std::vector<Vec3> line;
   for (size_t p = 0; p < m.paths.size(); ++p) {
     const std::vector<Eigen::Index>& rows = m.paths[p];
@@ -265,9 +265,8 @@ LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points
       for (size_t k = 1; k < steps; ++k)
         targets.row(rows[i * steps + k]) = sample_polyline(piece, t, double(k) / double(steps), Sampling::linear).transpose();
     }
-    spans.push_back(make_span(line, rows));
+    whole.push_back(make_span(line, rows));
   }
-  const std::vector<Span> whole = spans;
   const double tolerance = m.settings.tolerance * std::max(bounding_box_diagonal(base.positions), 1e-300);
 
   Report report;
@@ -283,7 +282,7 @@ LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points
   // Phase 1: the split points slide too, to where the fitted surface puts them along the whole edge.
   for (uint32_t round = 0; round < m.settings.slide_iterations; ++round) {
     double move = 0;
-    for (const Span& span : spans) move = std::max(move, slide(span, fitted, targets, scratch));
+    for (const Span& span : whole) move = std::max(move, slide(span, fitted, targets, scratch));
     solve_once();
     if (move <= tolerance) break;
   }
@@ -368,15 +367,15 @@ LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points
   const Eigen::MatrixX3d feet_solution = solution, feet_fitted = fitted, feet_targets = targets;
   const double feet_distance = distance_to_curves();
   // Phase 3: the split points settle on polyline samples, and each piece is fitted between them.
+  std::vector<Span> split;
   if (pieces > 1) {
-    std::vector<Span> split;
-    for (Span& span : spans) snap_split_points(span, pieces, targets, split);
-    spans = std::move(split);
+    for (const Span& span : whole) snap_split_points(span, pieces, targets, split);
     solve_once();
   }
+  const std::vector<Span>& sliding = pieces > 1 ? split : whole;
   while (report.iterations < m.settings.max_iterations) {
     double move = 0;
-    for (const Span& span : spans) move = std::max(move, slide(span, fitted, targets, scratch));
+    for (const Span& span : sliding) move = std::max(move, slide(span, fitted, targets, scratch));
     if (move <= tolerance) break;
     solve_once();
   }
