@@ -38,6 +38,14 @@ inline P3 edge_point(const P3& a, const P3& b, const P3& half_faces, bool sharp)
   return sharp ? 0.5 * (a + b) : 0.5 * (0.5 * (a + b) + half_faces);
 }
 
+// The vertex rules: a crease vertex from the sum of its two sharp neighbours; a smooth (or dart) vertex
+// of valence n from its ring sum, (n-2)/n of the vertex plus 1/n^2 of the ring sum.
+inline P3 crease_point(const P3& self, const P3& sharp_sum) { return 0.75 * self + 0.125 * sharp_sum; }
+inline P3 smooth_point(const P3& self, const P3& ring_sum, uint32_t n) {
+  const double inverse = n == 4 ? 0.25 : 1.0 / n;
+  return (1.0 - 2.0 * inverse) * self + (inverse * inverse) * ring_sum;
+}
+
 // The vertex point of parent vertex v, whose out slot holds its ring sum (the sum of its neighbours
 // plus the sum of its face points) when its rule is smooth or dart.
 inline void finish_vertex(const Level& p, uint32_t v, const double* in, double* out) {
@@ -49,21 +57,15 @@ inline void finish_vertex(const Level& p, uint32_t v, const double* in, double* 
       store(q, load(self));
       break;
     case VertexRule::crease: {
-      // 3/4 of the vertex, 1/8 of each of its two sharp neighbours.
       P3 sum{{0, 0}, 0};
       for (uint32_t r = r0; r < r1; ++r)
         if (p.edge_sharp[p.ring_edges[r]]) sum += load(in + 3 * size_t{p.ring_neighbors[r]});
-      store(q, 0.75 * load(self) + 0.125 * sum);
+      store(q, crease_point(load(self), sum));
       break;
     }
-    default: {
-      // (n-2)/n of the vertex plus 1/n^2 of the ring sum.
-      const uint32_t n = r1 - r0;
-      const double inverse = n == 4 ? 0.25 : 1.0 / n;
-      const double self_weight = 1.0 - 2.0 * inverse, ring_weight = inverse * inverse;
-      store(q, self_weight * load(self) + ring_weight * load(q));
+    default:
+      store(q, smooth_point(load(self), load(q), r1 - r0));
       break;
-    }
   }
 }
 
@@ -166,9 +168,7 @@ void refine_block(const Blocks& x, uint32_t g, uint32_t n, const uint32_t* corne
     side = side_next;
   }
   // The centre: smooth, valence n.
-  const double inverse = n == 4 ? 0.25 : 1.0 / n;
-  const double self_weight = 1.0 - 2.0 * inverse, ring_weight = inverse * inverse;
-  store(x.out + 3 * size_t{x.centre0 + g}, self_weight * centre + ring_weight * centre_sum);
+  store(x.out + 3 * size_t{x.centre0 + g}, smooth_point(centre, centre_sum, n));
 }
 
 // The points of level l+1 from level l (>= 1), going by the faces of level l-1 ("blocks"): a block of
@@ -228,9 +228,9 @@ void refine_by_blocks(const Level& grand, const Level& p, const double* in, doub
     // The side point's ring is complete (its blocks added theirs): valence 4, or a crease along e.
     double* m_out = out + 3 * size_t{im};
     if (sharp)
-      store(m_out, 0.75 * m + 0.125 * (load(in + 3 * size_t{gev[2 * e]}) + load(in + 3 * size_t{gev[2 * e + 1]})));
+      store(m_out, crease_point(m, load(in + 3 * size_t{gev[2 * e]}) + load(in + 3 * size_t{gev[2 * e + 1]})));
     else
-      store(m_out, 0.5 * m + 0.0625 * (load(m_out) + m_sum));
+      store(m_out, smooth_point(m, load(m_out) + m_sum, 4));
   }
 
   // Corners from their ring sums (centres and side points are done).
