@@ -34,6 +34,7 @@ namespace Far = OpenSubdiv::Far;
 namespace Sdc = OpenSubdiv::Sdc;
 namespace sd = fire::subdivide;
 // The oracle test's OpenSubdiv setup: the same vertex type and the options we claim to match.
+using fire::osd_reference::in_osd_numbering;
 using fire::osd_reference::Point;
 using fire::osd_reference::to_points;
 using fire::Vec3;
@@ -139,6 +140,7 @@ void run_case(const Mesh& mesh, int levels, int repetitions, Order order) {
   const std::vector<Point> osd_base = to_points(mesh.positions);
   std::vector<Vec3> last, scratch;
   std::vector<std::vector<Point>> osd_levels;
+  sd::Refinement scratch_refinement;  // the last one built in (a), to compare its points
 
   // (a) From scratch. Ours without and with the last level's adjacency, OpenSubdiv without and with
   // fullTopologyInLastLevel (its default is without).
@@ -146,6 +148,7 @@ void run_case(const Mesh& mesh, int levels, int repetitions, Order order) {
     auto refinement = sd::build_refinement(topology, {levels, adjacency});
     if (!refinement) std::abort();
     sd::evaluate(*refinement, mesh.positions, last, scratch);
+    scratch_refinement = std::move(*refinement);
   };
   auto osd_scratch = [&](bool full) {
     auto refiner = osd_input.refine(levels, full);
@@ -154,7 +157,7 @@ void run_case(const Mesh& mesh, int levels, int repetitions, Order order) {
   Variant a_ours{[&] { ours_scratch(false); }, {}}, a_osd{[&] { osd_scratch(false); }, {}};
   Variant a_ours_full{[&] { ours_scratch(true); }, {}}, a_osd_full{[&] { osd_scratch(true); }, {}};
   time_variants(order, repetitions, {&a_ours, &a_osd, &a_ours_full, &a_osd_full}, [] {});
-  const double a_check = max_difference(last, osd_levels.back().data());
+  const double a_check = max_difference(in_osd_numbering(scratch_refinement, last), osd_levels.back().data());
 
   // (b) Positions only. Tables built once; every repetition moves the base points first (not timed).
   auto refinement = sd::build_refinement(topology, {levels, false});
@@ -230,9 +233,12 @@ void run_case(const Mesh& mesh, int levels, int repetitions, Order order) {
   osd_factorized_update();
   osd_level_by_level();
   const Point* osd_per_level_last = osd_all.data() + (osd_all.size() - last.size());
-  const double b_check = std::max({max_difference(last, osd_last.data()), max_difference(last, osd_per_level_last),
-                                   max_difference(last_factorized, osd_last.data()),
-                                   max_difference(explicit_levels.back(), osd_last.data())});
+  const std::vector<Vec3> ours_in_osd_numbering = in_osd_numbering(*refinement, last);
+  const double b_check =
+      std::max({max_difference(ours_in_osd_numbering, osd_last.data()),
+                max_difference(ours_in_osd_numbering, osd_per_level_last),
+                max_difference(in_osd_numbering(*refinement, last_factorized), osd_last.data()),
+                max_difference(in_osd_numbering(*refinement, explicit_levels.back()), osd_last.data())});
 
   const double b_ours_best = std::min({b_ours.median(), b_ours_explicit.median(), b_ours_factorized.median()});
   const double b_osd_best = std::min(b_osd_factorized.median(), b_osd_per_level.median());

@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# Benchmark (b), points moved, against OpenSubdiv under several code layouts. OpenSubdiv's
+# Benchmarks (a) and (b) against OpenSubdiv under several code layouts. OpenSubdiv's
 # StencilTable::UpdateValues is a template compiled into bench_subdivide, and its inner loop runs up to
 # 40 % faster or slower depending on where the loop lands (perf/RESULTS.md); ours barely moves. This
 # builds the benchmark once per alignment setting, each in its own folder build-layout-NAME, runs each
-# RUNS times (interleaved, 11 repetitions), and prints the (b) columns as one Markdown table, so that a
-# ratio can be quoted against the peer's best layout.
+# RUNS times (interleaved, 11 repetitions), and prints the (a) and (b) columns as one Markdown table, so
+# that a ratio can be quoted against the peer's best layout.
 #
 # usage: perf/subdivide/layouts.sh [RUNS]   (RUNS defaults to 3; run from anywhere, after `tools/run bench`
 #        has installed the packages; about 2 minutes of building per layout on 2 cores)
@@ -15,10 +15,10 @@ runs="${1:-3}"
 jobs="$(nproc 2>/dev/null || echo 2)"
 layouts=("default=" "loops16=-falign-loops=16" "loops32=-falign-loops=32" "loops64=-falign-loops=64 -falign-functions=64")
 
-echo "Benchmark (b), $(uname -m), $(nproc) cores, $(date -u +%Y-%m-%d): ours = evaluate, OpenSubdiv = level by level UpdateValues"
+echo "Benchmarks (a) and (b), $(uname -m), $(nproc) cores, $(date -u +%Y-%m-%d)"
 echo
-echo "| layout (CMAKE_CXX_FLAGS) | run | base mesh | level | ours ms | OpenSubdiv ms | fastest OSD / fastest ours |"
-echo "|---|---|---|---|---|---|---|"
+echo "| layout (CMAKE_CXX_FLAGS) | run | base mesh | level | (a) ours ms | (a) OSD ms | (a) OSD / ours | (b) ours ms | (b) OSD level by level ms | (b) fastest OSD / fastest ours |"
+echo "|---|---|---|---|---|---|---|---|---|---|"
 for layout in "${layouts[@]}"; do
   name="${layout%%=*}" flags="${layout#*=}"
   dir="$root/build-layout-$name"
@@ -27,9 +27,10 @@ for layout in "${layouts[@]}"; do
     "-DCMAKE_CXX_FLAGS=$flags" >/dev/null
   cmake --build "$dir" -j "$jobs" --target bench_subdivide >/dev/null
   for ((run = 1; run <= runs; ++run)); do
-    # Table rows of bench_subdivide: | mesh | level | ... | (b) ours | ... | (b) OSD level by level | ratio | max diff |
+    # Table rows of bench_subdivide: | mesh | level | vertices | (a) ours | (a) OSD | (a) ratio | ... | (b) ours |
+    # ... | (b) OSD level by level | (b) ratio | max diff |
     "$dir/perf/subdivide/bench_subdivide" "$root/../shared" 11 interleaved |
       awk -F'|' -v layout="${flags:-default}" -v run="$run" \
-        'NR > 2 { gsub(/^ +| +$/, "", $2); printf "| %s | %d | %s |%s|%s|%s|%s|\n", layout, run, $2, $3, $11, $16, $17 }'
+        'NR > 2 { gsub(/^ +| +$/, "", $2); printf "| %s | %d | %s |%s|%s|%s|%s|%s|%s|%s|\n", layout, run, $2, $3, $5, $6, $7, $11, $16, $17 }'
   done
 done

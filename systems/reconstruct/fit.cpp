@@ -86,14 +86,14 @@ Result<LimitFit> LimitFit::build(const subdivide::Refinement& refinement, const 
     const uint32_t a = level0.edge_vertices[2 * e], b = level0.edge_vertices[2 * e + 1];
     edge_of_pair[uint64_t(std::min(a, b)) << 32 | std::max(a, b)] = e;
   }
-  // Rows: the drawn base vertices (a child keeps its parent's index), then the inner level-L vertices of
+  // Rows: the drawn base vertices, then the inner level-L vertices of
   // every drawn curve, network edge by network edge.
   std::vector<uint32_t> selected;
   impl->vertex_row.assign(nb, -1);
   for (uint32_t v = 0; v < nb; ++v)
     if (base.vertex_drawn[v]) {
       impl->vertex_row[v] = Eigen::Index(selected.size());
-      selected.push_back(v);
+      selected.push_back(subdivide::last_level_vertex(refinement, v));
     }
   std::vector<uint32_t> chain;
   for (uint32_t c = 0; c < base.curve_count() && base.curve_drawn[c]; ++c) {

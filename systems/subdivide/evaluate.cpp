@@ -1,7 +1,8 @@
-// Level-by-level evaluation: each level's stencils applied straight from its index arrays, the
-// weights following from the vertex rule and valence. Against explicit (source, weight) rows this
-// reads no weights and gathers each parent point fewer times; perf/RESULTS.md has the measurements.
-// Also the one-call subdivide().
+// Evaluation: regular patches straight from their 4x4 base points where the refinement has them, and
+// level by level elsewhere, each level's stencils applied straight from its index arrays, the weights
+// following from the vertex rule and valence. Against explicit (source, weight) rows this reads no
+// weights and gathers each parent point fewer times; perf/RESULTS.md has the measurements. Also the
+// one-call subdivide().
 #include <algorithm>
 #include <cstring>
 #include <string>
@@ -237,14 +238,103 @@ void refine_by_blocks(const Level& grand, const Level& p, const double* in, doub
   for (uint32_t v = 0; v < GV; ++v) finish_vertex(p, v, in, out);
 }
 
+size_t child_vertex_count(const Level& parent) {
+  return size_t{parent.vertex_count} + parent.face_count() + parent.edge_count();
+}
+
+// Level l+1's points of `levels` from level l's (out holds child_vertex_count(levels[l]) points).
+void refine_level(std::span<const Level> levels, size_t l, const double* in, double* out) {
+  if (l == 0)
+    refine_any_level(levels[0], in, out);
+  else
+    refine_by_blocks(levels[l - 1], levels[l], in, out);
+}
+
+// Regular patches (RegularPatches in subdivide.hpp). A last-level point of a patch is a tensor product
+// of 1D weights over its 4x4 base points: per patch, each of the 4 rows of base points is first reduced
+// to its points along the patch (4 taps each), and every grid point is then 4 taps across those (the
+// x,y pair of one point and the z of two neighbours go through the arithmetic together). The points go
+// out in the last level's order, which is this one: one sequential stream. Then the rest mesh, level
+// by level, and its points after them.
+inline Pair load_pair(const double* p) {
+  Pair r;
+  std::memcpy(&r, p, sizeof(Pair));
+  return r;
+}
+
+void evaluate_by_patches(const Refinement& refinement, std::span<const Vec3> base_points, std::vector<Vec3>& last,
+                         std::vector<Vec3>& scratch) {
+  const RegularPatches& plan = refinement.patches;
+  const uint32_t side = plan.side, s = side - 1;
+  size_t rest_points = 0;
+  for (size_t l = 1; l < plan.rest.size(); ++l) rest_points = std::max<size_t>(rest_points, plan.rest[l].vertex_count);
+  scratch.resize(plan.rest_controls.size() + 2 * rest_points);
+  last.resize(refinement.last().vertex_count);
+  double* q = last.data()->data();
+  const double* base = base_points.data()->data();
+  const double* w0 = plan.weights.data();
+  const double *w1 = w0 + side, *w2 = w1 + side, *w3 = w2 + side;
+  Pair row_xy[4][kMaxPatchSide];
+  double row_z[4][kMaxPatchSide + 1] = {};  // one spare: the last point's z goes in a pair too
+
+  for (uint32_t p = 0; p < plan.patch_count(); ++p) {
+    const uint32_t* controls = plan.controls.data() + 16 * size_t{p};
+    for (uint32_t a = 0; a < 4; ++a) {
+      const P3 c0 = load(base + 3 * size_t{controls[4 * a]}), c1 = load(base + 3 * size_t{controls[4 * a + 1]});
+      const P3 c2 = load(base + 3 * size_t{controls[4 * a + 2]}), c3 = load(base + 3 * size_t{controls[4 * a + 3]});
+      for (uint32_t j = 0; j < side; ++j)
+        row_xy[a][j] = ((w0[j] * c0.xy + w1[j] * c1.xy) + w2[j] * c2.xy) + w3[j] * c3.xy;
+      for (uint32_t j = 0; j < side; ++j) row_z[a][j] = ((w0[j] * c0.z + w1[j] * c1.z) + w2[j] * c2.z) + w3[j] * c3.z;
+    }
+    const uint32_t owned = plan.owned[p];
+    for (uint32_t i = 0; i < side; ++i) {
+      // Which of this row's points the patch writes: its first, inner and last ones.
+      const bool edge_row = i == 0 || i == s;
+      const bool first = owned >> (i == 0 ? 4 : i == s ? 7 : 3) & 1;
+      const bool inner = !edge_row || (owned >> (i == 0 ? 0 : 2) & 1);
+      const bool final = owned >> (i == 0 ? 5 : i == s ? 6 : 1) & 1;
+      const double a0 = w0[i], a1 = w1[i], a2 = w2[i], a3 = w3[i];
+      auto xy = [&](uint32_t j) {
+        return ((a0 * row_xy[0][j] + a1 * row_xy[1][j]) + a2 * row_xy[2][j]) + a3 * row_xy[3][j];
+      };
+      for (uint32_t j = 0; j < side; j += 2) {
+        const Pair z = ((a0 * load_pair(row_z[0] + j) + a1 * load_pair(row_z[1] + j)) + a2 * load_pair(row_z[2] + j)) +
+                       a3 * load_pair(row_z[3] + j);
+        if (j == 0 ? first : j == s ? final : inner) {
+          store(q, {xy(j), z[0]});
+          q += 3;
+        }
+        if (j + 1 < side && (j + 1 == s ? final : inner)) {
+          store(q, {xy(j + 1), z[1]});
+          q += 3;
+        }
+      }
+    }
+  }
+
+  if (plan.rest.empty()) return;
+  double* rest_base = scratch.data()->data();
+  double* rest_a = rest_base + 3 * plan.rest_controls.size();
+  double* rest_b = rest_a + 3 * rest_points;
+  for (size_t i = 0; i < plan.rest_controls.size(); ++i)
+    store(rest_base + 3 * i, load(base + 3 * size_t{plan.rest_controls[i]}));
+  const double* src = rest_base;
+  double* dst = rest_a;
+  for (size_t l = 0; l + 1 < plan.rest.size(); ++l) {
+    refine_level(plan.rest, l, src, dst);
+    src = dst;
+    dst = dst == rest_a ? rest_b : rest_a;
+  }
+  for (uint32_t v : plan.rest_sources) {
+    store(q, load(src + 3 * size_t{v}));
+    q += 3;
+  }
+}
+
 // Level l+1's points from level l's.
 void refine_points(const Refinement& refinement, size_t l, std::span<const Vec3> in, std::vector<Vec3>& out) {
-  const Level& parent = refinement.levels[l];
-  out.resize(size_t{parent.vertex_count} + parent.face_count() + parent.edge_count());
-  if (l == 0)
-    refine_any_level(parent, in.data()->data(), out.data()->data());
-  else
-    refine_by_blocks(refinement.levels[l - 1], parent, in.data()->data(), out.data()->data());
+  out.resize(child_vertex_count(refinement.levels[l]));
+  refine_level(refinement.levels, l, in.data()->data(), out.data()->data());
 }
 
 }  // namespace
@@ -254,6 +344,10 @@ void evaluate(const Refinement& refinement, std::span<const Vec3> base_points, s
   const size_t steps = refinement.levels.size() - 1;
   if (steps == 0) {
     last_level_points.assign(base_points.begin(), base_points.end());
+    return;
+  }
+  if (refinement.patches.patch_count() > 0) {
+    evaluate_by_patches(refinement, base_points, last_level_points, scratch);
     return;
   }
   // Alternate between the two buffers so that the last step writes last_level_points.
@@ -271,6 +365,12 @@ void evaluate_all_levels(const Refinement& refinement, std::span<const Vec3> bas
   level_points[0].assign(base_points.begin(), base_points.end());
   for (size_t l = 0; l + 1 < refinement.levels.size(); ++l)
     refine_points(refinement, l, level_points[l], level_points[l + 1]);
+  // The last level came out in OpenSubdiv's numbering.
+  if (refinement.last_from_osd.empty()) return;
+  std::vector<Vec3>& last = level_points.back();
+  std::vector<Vec3> renumbered(last.size());
+  for (size_t v = 0; v < last.size(); ++v) renumbered[refinement.last_from_osd[v]] = last[v];
+  last = std::move(renumbered);
 }
 
 Result<SubdividedMesh> subdivide(const SubdivisionInput& input, int levels) {

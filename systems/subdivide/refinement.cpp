@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <string>
 
-#include "systems/subdivide/subdivide.hpp"
+#include "systems/subdivide/patches.hpp"
 
 namespace fire::subdivide {
 namespace {
@@ -410,7 +410,8 @@ class ChildBuilder {
 };
 }  // namespace
 
-Result<Refinement> build_refinement(const BaseTopology& base, const RefinementOptions& options) {
+namespace detail {
+Result<Refinement> build_levels(const BaseTopology& base, const RefinementOptions& options) {
   if (options.levels < 0 || options.levels > kMaxLevels)
     return Result<Refinement>::failure("subdivision level " + std::to_string(options.levels) +
                                        " is outside 0 .. " + std::to_string(kMaxLevels));
@@ -429,18 +430,35 @@ Result<Refinement> build_refinement(const BaseTopology& base, const RefinementOp
   }
   return refinement;
 }
+}  // namespace detail
 
-void vertices_along_edge(const Refinement& r, size_t level, uint32_t edge, uint32_t from, std::vector<uint32_t>& out) {
+Result<Refinement> build_refinement(const BaseTopology& base, const RefinementOptions& options) {
+  Result<Refinement> refinement = detail::build_levels(base, options);
+  if (refinement && options.levels >= 3 && options.levels <= 6) detail::plan_regular_patches(base, *refinement);
+  return refinement;
+}
+
+namespace {
+// In OpenSubdiv's numbering at every level; the last level's vertices are mapped as they are found.
+void along_edge(const Refinement& r, size_t level, uint32_t edge, uint32_t from, std::vector<uint32_t>& out) {
   if (level + 1 == r.levels.size()) {
-    out.push_back(from);
+    out.push_back(r.last_from_osd.empty() ? from : r.last_from_osd[from]);
     return;
   }
   const Level& lv = r.levels[level];
   const uint32_t k = lv.edge_vertices[2 * edge] == from ? 0u : 1u;
   const uint32_t mid = lv.vertex_count + lv.face_count() + edge;
   const uint32_t children = lv.corner_count() + 2 * edge;
-  vertices_along_edge(r, level + 1, children + k, from, out);
-  vertices_along_edge(r, level + 1, children + (1 - k), mid, out);
+  along_edge(r, level + 1, children + k, from, out);
+  along_edge(r, level + 1, children + (1 - k), mid, out);
+}
+}  // namespace
+
+void vertices_along_edge(const Refinement& r, size_t level, uint32_t edge, uint32_t from, std::vector<uint32_t>& out) {
+  if (level + 1 == r.levels.size())
+    out.push_back(from);
+  else
+    along_edge(r, level, edge, from, out);
 }
 
 }  // namespace fire::subdivide

@@ -96,6 +96,24 @@ class RowWriter {
   const Level& p_;
 };
 
+// The rows of `table` (in OpenSubdiv's numbering of the last level) in the last level's numbering.
+StencilTable renumber_rows(const StencilTable& table, const std::vector<uint32_t>& last_from_osd) {
+  const uint32_t rows = table.row_count();
+  std::vector<uint32_t> order(rows);
+  for (uint32_t r = 0; r < rows; ++r) order[last_from_osd[r]] = r;
+  StencilTable result;
+  result.offsets.resize(size_t{rows} + 1);
+  result.sources.reserve(table.sources.size());
+  result.weights.reserve(table.weights.size());
+  for (uint32_t r = 0; r < rows; ++r) {
+    const uint32_t b = table.offsets[order[r]], e = table.offsets[order[r] + 1];
+    result.sources.insert(result.sources.end(), table.sources.begin() + b, table.sources.begin() + e);
+    result.weights.insert(result.weights.end(), table.weights.begin() + b, table.weights.begin() + e);
+    result.offsets[r + 1] = static_cast<uint32_t>(result.sources.size());
+  }
+  return result;
+}
+
 }  // namespace
 
 StencilTable stencil_table(const Refinement& refinement, size_t level) {
@@ -123,6 +141,8 @@ StencilTable stencil_table(const Refinement& refinement, size_t level) {
     const uint32_t o = table.offsets[V + F + e];
     writer.edge_row(e, table.sources.data() + o, table.weights.data() + o);
   }
+  if (level + 2 == refinement.levels.size() && !refinement.last_from_osd.empty())
+    return renumber_rows(table, refinement.last_from_osd);
   return table;
 }
 

@@ -15,7 +15,9 @@
 //
 // Child components follow OpenSubdiv's uniform ordering (Vtr::Refinement with
 // orderVerticesFromFacesFirst = false), so level l of a Refinement has the same vertex, edge and
-// face numbering as level l of a Far::TopologyRefiner built from the same faces:
+// face numbering as level l of a Far::TopologyRefiner built from the same faces, except for the last
+// level's vertices where the refinement has regular patches (RegularPatches below; the faces and edges
+// keep their numbers, and Refinement::last_from_osd maps the vertices):
 //   child vertices: parent vertex v -> v, parent face f -> V + f, parent edge e -> V + F + e;
 //   child faces:    face f gets one quad per corner; the quad of corner c (global corner index) is c;
 //   child edges:    corner c of face f gives the interior edge c (face point to edge point of the edge
@@ -101,10 +103,50 @@ struct RefinementOptions {
 };
 inline constexpr int kMaxLevels = 10;
 
+// Regular patches, for 3 to 6 levels. A base quad whose corners are smooth, of valence 4 and surrounded
+// by quads stays a regular grid at every level (a uniform bicubic B-spline patch): each of its
+// last-level points is a fixed tensor product of 1D weights over the 4x4 base points around it, so
+// evaluate() computes it straight from them, with no intermediate levels and no index arrays. The other
+// faces, with every face that shares a vertex with them (the base points their last-level points depend
+// on), form a mesh of their own (`rest`) that the level-by-level path refines.
+//
+// Where a refinement has regular patches, its last level is numbered in the order evaluate() writes
+// it, so that every write is sequential (with OpenSubdiv's numbering the points of one patch are spread
+// over the whole level, and those scattered writes cost more than the arithmetic; perf/RESULTS.md):
+// patch after patch, each patch's grid points row by row, leaving out the points on its sides and
+// corners that an earlier patch has; then the points only the rest mesh has, in rest_sources order.
+inline constexpr uint32_t kMaxPatchSide = 65;  // 2^6 + 1
+struct RegularPatches {
+  uint32_t side = 0;                    // last-level points per patch side: 2^levels + 1
+  std::vector<double> weights;          // 4 x side: the 1D weights of the points along a side over
+                                        // 4 base points, base point by base point
+  std::vector<uint32_t> controls;       // 16 base vertices per patch, 4 rows of 4; patch p's grid
+                                        // point (u, v) (u along its first edge) lies in the square of
+                                        // controls (u, v) .. (u+1, v+1) scaled by side - 1
+  std::vector<uint8_t> owned;           // per patch: bit k set if it writes the points on its side k
+                                        // (0: v = 0, 1: u = side-1, 2: v = side-1, 3: u = 0), bit 4+k
+                                        // if it writes corner k ((0,0), (side-1,0), (side-1,side-1), (0,side-1))
+  std::vector<Level> rest;              // the mesh of the other faces, refined (empty if there are none)
+  std::vector<uint32_t> rest_controls;  // base vertex of each base vertex of `rest`
+  std::vector<uint32_t> rest_sources;   // the last-level vertex of `rest` of each last-level vertex
+                                        // after the patches' points, in order
+  uint32_t patch_count() const { return static_cast<uint32_t>(controls.size() / 16); }
+};
+
 struct Refinement {
   std::vector<Level> levels;  // levels[0] is the base mesh
+  RegularPatches patches;     // empty where evaluate() goes level by level
+  // The last-level vertex of each vertex of OpenSubdiv's last level; empty where the two numberings are
+  // the same (no regular patches).
+  std::vector<uint32_t> last_from_osd;
   const Level& last() const { return levels.back(); }
 };
+
+// The last-level vertex that vertex v of an earlier level becomes (in OpenSubdiv's numbering a vertex
+// keeps its index at every later level).
+inline uint32_t last_level_vertex(const Refinement& refinement, uint32_t v) {
+  return refinement.last_from_osd.empty() ? v : refinement.last_from_osd[v];
+}
 
 // Builds the levels. Errors name the offending face, edge or vertex: a face with fewer
 // than 3 vertices or a repeated vertex, an index out of range, an edge shared by more than 2 faces or
@@ -112,17 +154,19 @@ struct Refinement {
 // a sharp edge that is not an edge, a refinement too large for 32-bit indices.
 Result<Refinement> build_refinement(const BaseTopology& base, const RefinementOptions& options);
 
-// Points of the last level from base points (one per base vertex), level by level; scratch holds the
-// intermediate levels (pass the same vectors again to avoid allocations; base_points must not alias
-// either).
+// Points of the last level from base points (one per base vertex): by regular patches where the
+// refinement has them, else level by level. scratch holds intermediate points (pass the same vectors
+// again to avoid allocations; base_points must not alias either).
 void evaluate(const Refinement& refinement, std::span<const Vec3> base_points, std::vector<Vec3>& last_level_points,
               std::vector<Vec3>& scratch);
 
-// Points of every level: level_points[0] is a copy of base_points.
+// Points of every level, level by level (the last level in its own numbering; from regular patches,
+// evaluate() can differ from it in the last bits): level_points[0] is a copy of base_points.
 void evaluate_all_levels(const Refinement& refinement, std::span<const Vec3> base_points,
                          std::vector<std::vector<Vec3>>& level_points);
 
-// Level `level`'s points -> level `level + 1`'s points as explicit rows (level < levels.size() - 1).
+// Level `level`'s points -> level `level + 1`'s points as explicit rows (level < levels.size() - 1), in
+// level `level + 1`'s numbering.
 StencilTable stencil_table(const Refinement& refinement, size_t level);
 
 // dst[r] = row r of table applied to src (dst.size() == table.row_count()).

@@ -557,6 +557,7 @@ Result<LimitCurves> LimitCurves::build(const PolygonMeshView& control, uint32_t 
 
   const subdivide::Level& L0 = refinement->levels[0];
   curves.base_edge_vertices_ = L0.edge_vertices;
+  for (uint32_t v = 0; v < L0.vertex_count; ++v) curves.last_of_base_.push_back(subdivide::last_level_vertex(*refinement, v));
   curves.along_.resize(L0.edge_count());
   for (uint32_t e = 0; e < L0.edge_count(); ++e) {
     const uint32_t a = L0.edge_vertices[2 * e], b = L0.edge_vertices[2 * e + 1];
@@ -578,11 +579,11 @@ bool LimitCurves::sample_chain(std::span<const uint32_t> chain, std::vector<Vec3
       for (uint32_t id : ids) out.push_back(limit_[id]);
     else {
       // Walked from b: the reverse of [b .. a) is (a .. b], so start at a and drop b.
-      out.push_back(limit_[a]);
+      out.push_back(vertex(a));
       for (size_t k = ids.size(); k-- > 1;) out.push_back(limit_[ids[k]]);
     }
   }
-  out.push_back(limit_[chain.back()]);
+  out.push_back(vertex(chain.back()));
   return true;
 }
 

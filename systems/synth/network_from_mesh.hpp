@@ -55,7 +55,7 @@ class LimitCurves {
   // samples_per_edge is rounded up to a power of two 2^L; the control mesh is refined L levels.
   static Result<LimitCurves> build(const PolygonMeshView& control, uint32_t samples_per_edge);
   // Limit position of control vertex v.
-  const Vec3& vertex(uint32_t v) const { return limit_[v]; }
+  const Vec3& vertex(uint32_t v) const { return limit_[last_of_base_[v]]; }
   // Like sample_chain_linear, on the limit surface: 2^L points per control edge, then the last vertex.
   // Returns false if two consecutive chain vertices are not joined by a control edge.
   bool sample_chain(std::span<const uint32_t> chain, std::vector<Vec3>& out) const;
@@ -65,6 +65,7 @@ class LimitCurves {
   std::vector<std::vector<uint32_t>> along_;    // per base edge: last-level vertices from its first to second vertex (exclusive)
   std::vector<std::pair<uint64_t, uint32_t>> edge_by_ends_;  // sorted (min << 32 | max) -> base edge
   std::vector<uint32_t> base_edge_vertices_;
+  std::vector<uint32_t> last_of_base_;  // per control vertex: its last-level vertex
 };
 
 }  // namespace fire

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "engine/common.hpp"
+#include "systems/subdivide/subdivide.hpp"
 
 namespace fire::osd_reference {
 
@@ -102,6 +103,42 @@ inline Limit limit(const Far::TopologyRefiner& refiner, const std::vector<Point>
   Point* tangent2 = result.tangent2.data();
   Far::PrimvarRefinerReal<double>(refiner).Limit(src, positions, tangent1, tangent2);
   return result;
+}
+
+// Per-vertex values of our last level (points, limit positions, normals) in OpenSubdiv's numbering.
+inline std::vector<Vec3> in_osd_numbering(const subdivide::Refinement& refinement, const std::vector<Vec3>& values) {
+  if (refinement.last_from_osd.empty()) return values;
+  std::vector<Vec3> out(values.size());
+  for (size_t v = 0; v < values.size(); ++v) out[v] = values[refinement.last_from_osd[v]];
+  return out;
+}
+
+// Our last level with OpenSubdiv's vertex numbering (faces and edges keep theirs).
+inline subdivide::Level last_level_in_osd_numbering(const subdivide::Refinement& refinement) {
+  subdivide::Level level = refinement.last();
+  const std::vector<uint32_t>& ours = refinement.last_from_osd;
+  if (ours.empty()) return level;
+  std::vector<uint32_t> theirs(ours.size());
+  for (uint32_t v = 0; v < ours.size(); ++v) theirs[ours[v]] = v;
+  for (uint32_t& v : level.face_vertices) v = theirs[v];
+  for (uint32_t& v : level.edge_vertices) v = theirs[v];
+  if (!level.has_adjacency()) return level;
+  const subdivide::Level& last = refinement.last();
+  level.ring_offsets.assign(1, 0);
+  level.ring_edges.clear();
+  level.ring_neighbors.clear();
+  level.ring_corners.clear();
+  for (uint32_t v = 0; v < ours.size(); ++v) {
+    const uint32_t w = ours[v];
+    for (uint32_t r = last.ring_offsets[w]; r < last.ring_offsets[w + 1]; ++r) {
+      level.ring_edges.push_back(last.ring_edges[r]);
+      level.ring_neighbors.push_back(theirs[last.ring_neighbors[r]]);
+      level.ring_corners.push_back(last.ring_corners[r]);
+    }
+    level.ring_offsets.push_back(static_cast<uint32_t>(level.ring_edges.size()));
+    level.vertex_rules[v] = last.vertex_rules[w];
+  }
+  return level;
 }
 
 }  // namespace fire::osd_reference

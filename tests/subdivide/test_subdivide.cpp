@@ -140,10 +140,14 @@ TEST_CASE("explicit and factorized stencil tables equal level-by-level evaluatio
   std::vector<Vec3> direct(table.row_count()), by_level, scratch;
   sd::apply(table, mesh->positions, direct);
   sd::evaluate(*refinement, mesh->positions, by_level, scratch);
-  CHECK(by_level == levels.back());
-  double worst = 0;
-  for (size_t i = 0; i < direct.size(); ++i) worst = std::max(worst, (direct[i] - by_level[i]).norm());
+  CHECK_FALSE(refinement->patches.rest.empty());  // both of evaluate's paths
+  double worst = 0, worst_levels = 0;
+  for (size_t i = 0; i < direct.size(); ++i) {
+    worst = std::max(worst, (direct[i] - by_level[i]).norm());
+    worst_levels = std::max(worst_levels, (levels.back()[i] - by_level[i]).norm());
+  }
   CHECK(worst < 1e-12);
+  CHECK(worst_levels < 1e-12);
   // Each row is an affine combination.
   for (uint32_t r = 0; r < table.row_count(); r += 97) {
     double sum = 0;
@@ -198,7 +202,10 @@ TEST_CASE("evaluate equals the explicit stencil rows on every shared mesh, level
         sd::evaluate_all_levels(*refinement, moved, level_points);
         std::vector<Vec3> last, scratch;
         sd::evaluate(*refinement, moved, last, scratch);
-        CHECK(last == level_points.back());
+        double worst_evaluate = 0;
+        for (size_t i = 0; i < last.size(); ++i)
+          worst_evaluate = std::max(worst_evaluate, (last[i] - level_points.back()[i]).norm());
+        CHECK(worst_evaluate <= tolerance);
         for (int l = 0; l < levels; ++l) {
           const sd::StencilTable table = sd::stencil_table(*refinement, size_t(l));
           std::vector<Vec3> rows(table.row_count());

@@ -401,7 +401,7 @@ TEST_CASE("limit sampling: every polyline point lies on the control mesh's Catmu
         found += std::binary_search(on_surface.begin(), on_surface.end(), std::array<double, 3>{p.x(), p.y(), p.z()});
       }
     CHECK(found == total);
-    // Network vertices are the control vertices' limit positions (a base vertex keeps its index).
+    // Network vertices are the control vertices' limit positions.
     for (uint32_t v = 0; v < net->vertex_slots(); ++v) {
       const Vec3& p = net->vertices.position[v];
       CHECK(std::binary_search(on_surface.begin(), on_surface.end(), std::array<double, 3>{p.x(), p.y(), p.z()}));
