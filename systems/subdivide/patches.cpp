@@ -228,7 +228,6 @@ void plan_regular_patches(const BaseTopology& topology, Refinement& refinement) 
       else if (v == s) bit = u == 0 ? 7 : u == s ? 6 : 2;
       else bit = u == 0 ? 3 : u == s ? 1 : -1;
     }
-  auto border_bit = [&border_bits](uint32_t cell) -> int { return border_bits[cell]; };
 
   std::vector<uint8_t> regular(base.vertex_count);
   for (uint32_t v = 0; v < base.vertex_count; ++v) regular[v] = regular_vertex(base, v);
@@ -257,7 +256,7 @@ void plan_regular_patches(const BaseTopology& topology, Refinement& refinement) 
     if (ok && run_lengths.empty()) {
       std::vector<std::pair<uint32_t, uint32_t>> inside;  // (old number, cell)
       for (uint32_t cell = 0; cell < cells; ++cell)
-        if (border_bit(cell) < 0) inside.emplace_back(grid.vertex(b, cell), cell);
+        if (border_bits[cell] < 0) inside.emplace_back(grid.vertex(b, cell), cell);
       std::sort(inside.begin(), inside.end());
       for (size_t i = 0; i < inside.size(); ++i) {
         if (i == 0 || inside[i].first != inside[i - 1].first + 1) {
@@ -281,7 +280,7 @@ void plan_regular_patches(const BaseTopology& topology, Refinement& refinement) 
     }
     uint32_t seen[8] = {}, fresh[8] = {};
     for (uint32_t cell = 0; cell < cells; ++cell) {
-      if (const int bit = border_bit(cell); bit >= 0) {
+      if (const int bit = border_bits[cell]; bit >= 0) {
         ids[cell] = grid.vertex(b, cell);
         ++seen[bit];
         fresh[bit] += !written[ids[cell]];
@@ -295,7 +294,7 @@ void plan_regular_patches(const BaseTopology& topology, Refinement& refinement) 
       if (fresh[bit] != 0) owned |= uint8_t(1u << bit);
     }
     for (uint32_t cell = 0; cell < cells; ++cell) {
-      const int bit = border_bit(cell);
+      const int bit = border_bits[cell];
       if (bit >= 0) {
         if (!(owned >> bit & 1)) continue;
         written[ids[cell]] = 1;
