@@ -165,10 +165,6 @@ std::vector<uint8_t> rest_faces(const Level& base, std::span<const uint32_t> irr
   return in;
 }
 
-}  // namespace
-
-namespace {
-
 // Renumbers the last level's vertices: order[i] is the old number of new vertex i, rank the inverse.
 // The rings are gathered in the new order, each fetched a few vertices ahead: its offsets then its
 // entries lie anywhere in arrays of several MB, and without the prefetches each vertex waits for them.

@@ -7,9 +7,9 @@ namespace fire::subdivide::detail {
 // The levels alone (Refinement::patches left empty).
 Result<Refinement> build_levels(const BaseTopology& base, const RefinementOptions& options);
 
-// Gives a refinement of 3 to 6 levels its regular patches and renumbers its last level (see
-// RegularPatches); leaves it as it is where that path does not apply (no regular base quad, or a
-// vertex in no face).
+// Gives a refinement of kMinPatchLevels to kMaxPatchLevels levels its regular patches and renumbers
+// its last level (see RegularPatches); leaves it as it is where that path does not apply (no regular
+// base quad, or a vertex in no face).
 void plan_regular_patches(const BaseTopology& base, Refinement& refinement);
 
 }  // namespace fire::subdivide::detail

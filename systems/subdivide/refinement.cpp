@@ -434,7 +434,8 @@ Result<Refinement> build_levels(const BaseTopology& base, const RefinementOption
 
 Result<Refinement> build_refinement(const BaseTopology& base, const RefinementOptions& options) {
   Result<Refinement> refinement = detail::build_levels(base, options);
-  if (refinement && options.levels >= 3 && options.levels <= 6) detail::plan_regular_patches(base, *refinement);
+  if (refinement && options.levels >= kMinPatchLevels && options.levels <= kMaxPatchLevels)
+    detail::plan_regular_patches(base, *refinement);
   return refinement;
 }
 

@@ -96,53 +96,38 @@ class RowWriter {
   const Level& p_;
 };
 
-// The rows of `table` (in OpenSubdiv's numbering of the last level) in the last level's numbering.
-StencilTable renumber_rows(const StencilTable& table, const std::vector<uint32_t>& last_from_osd) {
-  const uint32_t rows = table.row_count();
-  std::vector<uint32_t> order(rows);
-  for (uint32_t r = 0; r < rows; ++r) order[last_from_osd[r]] = r;
-  StencilTable result;
-  result.offsets.resize(size_t{rows} + 1);
-  result.sources.reserve(table.sources.size());
-  result.weights.reserve(table.weights.size());
-  for (uint32_t r = 0; r < rows; ++r) {
-    const uint32_t b = table.offsets[order[r]], e = table.offsets[order[r] + 1];
-    result.sources.insert(result.sources.end(), table.sources.begin() + b, table.sources.begin() + e);
-    result.weights.insert(result.weights.end(), table.weights.begin() + b, table.weights.begin() + e);
-    result.offsets[r + 1] = static_cast<uint32_t>(result.sources.size());
-  }
-  return result;
-}
-
 }  // namespace
 
 StencilTable stencil_table(const Refinement& refinement, size_t level) {
   const Level& p = refinement.levels.at(level);
   const uint32_t V = p.vertex_count, F = p.face_count(), E = p.edge_count();
   const RowWriter writer(p);
+  // Child r in OpenSubdiv's numbering is row row_of(r): the same, except in a renumbered last level.
+  const bool renumbered = level + 2 == refinement.levels.size() && !refinement.last_from_osd.empty();
+  const auto row_of = [&](uint32_t r) { return renumbered ? refinement.last_from_osd[r] : r; };
   StencilTable table;
-  table.offsets.resize(size_t{V} + F + E + 1);
-  uint32_t total = 0;
-  for (uint32_t v = 0; v < V; ++v) table.offsets[v + 1] = total += writer.vertex_row_size(v);
-  for (uint32_t f = 0; f < F; ++f) table.offsets[V + f + 1] = total += writer.face_size(f);
-  for (uint32_t e = 0; e < E; ++e) table.offsets[V + F + e + 1] = total += writer.edge_row_size(e);
-  table.sources.resize(total);
-  table.weights.resize(total);
-  for (uint32_t v = 0; v < V; ++v)
-    writer.vertex_row(v, table.sources.data() + table.offsets[v], table.weights.data() + table.offsets[v]);
+  table.offsets.assign(size_t{V} + F + E + 1, 0);
+  for (uint32_t v = 0; v < V; ++v) table.offsets[row_of(v) + 1] = writer.vertex_row_size(v);
+  for (uint32_t f = 0; f < F; ++f) table.offsets[row_of(V + f) + 1] = writer.face_size(f);
+  for (uint32_t e = 0; e < E; ++e) table.offsets[row_of(V + F + e) + 1] = writer.edge_row_size(e);
+  for (size_t r = 1; r < table.offsets.size(); ++r) table.offsets[r] += table.offsets[r - 1];
+  table.sources.resize(table.offsets.back());
+  table.weights.resize(table.offsets.back());
+  for (uint32_t v = 0; v < V; ++v) {
+    const uint32_t o = table.offsets[row_of(v)];
+    writer.vertex_row(v, table.sources.data() + o, table.weights.data() + o);
+  }
   for (uint32_t f = 0; f < F; ++f) {
-    const uint32_t b = p.face_offsets[f], n = writer.face_size(f), o = table.offsets[V + f];
+    const uint32_t b = p.face_offsets[f], n = writer.face_size(f), o = table.offsets[row_of(V + f)];
     for (uint32_t j = 0; j < n; ++j) {
       table.sources[o + j] = p.face_vertices[b + j];
       table.weights[o + j] = 1.0 / n;
     }
   }
   for (uint32_t e = 0; e < E; ++e) {
-    const uint32_t o = table.offsets[V + F + e];
+    const uint32_t o = table.offsets[row_of(V + F + e)];
     writer.edge_row(e, table.sources.data() + o, table.weights.data() + o);
   }
-  if (level + 2 == refinement.levels.size() && !refinement.last_from_osd.empty())
-    return renumber_rows(table, refinement.last_from_osd);
   return table;
 }
 

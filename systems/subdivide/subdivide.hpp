@@ -103,19 +103,21 @@ struct RefinementOptions {
 };
 inline constexpr int kMaxLevels = 10;
 
-// Regular patches, for 3 to 6 levels. A base quad whose corners are smooth, of valence 4 and surrounded
-// by quads stays a regular grid at every level (a uniform bicubic B-spline patch): each of its
-// last-level points is a fixed tensor product of 1D weights over the 4x4 base points around it, so
-// evaluate() computes it straight from them, with no intermediate levels and no index arrays. The other
-// faces, with every face that shares a vertex with them (the base points their last-level points depend
-// on), form a mesh of their own (`rest`) that the level-by-level path refines.
+// Regular patches, for kMinPatchLevels to kMaxPatchLevels levels. A base quad whose corners are
+// smooth, of valence 4 and surrounded by quads stays a regular grid at every level (a uniform bicubic
+// B-spline patch): each of its last-level points is a fixed tensor product of 1D weights over the 4x4
+// base points around it, so evaluate() computes it straight from them, with no intermediate levels and
+// no index arrays. The other faces, with every face that shares a vertex with them (the base points
+// their last-level points depend on), form a mesh of their own (`rest`) that the level-by-level path
+// refines.
 //
 // Where a refinement has regular patches, its last level is numbered in the order evaluate() writes
 // it, so that every write is sequential (with OpenSubdiv's numbering the points of one patch are spread
 // over the whole level, and those scattered writes cost more than the arithmetic; perf/RESULTS.md):
 // patch after patch, each patch's grid points row by row, leaving out the points on its sides and
 // corners that an earlier patch has; then the points only the rest mesh has, in rest_sources order.
-inline constexpr uint32_t kMaxPatchSide = 65;  // 2^6 + 1
+inline constexpr int kMinPatchLevels = 3, kMaxPatchLevels = 6;
+inline constexpr uint32_t kMaxPatchSide = (1u << kMaxPatchLevels) + 1;
 struct RegularPatches {
   uint32_t side = 0;                    // last-level points per patch side: 2^levels + 1
   std::vector<double> weights;          // 4 x side: the 1D weights of the points along a side over
