@@ -1,8 +1,14 @@
 #pragma once
-// A polygon surface: what reconstruction produces and export writes. Faces as flat offsets + indices.
+// Surfaces as engine data.
+//
+// SurfaceMesh: a polygon surface, what export writes and the file readers return.
+// SurfaceLevels: the live surface that refine and subdivide write and the renderer, the exporters and
+// `fire eval` read: the last subdivision level's limit positions and normals, its quads as one flat
+// index array, a topology version, the range changed in the last write, and whether it has settled.
 #include <cstdint>
 #include <vector>
 
+#include "engine/change.hpp"
 #include "engine/common.hpp"
 
 namespace fire {
@@ -15,5 +21,53 @@ struct SurfaceMesh {
   size_t face_count() const { return face_offsets.size() - 1; }
   uint32_t face_size(size_t f) const { return face_offsets[f + 1] - face_offsets[f]; }
 };
+
+struct SurfaceLevels {
+  uint32_t level = 0;           // subdivision level the quads belong to (0: no surface yet)
+  std::vector<Vec3> positions;  // limit position per vertex of that level
+  std::vector<Vec3> normals;    // unit limit normal per vertex
+  std::vector<uint32_t> quads;  // 4 vertex indices per quad, counter-clockwise seen from the front
+  // Bumped whenever `quads` or the vertex count change; a reader holding index buffers re-uploads them.
+  uint64_t topology_version = 0;
+  Frame frame = 0;              // frame of the last write
+  ChangedRange changed;         // vertices whose position or normal was written in `frame`
+  // False while the surface is provisional: new faces shown from their transfinite patches, the fit
+  // that passes through the curves still converging over the next frames.
+  bool settled = true;
+
+  uint32_t vertex_count() const { return static_cast<uint32_t>(positions.size()); }
+  uint32_t quad_count() const { return static_cast<uint32_t>(quads.size() / 4); }
+  bool empty() const { return quads.empty(); }
+};
+
+// The same surface as a polygon mesh, for export.
+inline SurfaceMesh to_surface_mesh(const SurfaceLevels& s) {
+  SurfaceMesh m;
+  m.positions = s.positions;
+  m.normals = s.normals;
+  m.face_vertices = s.quads;
+  m.face_offsets.resize(s.quad_count() + 1);
+  for (uint32_t q = 0; q <= s.quad_count(); ++q) m.face_offsets[q] = 4 * q;
+  return m;
+}
+
+// Replaces `out` with a quad mesh (every face must have 4 vertices, normals present) written at `now`:
+// positions always count as changed; the topology version moves only when the quads or the vertex
+// count differ from what `out` held. Returns false, leaving `out` alone, when a face is not a quad.
+inline bool assign_quads(const SurfaceMesh& mesh, Frame now, SurfaceLevels& out) {
+  for (size_t f = 0; f < mesh.face_count(); ++f)
+    if (mesh.face_size(f) != 4) return false;
+  if (mesh.normals.size() != mesh.positions.size()) return false;
+  bool same_topology = out.quads == mesh.face_vertices && out.positions.size() == mesh.positions.size();
+  if (!same_topology) {
+    out.quads = mesh.face_vertices;
+    ++out.topology_version;
+  }
+  out.positions = mesh.positions;
+  out.normals = mesh.normals;
+  out.frame = now;
+  out.changed = {0, static_cast<uint32_t>(mesh.positions.size())};
+  return true;
+}
 
 }  // namespace fire
