@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include "engine/assert.hpp"
+
 namespace fire {
 
 struct ColumnMark {
@@ -35,8 +37,10 @@ class Column {
     if (recording_ && data_.size() - 1 < base_size_) journal_.emplace_back(static_cast<uint32_t>(data_.size() - 1), data_.back());
     data_.pop_back();
   }
-  // Outside transactions only (loading, compaction).
-  void assign(std::vector<T> v) { data_ = std::move(v); }
+  void assign(std::vector<T> v) {
+    FIRE_ASSERT(!recording_, "assign replaces the whole column, which a transaction cannot undo");
+    data_ = std::move(v);
+  }
   void reserve(size_t n) { data_.reserve(n); }
   void clear() { data_.clear(); journal_.clear(); }
 
@@ -46,12 +50,19 @@ class Column {
     return {base_size_, static_cast<uint32_t>(journal_.size())};
   }
   void end() { recording_ = false; }
-  // Restores the state at `mark`, which must be the most recent mark not yet rolled back.
-  void rollback(const ColumnMark& mark) {
+  // Restores the state at `mark`, which must be the most recent mark not yet rolled back, and tells
+  // `restored(begin, end)` every slot range it rewrote or removed, so change stamps mark exactly those.
+  template <class OnRestore>
+  void rollback(const ColumnMark& mark, OnRestore&& restored) {
+    FIRE_ASSERT(mark.journal <= journal_.size(), "rollback to a mark that was already rolled back");
+    if (data_.size() > mark.size) restored(mark.size, static_cast<uint32_t>(data_.size()));
     data_.resize(mark.size);
     while (journal_.size() > mark.journal) {
       auto& [i, old] = journal_.back();
-      if (i < data_.size()) data_[i] = old;
+      if (i < data_.size()) {
+        data_[i] = old;
+        restored(i, i + 1);
+      }
       journal_.pop_back();
     }
   }

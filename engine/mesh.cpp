@@ -1,5 +1,7 @@
 #include "engine/mesh.hpp"
 
+#include "engine/hash.hpp"
+
 #include <algorithm>
 #include <cstring>
 
@@ -9,36 +11,37 @@ namespace {
 
 constexpr std::array<uint32_t, 2> kNoPair{kNone, kNone};
 
-void mark(std::vector<uint8_t>& dirty, uint32_t i) {
-  if (dirty.size() <= i) dirty.resize(i + 1, 1);
-  dirty[i] = 1;
-}
-
 }  // namespace
 
-// Visits every journaled column.
+// Visits every journaled column with the stamps its writes go to: per slot for the pools' columns, as a
+// range for the point and loop columns, none for the free lists (a slot's life shows in its flags).
+template <class F>
+void Mesh::for_each_stamped_column(F&& f) {
+  f(vertices.position, &vertices.changes, true);
+  f(vertices.first_edge, &vertices.changes, true);
+  f(vertices.generation, &vertices.changes, true);
+  f(vertices.flags, &vertices.changes, true);
+  f(vertices.free_list, nullptr, false);
+  f(edges.vertex, &edges.changes, true);
+  f(edges.face, &edges.changes, true);
+  f(edges.next, &edges.changes, true);
+  f(edges.point_offset, &edges.changes, true);
+  f(edges.point_count, &edges.changes, true);
+  f(edges.generation, &edges.changes, true);
+  f(edges.flags, &edges.changes, true);
+  f(edges.free_list, nullptr, false);
+  f(faces.edge_offset, &faces.changes, true);
+  f(faces.edge_count, &faces.changes, true);
+  f(faces.generation, &faces.changes, true);
+  f(faces.flags, &faces.changes, true);
+  f(faces.free_list, nullptr, false);
+  f(points, &point_changes, false);
+  f(face_edges, &face_edge_changes, false);
+}
+
 template <class F>
 void Mesh::for_each_column(F&& f) {
-  f(vertices.position);
-  f(vertices.first_edge);
-  f(vertices.generation);
-  f(vertices.flags);
-  f(vertices.free_list);
-  f(edges.vertex);
-  f(edges.face);
-  f(edges.next);
-  f(edges.point_offset);
-  f(edges.point_count);
-  f(edges.generation);
-  f(edges.flags);
-  f(edges.free_list);
-  f(faces.edge_offset);
-  f(faces.edge_count);
-  f(faces.generation);
-  f(faces.flags);
-  f(faces.free_list);
-  f(points);
-  f(face_edges);
+  for_each_stamped_column([&](auto& column, ChangeStamps*, bool) { f(column); });
 }
 
 template <class F>
@@ -86,7 +89,7 @@ uint32_t Mesh::loop_position(uint32_t f, uint32_t e) const {
 }
 
 uint32_t Mesh::allocate(Column<uint32_t>& free_list, Column<uint32_t>& generation, Column<uint8_t>& flags,
-                        std::vector<uint8_t>& dirty) {
+                        ChangeStamps& changes) {
   uint32_t slot;
   if (!free_list.empty()) {
     slot = free_list[free_list.size() - 1];
@@ -97,21 +100,21 @@ uint32_t Mesh::allocate(Column<uint32_t>& free_list, Column<uint32_t>& generatio
     generation.push_back(0);
     flags.push_back(kAlive);
   }
-  mark(dirty, slot);
+  changes.touch(slot, frame_);
   return slot;
 }
 
 void Mesh::release(uint32_t slot, Column<uint32_t>& free_list, Column<uint32_t>& generation, Column<uint8_t>& flags,
-                   std::vector<uint8_t>& dirty) {
+                   ChangeStamps& changes) {
   flags.set(slot, 0);
   generation.set(slot, generation[slot] + 1);
   free_list.push_back(slot);
-  mark(dirty, slot);
+  changes.touch(slot, frame_);
 }
 
 uint32_t Mesh::add_vertex(const Vec3& p, uint8_t extra_flags) {
   bool fresh = vertices.free_list.empty();
-  uint32_t v = allocate(vertices.free_list, vertices.generation, vertices.flags, vertices.dirty);
+  uint32_t v = allocate(vertices.free_list, vertices.generation, vertices.flags, vertices.changes);
   if (fresh) {
     vertices.position.push_back(p);
     vertices.first_edge.push_back(kNone);
@@ -129,7 +132,7 @@ void Mesh::link_edge(uint32_t e) {
     uint32_t v = edges.vertex[e][s];
     next[s] = vertices.first_edge[v];
     vertices.first_edge.set(v, e);
-    mark(vertices.dirty, v);
+    vertices.changes.touch(v, frame_);
   }
   edges.next.set(e, next);
 }
@@ -137,7 +140,7 @@ void Mesh::link_edge(uint32_t e) {
 void Mesh::unlink_edge(uint32_t e) {
   for (int s = 0; s < 2; ++s) {
     uint32_t v = edges.vertex[e][s];
-    mark(vertices.dirty, v);
+    vertices.changes.touch(v, frame_);
     uint32_t after = edges.next[e][s];
     if (vertices.first_edge[v] == e) {
       vertices.first_edge.set(v, after);
@@ -158,7 +161,7 @@ void Mesh::unlink_edge(uint32_t e) {
 
 uint32_t Mesh::add_edge(uint32_t v0, uint32_t v1, std::span<const Vec3> polyline) {
   bool fresh = edges.free_list.empty();
-  uint32_t e = allocate(edges.free_list, edges.generation, edges.flags, edges.dirty);
+  uint32_t e = allocate(edges.free_list, edges.generation, edges.flags, edges.changes);
   uint32_t offset = static_cast<uint32_t>(points.size());
   for (size_t i = 0; i < polyline.size(); ++i) {
     if (i == 0) points.push_back(vertices.position[v0]);
@@ -166,6 +169,7 @@ uint32_t Mesh::add_edge(uint32_t v0, uint32_t v1, std::span<const Vec3> polyline
     else points.push_back(polyline[i]);
   }
   uint32_t count = static_cast<uint32_t>(polyline.size());
+  point_changes.note(offset, offset + count, frame_);
   if (fresh) {
     edges.vertex.push_back({v0, v1});
     edges.face.push_back(kNoPair);
@@ -193,15 +197,16 @@ uint32_t Mesh::add_face(std::span<const uint32_t> loop) {
       if (edge_of(loop[q]) == edge_of(oe)) return kNone;
   }
   bool fresh = faces.free_list.empty();
-  uint32_t f = allocate(faces.free_list, faces.generation, faces.flags, faces.dirty);
+  uint32_t f = allocate(faces.free_list, faces.generation, faces.flags, faces.changes);
   uint32_t offset = static_cast<uint32_t>(face_edges.size());
   for (uint32_t oe : loop) {
     face_edges.push_back(oe);
     auto fs = edges.face[edge_of(oe)];
     fs[is_reversed(oe)] = f;
     edges.face.set(edge_of(oe), fs);
-    mark(edges.dirty, edge_of(oe));
+    edges.changes.touch(edge_of(oe), frame_);
   }
+  face_edge_changes.note(offset, static_cast<uint32_t>(face_edges.size()), frame_);
   if (fresh) {
     faces.edge_offset.push_back(offset);
     faces.edge_count.push_back(static_cast<uint32_t>(loop.size()));
@@ -226,8 +231,10 @@ bool Mesh::set_face_loop(uint32_t f, std::span<const uint32_t> loop) {
     auto fs = edges.face[edge_of(oe)];
     fs[is_reversed(oe)] = kNone;
     edges.face.set(edge_of(oe), fs);
-    mark(edges.dirty, edge_of(oe));
+    edges.changes.touch(edge_of(oe), frame_);
   }
+  face_edge_changes.note(static_cast<uint32_t>(face_edges.size()), static_cast<uint32_t>(face_edges.size() + loop.size()),
+                        frame_);
   faces.edge_offset.set(f, static_cast<uint32_t>(face_edges.size()));
   faces.edge_count.set(f, static_cast<uint32_t>(loop.size()));
   for (uint32_t oe : loop) {
@@ -235,9 +242,9 @@ bool Mesh::set_face_loop(uint32_t f, std::span<const uint32_t> loop) {
     auto fs = edges.face[edge_of(oe)];
     fs[is_reversed(oe)] = f;
     edges.face.set(edge_of(oe), fs);
-    mark(edges.dirty, edge_of(oe));
+    edges.changes.touch(edge_of(oe), frame_);
   }
-  mark(faces.dirty, f);
+  faces.changes.touch(f, frame_);
   return true;
 }
 
@@ -246,33 +253,34 @@ void Mesh::remove_face(uint32_t f) {
     auto fs = edges.face[edge_of(oe)];
     fs[is_reversed(oe)] = kNone;
     edges.face.set(edge_of(oe), fs);
-    mark(edges.dirty, edge_of(oe));
+    edges.changes.touch(edge_of(oe), frame_);
   }
-  release(f, faces.free_list, faces.generation, faces.flags, faces.dirty);
+  release(f, faces.free_list, faces.generation, faces.flags, faces.changes);
 }
 
 void Mesh::remove_edge(uint32_t e) {
   unlink_edge(e);
-  release(e, edges.free_list, edges.generation, edges.flags, edges.dirty);
+  release(e, edges.free_list, edges.generation, edges.flags, edges.changes);
 }
 
 void Mesh::remove_vertex(uint32_t v) {
-  release(v, vertices.free_list, vertices.generation, vertices.flags, vertices.dirty);
+  release(v, vertices.free_list, vertices.generation, vertices.flags, vertices.changes);
 }
 
 void Mesh::set_edge_flag(uint32_t e, uint8_t flag, bool on) {
   uint8_t f = edges.flags[e];
   edges.flags.set(e, static_cast<uint8_t>(on ? (f | flag) : (f & ~flag)));
-  mark(edges.dirty, e);
+  edges.changes.touch(e, frame_);
 }
 
 void Mesh::move_vertex(uint32_t v, const Vec3& p) {
   vertices.position.set(v, p);
-  mark(vertices.dirty, v);
+  vertices.changes.touch(v, frame_);
   for (uint32_t e : vertex_edges(v)) {
     uint32_t at = edges.vertex[e][0] == v ? edges.point_offset[e] : edges.point_offset[e] + edges.point_count[e] - 1;
     points.set(at, p);
-    mark(edges.dirty, e);
+    point_changes.note(at, at + 1, frame_);
+    edges.changes.touch(e, frame_);
   }
 }
 
@@ -288,25 +296,26 @@ void Mesh::end_transaction() {
 
 void Mesh::rollback(const MeshMark& m) {
   size_t k = 0;
-  bool changed = false;
-  for_each_column([&](auto& column) {
+  for_each_stamped_column([&](auto& column, ChangeStamps* stamps, bool per_slot) {
     column.end();
-    changed = changed || column.changed_since(m.columns[k]);
-    column.rollback(m.columns[k++]);
+    column.rollback(m.columns[k++], [&](uint32_t begin, uint32_t end) {
+      if (!stamps) return;
+      if (!per_slot) return stamps->note(begin, end, frame_);
+      for (uint32_t i = begin; i < end; ++i) stamps->touch(i, frame_);
+    });
   });
-  // A rejected command wrote nothing: leave the tags alone, or consumers would recompute everything.
-  if (!changed) return;
-  // Everything that survived the rollback may have changed: tag it all for consumers to re-read.
-  vertices.dirty.assign(vertex_slots(), 1);
-  edges.dirty.assign(edge_slots(), 1);
-  faces.dirty.assign(face_slots(), 1);
+}
+
+void Mesh::begin_frame(Frame f) {
+  FIRE_ASSERT(f >= frame_, "frames never go back: consumers would miss the writes in between");
+  frame_ = f;
 }
 
 void Mesh::forget_history() {
   for_each_column([](auto& column) { column.forget_journal(); });
 }
 
-CompactionMap Mesh::compact() {
+const CompactionMap& Mesh::compact() {
   CompactionMap map;
   auto build = [](const Column<uint8_t>& flags, std::vector<uint32_t>& m) {
     m.assign(flags.size(), kNone);
@@ -380,28 +389,28 @@ CompactionMap Mesh::compact() {
   c.faces.edge_offset.assign(std::move(fo));
   c.faces.edge_count.assign(std::move(fc));
   c.face_edges.assign(std::move(fe));
-  c.vertices.dirty.assign(nv, 1);
-  c.edges.dirty.assign(ne, 1);
-  c.faces.dirty.assign(nf, 1);
+  // Survivors keep their stamps, so a consumer that remaps through the map recomputes only real changes.
+  auto keep_stamps = [&](const ChangeStamps& old, const std::vector<uint32_t>& m, uint32_t n, ChangeStamps& out) {
+    out.stamp.assign(n, frame_);
+    for (uint32_t i = 0; i < m.size(); ++i)
+      if (m[i] != kNone && i < old.stamp.size()) out.stamp[m[i]] = old.stamp[i];
+    out.note(0, n, frame_);
+  };
+  keep_stamps(vertices.changes, map.vertex, nv, c.vertices.changes);
+  keep_stamps(edges.changes, map.edge, ne, c.edges.changes);
+  keep_stamps(faces.changes, map.face, nf, c.faces.changes);
+  c.point_changes.note(0, static_cast<uint32_t>(c.points.size()), frame_);
+  c.face_edge_changes.note(0, static_cast<uint32_t>(c.face_edges.size()), frame_);
+  c.frame_ = frame_;
+  c.last_compaction_ = {last_compaction_.count + 1, frame_, std::move(map)};
   *this = std::move(c);
-  return map;
+  return last_compaction_.map;
 }
 
 uint64_t Mesh::hash() const {
-  uint64_t h = 0xcbf29ce484222325ull;
-  auto mix = [&](const void* data, size_t n) {
-    auto* b = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < n; ++i) {
-      h ^= b[i];
-      h *= 0x100000001b3ull;
-    }
-  };
-  for_each_column([&](const auto& column) {
-    uint64_t n = column.size();
-    mix(&n, sizeof n);
-    if (n) mix(column.values().data(), n * sizeof(column[0]));
-  });
-  return h;
+  Fnv1a h;
+  for_each_column([&](const auto& column) { h.mix_array(column.values()); });
+  return h.value;
 }
 
 bool Mesh::same_pools(const Mesh& other) const {
@@ -413,12 +422,6 @@ bool Mesh::same_pools(const Mesh& other) const {
     if (mine[k].second && std::memcmp(mine[k].first, theirs[k].first, mine[k].second) != 0) return false;
   }
   return true;
-}
-
-void Mesh::clear_dirty() {
-  std::fill(vertices.dirty.begin(), vertices.dirty.end(), 0);
-  std::fill(edges.dirty.begin(), edges.dirty.end(), 0);
-  std::fill(faces.dirty.begin(), faces.dirty.end(), 0);
 }
 
 size_t Mesh::pool_bytes() const {

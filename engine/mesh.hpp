@@ -10,12 +10,15 @@
 // - Dead elements are tombstones (flag kAlive cleared, generation bumped) on a free list; compact()
 //   squeezes them out and returns old-to-new maps.
 // Every column is journaled: mutations made inside a transaction can be rolled back bit for bit.
+// Every write stamps the element with the current frame (engine/change.hpp), rollback included, so any
+// number of consumers can ask what changed since the frame they last saw.
 #include <array>
 #include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "engine/change.hpp"
 #include "engine/column.hpp"
 #include "engine/common.hpp"
 
@@ -52,7 +55,7 @@ struct VertexPool {
   Column<uint32_t> generation;
   Column<uint8_t> flags;
   Column<uint32_t> free_list;
-  std::vector<uint8_t> dirty;  // not journaled: undo marks what it restores as dirty
+  ChangeStamps changes;  // not journaled: rollback stamps what it restores
 };
 
 struct EdgePool {
@@ -64,7 +67,7 @@ struct EdgePool {
   Column<uint32_t> generation;
   Column<uint8_t> flags;
   Column<uint32_t> free_list;
-  std::vector<uint8_t> dirty;
+  ChangeStamps changes;
 };
 
 struct FacePool {
@@ -73,7 +76,7 @@ struct FacePool {
   Column<uint32_t> generation;
   Column<uint8_t> flags;
   Column<uint32_t> free_list;
-  std::vector<uint8_t> dirty;
+  ChangeStamps changes;
 };
 
 struct MeshMark;
@@ -83,6 +86,14 @@ struct CompactionMap {
   std::vector<uint32_t> vertex, edge, face;
 };
 
+// The last compaction, kept for consumers: one that saw compaction `count - 1` remaps its caches through
+// `map`; one that is further behind starts over.
+struct CompactionRecord {
+  uint64_t count = 0;
+  Frame frame = 0;
+  CompactionMap map;
+};
+
 class Mesh {
  public:
   VertexPool vertices;
@@ -90,6 +101,8 @@ class Mesh {
   FacePool faces;
   Column<Vec3> points;
   Column<uint32_t> face_edges;
+  ChangeStamps point_changes;      // ranges only: a point's element stamp is its edge's
+  ChangeStamps face_edge_changes;  // ranges only: a loop's element stamp is its face's
 
   // ---- reading
   size_t vertex_slots() const { return vertices.flags.size(); }
@@ -131,7 +144,13 @@ class Mesh {
   // Index of edge e in f's loop, or kNone.
   uint32_t loop_position(uint32_t f, uint32_t e) const;
 
-  // ---- primitive mutations (journaled inside a transaction, dirty-tagged always)
+  // ---- frames and change stamps
+  // Every write from now on is stamped `f`; frames never go back.
+  void begin_frame(Frame f);
+  Frame frame() const { return frame_; }
+  const CompactionRecord& last_compaction() const { return last_compaction_; }
+
+  // ---- primitive mutations (journaled inside a transaction, stamped always)
   uint32_t add_vertex(const Vec3& p, uint8_t extra_flags = 0);
   // The polyline must have at least 2 points; its ends are set to the vertices' positions exactly.
   uint32_t add_edge(uint32_t v0, uint32_t v1, std::span<const Vec3> polyline);
@@ -156,13 +175,14 @@ class Mesh {
   void forget_history();
 
   // ---- sync point
-  CompactionMap compact();
+  // Squeezes out dead slots, keeping each survivor's stamp, and records the map in last_compaction().
+  // Forgets the undo history: call it only where no undo may reach back.
+  const CompactionMap& compact();
 
-  // ---- comparison, hashing, dirty tags
-  // FNV-1a 64 over every pool column (sizes and bytes); dirty tags and journals excluded.
+  // ---- comparison, hashing
+  // FNV-1a 64 over every pool column (sizes and bytes); stamps and journals excluded.
   uint64_t hash() const;
   bool same_pools(const Mesh& other) const;
-  void clear_dirty();
   size_t pool_bytes() const;     // bytes held by the pools' arrays
   size_t journal_bytes() const;  // bytes held by the undo journals
 
@@ -171,13 +191,17 @@ class Mesh {
 
  private:
   template <class F>
+  void for_each_stamped_column(F&& f);
+  template <class F>
   void for_each_column(F&& f);
   template <class F>
   void for_each_column(F&& f) const;
   uint32_t allocate(Column<uint32_t>& free_list, Column<uint32_t>& generation, Column<uint8_t>& flags,
-                    std::vector<uint8_t>& dirty);
+                    ChangeStamps& changes);
   void release(uint32_t slot, Column<uint32_t>& free_list, Column<uint32_t>& generation, Column<uint8_t>& flags,
-               std::vector<uint8_t>& dirty);
+               ChangeStamps& changes);
+  Frame frame_ = 0;
+  CompactionRecord last_compaction_;
   void link_edge(uint32_t e);
   void unlink_edge(uint32_t e);
 };

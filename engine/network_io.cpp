@@ -115,10 +115,8 @@ Result<Mesh> network_from_json(std::string_view text, const std::string& source)
       if (m.add_face(loop) == kNone)
         throw Bad{where + " is not a closed loop of edges, repeats an edge, or walks an edge in a direction another face already walks"};
     }
-    m.clear_dirty();
     std::string problem = m.validate();
     if (!problem.empty()) throw Bad{problem};
-    for (auto& d : {&m.vertices.dirty, &m.edges.dirty, &m.faces.dirty}) std::fill(d->begin(), d->end(), 1);
     return m;
   } catch (const Bad& bad) {
     return Result<Mesh>::failure(source + ": " + bad.why);

@@ -10,6 +10,7 @@
 
 #include "engine/change.hpp"
 #include "engine/common.hpp"
+#include "engine/hash.hpp"
 
 namespace fire {
 
@@ -39,6 +40,17 @@ struct SurfaceLevels {
   uint32_t quad_count() const { return static_cast<uint32_t>(quads.size() / 4); }
   bool empty() const { return quads.empty(); }
 };
+
+// FNV-1a 64 over the level, positions, normals and quads: with the pools' hash, what a replay must
+// reproduce bit for bit. Versions, frames and ranges are bookkeeping and excluded.
+inline uint64_t surface_hash(const SurfaceLevels& s) {
+  Fnv1a h;
+  h.mix(&s.level, sizeof s.level);
+  h.mix_array(s.positions);
+  h.mix_array(s.normals);
+  h.mix_array(s.quads);
+  return h.value;
+}
 
 // The same surface as a polygon mesh, for export.
 inline SurfaceMesh to_surface_mesh(const SurfaceLevels& s) {

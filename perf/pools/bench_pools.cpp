@@ -117,7 +117,7 @@ Mesh build_by_splitting(bool history, double& seconds) {
 size_t heap_in_use() { return mallinfo2().uordblks; }
 
 struct Layout {  // bytes per element of each pool, from the column element types
-  size_t vertex, edge, face, face_edge, point, free_slot, dirty;
+  size_t vertex, edge, face, face_edge, point, free_slot, stamp;
 };
 
 Layout our_layout(const Mesh& m) {
@@ -130,7 +130,7 @@ Layout our_layout(const Mesh& m) {
   l.face_edge = sizeof(m.face_edges[0]);
   l.point = sizeof(m.points[0]);
   l.free_slot = sizeof(m.vertices.free_list[0]);
-  l.dirty = sizeof(m.vertices.dirty[0]);
+  l.stamp = sizeof(m.vertices.changes.stamp[0]);
   return l;
 }
 
@@ -271,8 +271,8 @@ int main() {
   std::printf("| face | %zu (edge offset 4, count 4, generation 4, flags 1) + %zu per edge in its loop (%.2f mean) | %zu (item 4) |\n",
               l.face, l.face_edge, double(nfe) / double(nf), om_face);
   std::printf("| point | %zu | %zu in the edge's heap block |\n", l.point, om_point);
-  std::printf("(FIRE also keeps 1 dirty byte per vertex, edge and face and %zu bytes per dead slot on a free list, none after compaction)\n",
-              l.free_slot);
+  std::printf("(FIRE also keeps a %zu-byte change stamp per vertex, edge and face and %zu bytes per dead slot on a free list, none after compaction)\n",
+              l.stamp, l.free_slot);
   std::printf("\ntotal bytes: FIRE layout %zu, FIRE pool_bytes() after compaction %zu (%.2f per point); "
               "OpenMesh layout %zu, OpenMesh heap measured (mallinfo2) %zu (%.2f per point)\n",
               layout_total, mesh.pool_bytes(), double(mesh.pool_bytes()) / double(np), om_layout_total, om_heap,

@@ -4,14 +4,9 @@
 #include <vector>
 
 #include "engine/input_log.hpp"
+#include "engine/scheduler.hpp"
 
 namespace fire {
-
-struct FrameTime {
-  uint64_t index = 0;
-  int64_t begin_us = 0;  // frame covers [begin_us, end_us)
-  int64_t end_us = 0;
-};
 
 struct InputCursor {
   size_t next = 0;  // first event not yet delivered

@@ -11,6 +11,13 @@ namespace fire::reconstruct {
 struct ReconstructionCache {
   bool built = false;
   Options options;
+  // The network's frame and compaction count at the last update: what changed since is recomputed.
+  Frame seen = 0;
+  uint64_t compactions_seen = 0;
+  // Set by the refine stage for the subdivide stage: a new base mesh waits, and whether its topology
+  // (hence Catmull-Clark and the fit's factorization) must be rebuilt first.
+  bool pending_subdivide = false;
+  bool rebuild_topology = false;
   // Per element slot of the network; valid[] says whether the entry holds the element's current result.
   std::vector<EdgeSplits> edges;
   std::vector<uint8_t> edge_valid;
@@ -38,12 +45,17 @@ const BaseMesh& ReconstructionState::base() const { return cache_->base; }
 
 namespace {
 
+bool changed_since(const Mesh& net, Frame seen) {
+  for (const ChangeStamps* c : {&net.vertices.changes, &net.edges.changes, &net.faces.changes})
+    for (Frame stamp : c->stamp)
+      if (stamp > seen) return true;
+  return false;
+}
+
 bool used_by_face(const Mesh& net, uint32_t e) {
   return net.edges.face[e][0] != kNone || net.edges.face[e][1] != kNone;
 }
 
-// A slot beyond the tag array was never tagged clean.
-bool tagged(const std::vector<uint8_t>& dirty, uint32_t i) { return i >= dirty.size() || dirty[i]; }
 
 }  // namespace
 
@@ -100,7 +112,7 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
       c.edge_valid[e] = 0;
       continue;
     }
-    if (!everything && c.edge_valid[e] && !tagged(net.edges.dirty, e)) continue;
+    if (!everything && c.edge_valid[e] && !net.edges.changes.changed_since(e, c.seen)) continue;
     c.edges[e] = split_network_edge(net.polyline(e), options.coons_steps);
     c.edge_valid[e] = 1;
     ++c.stats.edges_recomputed;
@@ -114,8 +126,8 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
       continue;
     }
     auto loop = net.face_loop(f);
-    bool stale = everything || !c.face_valid[f] || tagged(net.faces.dirty, f);
-    for (uint32_t oe : loop) stale = stale || tagged(net.edges.dirty, edge_of(oe));
+    bool stale = everything || !c.face_valid[f] || net.faces.changes.changed_since(f, c.seen);
+    for (uint32_t oe : loop) stale = stale || net.edges.changes.changed_since(edge_of(oe), c.seen);
     if (!stale) continue;
     splits.clear();
     for (uint32_t oe : loop) splits.push_back(&c.edges[edge_of(oe)]);
@@ -239,16 +251,34 @@ Status rebuild_topology(const Options& options, ReconstructionCache& c) {
   return Status::success();
 }
 
-Status run_update(const Mesh& net, const Options& options, ReconstructionCache& c, SurfaceMesh& surface) {
-  if (auto s = check_reconstruction_input(net, options); !s) return s;
-  const bool everything = !c.built || !(c.options == options);
+// Per-element stage and base mesh. Returns whether the base mesh may differ from the last update's.
+Result<bool> run_refine(const Mesh& net, const Options& options, ReconstructionCache& c) {
+  if (auto s = check_reconstruction_input(net, options); !s) return Result<bool>::failure(s.error);
+  // Cached results name slots; after a compaction they would name the wrong ones.
+  const bool everything =
+      !c.built || !(c.options == options) || net.last_compaction().count != c.compactions_seen;
+  if (!everything && !c.pending_subdivide && !changed_since(net, c.seen)) {
+    c.stats = {};
+    return false;
+  }
   c.built = false;
   c.options = options;
   update_elements(net, options, c, everything);
   c.base = assemble(net, options, c);
-  if (everything || !same_topology(c, c.base)) {
+  c.rebuild_topology = c.rebuild_topology || everything || !same_topology(c, c.base);
+  c.pending_subdivide = true;
+  c.seen = net.frame();
+  c.compactions_seen = net.last_compaction().count;
+  c.built = true;
+  return true;
+}
+
+Status run_subdivide(const Options& options, ReconstructionCache& c, SurfaceMesh& surface) {
+  if (!c.pending_subdivide) return Status::success();
+  if (c.rebuild_topology) {
     if (auto s = rebuild_topology(options, c); !s) return s;
     c.stats.topology_rebuilt = true;
+    c.rebuild_topology = false;
   }
   std::vector<Vec3> base_points = c.base.positions;
   if (options.method == Method::fire) {
@@ -263,16 +293,30 @@ Status run_update(const Mesh& net, const Options& options, ReconstructionCache& 
   out.face_offsets = c.refinement.last().face_offsets;
   out.face_vertices = c.refinement.last().face_vertices;
   surface = std::move(out);
-  c.built = true;
+  c.pending_subdivide = false;
   return Status::success();
 }
 
 }  // namespace
 
-Status reconstruct_update(const Mesh& net, const Options& options, ReconstructionState& state, SurfaceMesh& surface) {
-  Status s = run_update(net, options, state.cache(), surface);
+Result<bool> refine_update(const Mesh& net, const Options& options, ReconstructionState& state) {
+  Result<bool> r = run_refine(net, options, state.cache());
+  if (!r) state.cache() = ReconstructionCache{};
+  return r;
+}
+
+Status subdivide_update(const Options& options, ReconstructionState& state, SurfaceMesh& surface) {
+  Status s = run_subdivide(options, state.cache(), surface);
   if (!s) state.cache() = ReconstructionCache{};
   return s;
+}
+
+Status reconstruct_update(const Mesh& net, const Options& options, ReconstructionState& state, SurfaceMesh& surface) {
+  ReconstructionCache& c = state.cache();
+  // A call with nothing changed still re-runs the global stages, as a fresh reconstruction would.
+  if (c.built) c.pending_subdivide = true;
+  if (auto r = refine_update(net, options, state); !r) return Status::failure(r.error());
+  return subdivide_update(options, state, surface);
 }
 
 Result<SurfaceMesh> reconstruct_surface(const Mesh& net, const Options& options) {

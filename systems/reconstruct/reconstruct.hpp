@@ -13,13 +13,14 @@
 //
 // Both write a SurfaceMesh: the level-L quads with their vertices' limit positions and limit normals.
 // The network is read, never written. Incremental use: reconstruct_update() keeps the per-edge and
-// per-face results of the previous call in a ReconstructionState and recomputes only the edges whose
-// dirty tag is set and the faces whose tag, or one of whose edges' tags, is set; its result equals a
+// per-face results of the previous call in a ReconstructionState and recomputes only the edges stamped
+// after the frame it last saw and the faces stamped so, or one of whose edges is; its result equals a
 // fresh reconstruction of the same network bit for bit. What stays global: numbering the base mesh,
 // Catmull-Clark (its topology and, for FIRE, the fit's factorization are rebuilt only when the base
 // mesh's topology changed) and the fit's solves (back-substitutions over the whole base mesh).
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "engine/mesh.hpp"
@@ -93,16 +94,33 @@ class ReconstructionState {
   std::unique_ptr<ReconstructionCache> cache_;
 };
 
+// What the frame's refine and subdivide systems share: the incremental state and the last problem, in
+// words ("" while the surface follows the network).
+struct SurfaceBuild {
+  ReconstructionState state;
+  std::string problem;
+  bool clear_surface = false;  // the network lost its last face: the surface must go too
+  uint64_t updates = 0;        // refine updates that produced a new base mesh
+};
+
 // Rejects, with the element and the problem named: options out of range, a network that breaks its
 // invariants (non-finite coordinates included), no faces, a face with fewer than 3 edges (thesis), a
 // polyline of zero length, two consecutive polyline points that coincide, two corners of a face that
 // coincide.
 Status check_reconstruction_input(const Mesh& net, const Options& options);
 
-// Reconstructs `net` into `surface`, reusing what `state` holds from the previous call where the dirty
-// tags say nothing changed (the caller clears the tags, e.g. at the end of the frame). On failure
+// Reconstructs `net` into `surface`, reusing what `state` holds from the previous call where the change
+// stamps say nothing changed since then. Writes made in the frame of that call after it ran are not seen:
+// the caller starts a new frame (Mesh::begin_frame) before editing again. On failure
 // `surface` is left as it was and `state` is emptied, so the next call rebuilds everything.
 Status reconstruct_update(const Mesh& net, const Options& options, ReconstructionState& state, SurfaceMesh& surface);
+
+// reconstruct_update in the two halves the frame runs as systems. refine_update recomputes the changed
+// edges and faces and assembles the base mesh; it returns false, doing nothing, when nothing changed since
+// its last call. subdivide_update then rebuilds topology where needed, fits and evaluates into `surface`,
+// and does nothing when refine_update found nothing new. On failure the state is emptied as above.
+Result<bool> refine_update(const Mesh& net, const Options& options, ReconstructionState& state);
+Status subdivide_update(const Options& options, ReconstructionState& state, SurfaceMesh& surface);
 
 // One reconstruction from scratch.
 Result<SurfaceMesh> reconstruct_surface(const Mesh& net, const Options& options);

@@ -19,11 +19,17 @@ check "export-network --help" "'$fire' export-network --help | grep -q OBJ"
 h1=$("$fire" replay "$src/tools/demo/sketch.log" --hash 2>/dev/null)
 h2=$("$fire" replay "$src/tools/demo/sketch.log" --hash 2>/dev/null)
 check "replay hash is stable ($h1)" "[ -n '$h1' ] && [ '$h1' = '$h2' ]"
-# The hash every build on every machine must print for the bundled demo (regenerate it only when the demo
-# log or the meaning of the pools changes on purpose).
+# The hash of the pools and the surface every build on every machine must print for the bundled demo
+# (regenerate it only when the demo log, the pools or the surface change on purpose).
 golden=$(cat "$src/tests/engine/demo.hash")
 check "replay hash matches the recorded one ($golden)" "[ '$h1' = '$golden' ]"
 check "replay writes the network" "'$fire' replay '$src/tools/demo/sketch.log' -o '$tmp/demo.fnet' 2>/dev/null && [ -s '$tmp/demo.fnet' ]"
+# The surface the frame's refine and subdivide systems left equals a reconstruction from scratch of the
+# same network, byte for byte.
+check "replay writes the surface" "'$fire' replay '$src/tools/demo/sketch.log' -o '$tmp/s.fnet' --surface '$tmp/live.obj' 2>/dev/null && [ -s '$tmp/live.obj' ]"
+check "the live surface equals a full rebuild" "'$fire' reconstruct '$tmp/s.fnet' -o '$tmp/full.obj' && cmp -s '$tmp/live.obj' '$tmp/full.obj'"
+check "--no-surface skips refine and subdivide" "'$fire' replay '$src/tools/demo/sketch.log' --no-surface --timings 2>/dev/null | grep -q 'surface: level 0, 0 quads'"
+expect_error "--surface with an unknown extension" "unknown surface format" "$fire" replay "$src/tools/demo/sketch.log" --surface "$tmp/x.xyz"
 check "export-network writes one l per edge" "'$fire' export-network '$tmp/demo.fnet' -o '$tmp/demo.obj' && [ \$(grep -c '^l ' '$tmp/demo.obj') -eq 32 ]"
 
 printf 'FIRE-LOG 1\n0 down\n10 pen 1 2' >"$tmp/trunc.log"

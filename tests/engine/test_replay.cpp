@@ -51,8 +51,10 @@ TEST_CASE("the demo log replays to the same pools every time", "[replay]") {
     REQUIRE(w->mesh.validate() == "");
     CHECK(w->mesh.face_count() == 14);
     CHECK(w->rejections.size() == 1);
-    CHECK(s.timings().size() == 3);
-    hash = w->mesh.hash();
+    CHECK(s.timings().size() == 5);
+    CHECK(w->surface.quad_count() > 0);
+    CHECK(w->surface_build.problem == "");
+    hash = world_hash(*w);
   }
   CHECK(hashes[0] == hashes[1]);
 }
@@ -135,22 +137,64 @@ TEST_CASE("the demo log exercises every split case, an undo, a redo and a delete
     const uint32_t count = w->mesh.edges.point_count[end.edge];
     return end.point == 0 || end.point + 1 == count ? std::string("vertex") : std::string("edge");
   };
-  Scheduler s(fake_clock);
-  s.add("input", [&] { input_system(w->log, w->frame, w->cursor, w->frame_events); });
-  s.add("sketch", [&] { sketch_system(w->frame_events, w->mesh, w->sketch_settings, w->sketch, w->requests, w->rejections); });
-  s.add("probe", [&] {
-    for (const EditRequest& r : w->requests) {
-      if (r.kind == RequestKind::Undo) ++seen["undo"];
-      else if (r.kind == RequestKind::Redo) ++seen["redo"];
-      else if (r.command.kind == EditKind::DeleteCurve) ++seen["delete"];
-      else if (r.command.kind == EditKind::SplitFace) ++seen[end_kind(r.command.start) + "-" + end_kind(r.command.end)];
-    }
-  });
-  s.add("split", [&] { split_system(w->requests, w->mesh, w->history, w->rejections); });
-  replay_headless(*w, s);
+  std::vector<SystemSpec> systems = session_systems(*w);
+  REQUIRE(systems[1].name == "sketch");
+  systems.insert(systems.begin() + 2, SystemSpec{"probe", {"requests"}, {}, {"mesh"}, [&] {
+                                                   for (const EditRequest& r : w->requests) {
+                                                     if (r.kind == RequestKind::Undo) ++seen["undo"];
+                                                     else if (r.kind == RequestKind::Redo) ++seen["redo"];
+                                                     else if (r.command.kind == EditKind::DeleteCurve) ++seen["delete"];
+                                                     else if (r.command.kind == EditKind::SplitFace)
+                                                       ++seen[end_kind(r.command.start) + "-" + end_kind(r.command.end)];
+                                                   }
+                                                 }});
+  auto s = Scheduler::build(std::move(systems), fake_clock);
+  REQUIRE(s.ok());
+  w->build_surface = false;
+  replay_headless(*w, *s);
   REQUIRE(w->rejections.size() == 1);  // the one stroke meant to be rejected
   for (const char* kind : {"edge-edge", "edge-vertex", "vertex-edge", "vertex-vertex", "undo", "redo", "delete"}) {
     INFO(kind);
     CHECK(seen[kind] >= 1);
   }
+}
+
+TEST_CASE("the scheduler refuses a read of what a later system writes, unless it reads the previous frame",
+          "[scheduler]") {
+  auto noop = [] {};
+  auto refused = Scheduler::build({{"sketch", {"mesh"}, {"requests"}, {}, noop}, {"split", {"requests"}, {"mesh"}, {}, noop}},
+                                  fake_clock);
+  REQUIRE_FALSE(refused.ok());
+  CHECK_THAT(refused.error(), Catch::Contains("'sketch' reads 'mesh'") && Catch::Contains("'split'"));
+  auto declared = Scheduler::build(
+      {{"sketch", {}, {"requests"}, {"mesh"}, noop}, {"split", {"requests"}, {"mesh"}, {}, noop}}, fake_clock);
+  CHECK(declared.ok());
+  auto stale = Scheduler::build({{"sketch", {}, {"requests"}, {"surface"}, noop}, {"split", {"requests"}, {"mesh"}, {}, noop}},
+                                fake_clock);
+  REQUIRE_FALSE(stale.ok());
+  CHECK_THAT(stale.error(), Catch::Contains("no later system writes it"));
+  auto twice = Scheduler::build({{"a", {}, {}, {}, noop}, {"a", {}, {}, {}, noop}}, fake_clock);
+  CHECK_FALSE(twice.ok());
+}
+
+TEST_CASE("the scheduler keeps per-system samples for mean, p99 and max", "[scheduler]") {
+  int calls = 0;
+  auto s = Scheduler::build({{"count", {}, {"n"}, {}, [&] { ++calls; }}}, fake_clock);
+  REQUIRE(s.ok());
+  for (int i = 0; i < 100; ++i) s->run_frame();
+  CHECK(calls == 100);
+  const SystemTiming& t = s->timings()[0];
+  REQUIRE(t.samples_ns.size() == 100);
+  CHECK(t.percentile_ns(99) <= t.max_ns);
+  CHECK(t.mean_ns() > 0);
+  CHECK(s->frame_timing().samples_ns.size() == 100);
+  CHECK(s->frame_timing().max_ns >= t.max_ns);
+  CHECK_THAT(s->describe(), Catch::Contains("count: reads -; writes n"));
+}
+
+TEST_CASE("the session's frame order is accepted and the surface follows the network", "[scheduler][surface]") {
+  World w;
+  auto s = Scheduler::build(session_systems(w), fake_clock);
+  REQUIRE(s.ok());
+  CHECK_THAT(s->describe(), Catch::Contains("sketch: reads frame_events, sketch_settings; reads last frame's mesh"));
 }

@@ -306,14 +306,21 @@ TEST_CASE("validate names the first broken invariant", "[pools]") {
   CHECK_THAT(n.validate(), Catch::Matchers::Contains("face 0 uses edge 2 which does not name it back"));
 }
 
-TEST_CASE("dirty tags mark what an edit touched", "[pools]") {
+TEST_CASE("change stamps mark what an edit touched", "[pools][stamps]") {
   Mesh m = square();
-  m.clear_dirty();
+  m.begin_frame(1);
+  const uint32_t points_before = static_cast<uint32_t>(m.points.size());
   REQUIRE(execute_edit(m, split(0, {0, 0}, {2, 0}, line({0, 0, 0}, {1, 1, 0}))).ok);
-  CHECK(m.faces.dirty[0] == 1);
-  CHECK(m.faces.dirty[1] == 1);
-  CHECK(m.edges.dirty[1] == 1);  // now walked by the new face
-  CHECK(m.vertices.dirty[1] == 0);  // untouched corner
+  CHECK(m.faces.changes.since(0) == std::vector<uint32_t>{0, 1});
+  CHECK(m.edges.changes.changed_since(1, 0));  // now walked by the new face
+  CHECK_FALSE(m.vertices.changes.changed_since(1, 0));  // untouched corner
+  // The new curve's points are this frame's range of the point pool, nothing before it.
+  CHECK(m.point_changes.written_in(1).begin == points_before);
+  CHECK(m.point_changes.written_in(1).end == m.points.size());
+  CHECK(m.point_changes.written_in(2).empty());
+  // A consumer that saw frame 1 sees nothing new; one that saw frame 0 still sees the edit.
+  CHECK(m.faces.changes.since(1).empty());
+  CHECK(m.faces.changes.since(0).size() == 2);
 }
 
 TEST_CASE("border edits undo and redo like every other edit", "[split][undo]") {
@@ -342,14 +349,48 @@ TEST_CASE("border edits undo and redo like every other edit", "[split][undo]") {
   CHECK(h.redo_depth() == 0);
 }
 
-TEST_CASE("a rejected edit leaves the dirty tags alone", "[pools]") {
+TEST_CASE("a rejected edit leaves the stamps alone; undo stamps exactly what it restores", "[pools][stamps]") {
   EditHistory h;
   Mesh m = square(&h);
-  m.clear_dirty();
+  m.begin_frame(1);
   REQUIRE_FALSE(h.apply(m, split(0, {0, 0}, {0, 0}, line({0, 0, 0}, {0, 0, 1}))).ok);
-  for (uint8_t d : m.faces.dirty) CHECK(d == 0);
-  for (uint8_t d : m.edges.dirty) CHECK(d == 0);
-  REQUIRE(h.undo(m).ok);  // a real rollback (here: reopening the border) still tags what it restores
-  REQUIRE(m.edges.dirty.size() == m.edge_slots());
-  CHECK(m.edges.dirty[0] == 1);
+  CHECK(m.faces.changes.since(0).empty());
+  CHECK(m.edges.changes.since(0).empty());
+  CHECK(m.vertices.changes.since(0).empty());
+  m.begin_frame(2);
+  REQUIRE(h.undo(m).ok);  // reopens the border: removes the closing edge and the face
+  // The face and the closing edge (slot 3) are gone, and every edge that named the face is restored.
+  CHECK(m.faces.changes.since(1) == std::vector<uint32_t>{0});
+  CHECK(m.edges.changes.since(1) == std::vector<uint32_t>{0, 1, 2, 3});
+  CHECK_FALSE(m.edge_alive(3));
+  // The closing edge's two ends lose it from their edge lists; the other corners are untouched.
+  for (uint32_t v : m.vertices.changes.since(1)) CHECK((v == m.edges.vertex[2][1] || v == 0));
+}
+
+TEST_CASE("compaction keeps the survivors' stamps and records its map", "[pools][stamps]") {
+  EditHistory h;
+  Mesh m = square(&h);
+  m.begin_frame(1);
+  REQUIRE(execute_edit(m, split(0, {0, 0}, {2, 0}, line({0, 0, 0}, {1, 1, 0}))).ok);
+  m.begin_frame(2);
+  uint32_t curve = kNone;
+  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e) && m.edges.face[e][0] != kNone && m.edges.face[e][1] != kNone) curve = e;
+  REQUIRE(curve != kNone);
+  EditCommand del;
+  del.kind = EditKind::DeleteCurve;
+  del.edge = curve;
+  REQUIRE(execute_edit(m, del).ok);
+  const std::vector<uint32_t> changed_in_2 = m.edges.changes.since(1);
+  m.begin_frame(3);
+  CHECK(m.last_compaction().count == 0);
+  const CompactionMap map = m.compact();
+  CHECK(m.last_compaction().count == 1);
+  CHECK(m.last_compaction().frame == 3);
+  CHECK(m.validate() == "");
+  for (uint32_t e = 0; e < map.edge.size(); ++e) {
+    if (map.edge[e] == kNone) continue;
+    const bool was_changed = std::find(changed_in_2.begin(), changed_in_2.end(), e) != changed_in_2.end();
+    CHECK(m.edges.changes.changed_since(map.edge[e], 1) == was_changed);
+  }
 }

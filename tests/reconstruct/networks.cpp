@@ -63,7 +63,6 @@ Mesh grid_network(uint32_t nx, uint32_t ny, uint32_t samples, const Height& heig
                    {(j + 1) * nx + i, true},
                    {vertical + j * (nx + 1) + i, true}});
   REQUIRE(m.validate() == "");
-  m.clear_dirty();
   return m;
 }
 

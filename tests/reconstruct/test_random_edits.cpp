@@ -115,7 +115,7 @@ TEST_CASE("random edits: incremental reconstruction equals a rebuild after every
       CHECK_THAT(thesis_status.error, Catch::Contains("has 2 edges"));
       ++thesis_refused;
     }
-    net.clear_dirty();
+    net.begin_frame(net.frame() + 1);
   }
   // The mix really edited the network, and the thesis comparison really ran (seed 20261124: 106 edits
   // applied, 45 thesis comparisons, 75 refusals).

@@ -6,6 +6,7 @@
 
 #include "platform/clock.hpp"
 #include "platform/network_file.hpp"
+#include "platform/surface_io.hpp"
 #include "tools/fire/commands.hpp"
 #include "tools/fire/session.hpp"
 
@@ -14,10 +15,16 @@ namespace fire::cli {
 namespace {
 
 struct ReplayOptions {
-  std::string log_path, out_path, obj_path;
-  bool hash = false, timings = false;
+  std::string log_path, out_path, obj_path, surface_path;
+  bool hash = false, timings = false, no_surface = false;
   double snap = SketchSettings{}.snap_distance;
+  reconstruct::Options surface;
 };
+
+void print_timing(const SystemTiming& t) {
+  std::printf("system %-10s mean %10.1f us  p99 %10.1f us  max %10.1f us  total %9.3f ms\n", t.name.c_str(),
+              t.mean_ns() / 1e3, double(t.percentile_ns(99)) / 1e3, double(t.max_ns) / 1e3, double(t.total_ns) / 1e6);
+}
 
 int run_replay(const ReplayOptions& o) {
   auto log = read_input_log(o.log_path);
@@ -29,9 +36,21 @@ int run_replay(const ReplayOptions& o) {
     std::cerr << "fire replay: --snap must be a positive distance\n";
     return 1;
   }
+  if (o.no_surface && !o.surface_path.empty()) {
+    std::cerr << "fire replay: --surface needs the surface that --no-surface turns off\n";
+    return 1;
+  }
+  if (!o.surface_path.empty()) {
+    if (auto format = surface_format_of(o.surface_path); !format) {
+      std::cerr << "fire replay: " << format.error() << "\n";
+      return 1;
+    }
+  }
   auto world = std::make_unique<World>();
   world->log = std::move(*log);
   world->sketch_settings.snap_distance = o.snap;
+  world->build_surface = !o.no_surface;
+  world->surface_options = o.surface;
   Scheduler scheduler = make_scheduler(*world, monotonic_ns);
   replay_headless(*world, scheduler);
 
@@ -45,16 +64,31 @@ int run_replay(const ReplayOptions& o) {
     return 2;
   }
   const Mesh& m = world->mesh;
+  const SurfaceLevels& surface = world->surface;
+  if (!world->surface_build.problem.empty())
+    std::cerr << o.log_path << ": the surface does not follow the last edit: " << world->surface_build.problem << "\n";
   if (o.timings) {
-    std::printf("frames %" PRIu64 "\n", scheduler.frames());
-    for (const SystemTiming& t : scheduler.timings())
-      std::printf("system %-8s total %9.3f ms  mean %8.4f ms  max %8.4f ms\n", t.name.c_str(), t.total_ns / 1e6,
-                  t.runs ? t.total_ns / 1e6 / double(t.runs) : 0.0, t.max_ns / 1e6);
+    std::printf("frames %" PRIu64 " run (frames with no input skipped)\n", scheduler.frames());
+    for (const SystemTiming& t : scheduler.timings()) print_timing(t);
+    print_timing(scheduler.frame_timing());
     std::printf("vertices %zu edges %zu faces %zu points %zu; edits %zu applied, %zu rejected\n", m.vertex_count(),
                 m.edge_count(), m.face_count(), m.live_point_count(), world->history.undo_depth(),
                 world->rejections.size());
+    std::printf("surface: level %u, %u quads, %u vertices, %" PRIu64 " updates\n", surface.level, surface.quad_count(),
+                surface.vertex_count(), world->surface_build.updates);
   }
-  if (o.hash) std::printf("%016" PRIx64 "\n", m.hash());
+  if (o.hash) std::printf("%016" PRIx64 "\n", world_hash(*world));
+  if (!o.surface_path.empty()) {
+    if (surface.empty()) {
+      std::cerr << "fire replay: " << o.log_path << " ends with no surface to write to " << o.surface_path
+                << (m.face_count() == 0 ? " (the network has no faces)\n" : "\n");
+      return 1;
+    }
+    if (auto s = write_surface(to_surface_mesh(surface), o.surface_path); !s) {
+      std::cerr << "fire replay: " << s.error << "\n";
+      return 1;
+    }
+  }
   if (!o.out_path.empty()) {
     if (auto s = save_network(m, o.out_path); !s) {
       std::cerr << "fire replay: " << s.error << "\n";
@@ -74,12 +108,23 @@ int run_replay(const ReplayOptions& o) {
 
 void add_network_commands(CLI::App& app, Registry& registry) {
   auto o = std::make_shared<ReplayOptions>();
-  CLI::App* replay = app.add_subcommand("replay", "Replay an input log headless through the frame systems (input, sketch, split)");
+  CLI::App* replay = app.add_subcommand(
+      "replay", "Replay an input log headless through the frame systems (input, sketch, split, refine, subdivide)");
   replay->add_option("LOG", o->log_path, "input log (format: engine/INPUT_LOG.md)")->required();
   replay->add_option("-o,--output", o->out_path, "write the final curve network here (format: engine/NETWORK_FORMAT.md)");
   replay->add_option("--export-obj", o->obj_path, "also write the network's polylines as OBJ lines");
-  replay->add_flag("--hash", o->hash, "print a 64-bit hash of the final pools (identical on every run and machine)");
-  replay->add_flag("--timings", o->timings, "print per-system timings and final counts");
+  replay->add_option("--surface", o->surface_path,
+                     "write the final surface here (.obj, .ply, .stl or .glb), as the frame's subdivide system left it");
+  replay->add_flag("--no-surface", o->no_surface, "run only input, sketch and split (no refine and subdivide)");
+  replay->add_option("--levels", o->surface.levels, "subdivision levels of the surface")
+      ->capture_default_str()
+      ->check(CLI::Range(1u, reconstruct::kMaxLevels));
+  replay->add_option("--fairness", o->surface.fairness, "fairness weight of the surface fit, 0 to 1")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  replay->add_flag("--hash", o->hash,
+                   "print a 64-bit hash of the final pools and surface (identical on every run and machine)");
+  replay->add_flag("--timings", o->timings, "print per-system timings (mean, p99, max per frame) and final counts");
   replay->add_option("--snap", o->snap, "snap distance for stroke ends, in model units")->capture_default_str();
   replay->callback([o, &registry] { registry.exit_code = run_replay(*o); });
 

@@ -1,31 +1,70 @@
 #include "tools/fire/session.hpp"
 
+#include <cstdio>
+#include <cstdlib>
+
+#include "engine/hash.hpp"
+#include "systems/refine/refine_system.hpp"
 #include "systems/split/split_system.hpp"
+#include "systems/subdivide/subdivide_system.hpp"
 
 namespace fire {
 
-Scheduler make_scheduler(World& w, Scheduler::Clock clock) {
-  Scheduler s(clock);
-  s.add("input", [&w] { input_system(w.log, w.frame, w.cursor, w.frame_events); });
-  s.add("sketch", [&w] { sketch_system(w.frame_events, w.mesh, w.sketch_settings, w.sketch, w.requests, w.rejections); });
-  s.add("split", [&w] { split_system(w.requests, w.mesh, w.history, w.rejections); });
-  return s;
+std::vector<SystemSpec> session_systems(World& w) {
+  std::vector<SystemSpec> systems;
+  systems.push_back({"input", {"log", "frame"}, {"frame_events"}, {}, [&w] {
+                       input_system(w.log, w.frame, w.cursor, w.frame_events);
+                     }});
+  systems.push_back({"sketch", {"frame_events", "sketch_settings"}, {"requests", "rejections"}, {"mesh"}, [&w] {
+                       sketch_system(w.frame_events, w.mesh, w.sketch_settings, w.sketch, w.requests, w.rejections);
+                     }});
+  systems.push_back({"split", {"requests"}, {"mesh", "rejections"}, {}, [&w] {
+                       split_system(w.requests, w.mesh, w.history, w.rejections);
+                     }});
+  systems.push_back({"refine", {"mesh", "surface_options"}, {"base_mesh"}, {}, [&w] {
+                       if (w.build_surface) refine_system(w.mesh, w.surface_options, w.surface_build);
+                     }});
+  systems.push_back({"subdivide", {"base_mesh", "surface_options", "frame"}, {"surface"}, {}, [&w] {
+                       if (w.build_surface) subdivide_system(w.surface_options, w.frame, w.surface_build, w.surface);
+                     }});
+  return systems;
+}
+
+Scheduler make_scheduler(World& world, Scheduler::Clock clock) {
+  auto scheduler = Scheduler::build(session_systems(world), clock);
+  // The order above is fixed in code: a refusal is a programming error, caught by every replay test.
+  if (!scheduler) {
+    std::fprintf(stderr, "internal error: %s\n", scheduler.error().c_str());
+    std::abort();
+  }
+  return std::move(*scheduler);
+}
+
+void begin_frame(World& w, uint64_t index, int64_t begin_us) {
+  w.frame = {index, begin_us, begin_us + kFrameStepUs};
+  w.mesh.begin_frame(index);
 }
 
 void replay_headless(World& w, Scheduler& scheduler) {
   if (w.log.events.empty()) return;
-  int64_t t = w.log.events.front().t_us;
-  w.frame = {0, t, t + kFrameStepUs};
+  begin_frame(w, 0, w.log.events.front().t_us);
   while (w.cursor.next < w.log.events.size() || !w.sketch.pending.empty()) {
     // Skip stretches with nothing to do: the frames still count, so frame numbers match a live session.
     if (w.sketch.pending.empty() && w.log.events[w.cursor.next].t_us >= w.frame.end_us) {
-      int64_t steps = (w.log.events[w.cursor.next].t_us - w.frame.begin_us) / kFrameStepUs;
-      w.frame = {w.frame.index + uint64_t(steps), w.frame.begin_us + steps * kFrameStepUs,
-                 w.frame.begin_us + (steps + 1) * kFrameStepUs};
+      const int64_t steps = (w.log.events[w.cursor.next].t_us - w.frame.begin_us) / kFrameStepUs;
+      begin_frame(w, w.frame.index + uint64_t(steps), w.frame.begin_us + steps * kFrameStepUs);
     }
     scheduler.run_frame();
-    w.frame = {w.frame.index + 1, w.frame.end_us, w.frame.end_us + kFrameStepUs};
+    begin_frame(w, w.frame.index + 1, w.frame.end_us);
   }
+}
+
+uint64_t world_hash(const World& w) {
+  Fnv1a h;
+  const uint64_t pools = w.mesh.hash(), surface = surface_hash(w.surface);
+  h.mix(&pools, sizeof pools);
+  h.mix(&surface, sizeof surface);
+  return h.value;
 }
 
 }  // namespace fire

@@ -1,36 +1,58 @@
 #pragma once
 // A drawing session: the world's data and the per-frame system order of the design card, used by
-// `fire replay` headless (and later by the live app).
+// `fire replay` headless (and by the live app).
+//
+//   input -> sketch -> split -> refine -> subdivide
+//
+// Each system is declared with the world data it reads and writes (names below), so the scheduler can
+// refuse an order in which a system reads what a later one writes in the same frame.
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include "engine/input_log.hpp"
 #include "engine/mesh.hpp"
 #include "engine/scheduler.hpp"
+#include "engine/surface.hpp"
 #include "systems/input/input.hpp"
+#include "systems/reconstruct/reconstruct.hpp"
 #include "systems/sketch/sketch.hpp"
 #include "systems/split/edit.hpp"
 
 namespace fire {
 
 struct World {
+  // input
   InputLog log;
   InputCursor cursor;
   FrameTime frame;
   std::vector<InputEvent> frame_events;
+  // sketch
   SketchState sketch;
   SketchSettings sketch_settings;
   std::vector<EditRequest> requests;
+  std::vector<Rejection> rejections;
+  // split
   Mesh mesh;
   EditHistory history;
-  std::vector<Rejection> rejections;
+  // refine, subdivide
+  bool build_surface = true;
+  reconstruct::Options surface_options;
+  reconstruct::SurfaceBuild surface_build;
+  SurfaceLevels surface;
 };
 
 inline constexpr int64_t kFrameStepUs = 10'000;  // 100 Hz, the Wii Remote's report rate
 
-// Builds the scheduler over `world` with the systems in design-card order.
+// The design card's systems over `world`, in frame order, with their declared reads and writes.
+std::vector<SystemSpec> session_systems(World& world);
+// Builds the scheduler over session_systems(world).
 Scheduler make_scheduler(World& world, Scheduler::Clock clock);
+// Starts frame `index` covering [begin_us, begin_us + kFrameStepUs): the pools stamp what follows with it.
+void begin_frame(World& world, uint64_t index, int64_t begin_us);
 // Runs fixed-step frames from the first event until every event is consumed and no request waits.
 void replay_headless(World& world, Scheduler& scheduler);
+// Hash of the pools and the surface: what a replay must reproduce bit for bit.
+uint64_t world_hash(const World& world);
 
 }  // namespace fire
