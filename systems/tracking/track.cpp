@@ -13,6 +13,7 @@ constexpr double kMaxFrameGap = 2.5;      // interpolate across one lost report,
 constexpr double kEpipolarCapPx = 5.0;    // a blob farther than this from its epipolar line counts as this far
 constexpr double kJumpGate_m = 0.02;      // pen positions this far apart are different things
 constexpr double kMaxPenSpeed_m_s = 5.0;  // a hand moves the pen no faster
+constexpr double kBridgeSpeed_m_s = 1.0;  // a drawing hand, while both cameras lose the pen, moves it no faster
 constexpr double kMovingPx = 1.5;         // a blob moving less per frame says little about timing
 
 double median(std::vector<double> v) {
@@ -430,6 +431,50 @@ Result<WandCalibration> calibrate_wand_streams(DeviceStreams streams, const Cali
   return out;
 }
 
+namespace {
+
+// The camera frame whose instant is the last at or before t (none before the first).
+std::optional<size_t> frame_at_or_before(const CameraFrames& f, double t) {
+  const auto it = std::upper_bound(f.t_frame_us.begin(), f.t_frame_us.end(), t);
+  if (it == f.t_frame_us.begin()) return std::nullopt;
+  return static_cast<size_t>(it - f.t_frame_us.begin()) - 1;
+}
+
+constexpr double kFollowStep_px = 40;  // the pen's blob moves less than this between two frames of a camera
+
+struct Followed {
+  Vec3 position;
+  Vec2 px;
+};
+
+// While only one camera sees the pen, the pen lies on that camera's ray through its blob: the point of
+// the ray nearest the pen's last position, if within `gate` of it, from the blob nearest the pen's last
+// pixel in that camera. A stray reflection elsewhere in the image is never taken for the pen.
+std::optional<Followed> follow_on_ray(const Camera& cam, std::span<const Vec2> blobs, const Vec2& last_px,
+                                      const Vec3& last, double gate) {
+  std::optional<Followed> best;
+  double best_step = kFollowStep_px;
+  for (const Vec2& px : blobs) {
+    const double step = (px - last_px).norm();
+    if (step > best_step) continue;
+    const Vec3 c = cam.centre(), d = cam.ray(px);
+    const Vec3 x = c + d * std::max(0.0, d.dot(last - c));
+    if ((x - last).norm() > gate) continue;
+    best_step = step;
+    best = Followed{x, px};
+  }
+  return best;
+}
+
+// How far the pen may be from where it was last seen after `dt_us`: a hand's fastest flick over a short
+// gap; over a longer one the pen was hidden while a drawing hand went on, which is slower.
+double reach_m(double dt_us, int64_t short_gap_us) {
+  const double speed = dt_us <= static_cast<double>(short_gap_us) ? kMaxPenSpeed_m_s : kBridgeSpeed_m_s;
+  return kJumpGate_m + speed * dt_us * 1e-6;
+}
+
+}  // namespace
+
 PenTrack track_pen(const DeviceStreams& streams, const Camera& c0, const Camera& c1, double cam1_offset_us,
                    const PenTrackOptions& options) {
   PenTrack out;
@@ -441,46 +486,82 @@ PenTrack track_pen(const DeviceStreams& streams, const Camera& c0, const Camera&
   OneEuroState filter;
   bool down = false;
   double last_sample_t = -std::numeric_limits<double>::infinity();
-  Vec3 last_position = Vec3::Zero();
+  double last_seen_t = last_sample_t;  // last instant some camera saw the pen (both, or one on the followed ray)
+  Vec3 last_position = Vec3::Zero();   // of the last sample, or of the ray point a single camera gave
+  std::array<Vec2, 2> pen_px{Vec2::Zero(), Vec2::Zero()};  // the pen's last pixel in each camera
   for (size_t k = 0; k < f0.size(); ++k) {
     const double t = f0.t_frame_us[k];
-    if (down && t - last_sample_t > static_cast<double>(options.max_gap_us)) down = false;
-    if (f0.blob_count[k] == 0 || !cam1.at(t + cam1_offset_us, ip)) continue;
+    // A stroke ends when no camera has seen the pen for max_gap_us, or when only one has for longer than
+    // a hand takes to pass in front of the other (max_bridge_us).
+    if (down && (t - last_seen_t > static_cast<double>(options.max_gap_us) ||
+                 t - last_sample_t > static_cast<double>(options.max_bridge_us)))
+      down = false;
+    // Keeps the pen followed through a frame without a stereo sample, from whichever camera still sees it.
+    auto follow_one_camera = [&] {
+      if (!down) return;
+      const double gate = reach_m(t - last_seen_t, options.short_gap_us);
+      std::optional<Followed> x =
+          follow_on_ray(c0, std::span<const Vec2>(f0.blobs[k].data(), f0.blob_count[k]), pen_px[0], last_position, gate);
+      int camera = 0;
+      if (!x) {
+        if (const auto j = frame_at_or_before(f1, t + cam1_offset_us)) {
+          x = follow_on_ray(c1, std::span<const Vec2>(f1.blobs[*j].data(), f1.blob_count[*j]), pen_px[1], last_position, gate);
+          camera = 1;
+        }
+      }
+      if (!x) return;
+      last_seen_t = t;
+      last_position = x->position;
+      pen_px[camera] = x->px;
+      ++out.bridged_frames;
+    };
+    if (f0.blob_count[k] == 0 || !cam1.at(t + cam1_offset_us, ip)) {
+      follow_one_camera();
+      continue;
+    }
     ++out.frames_seen_by_both;
     // Epipolar lines run along the baseline, so a stray blob level with the LED in the other
     // camera also fits the geometry. While the pen is down the candidate nearest its last
     // position wins; a stroke only starts from a frame where every fitting pair agrees.
     std::array<Triangulation, kIrSlots * kIrSlots> fits;
+    std::array<std::array<int, 2>, kIrSlots * kIrSlots> fit_blobs;
     int fit_count = 0;
     for (int i = 0; i < f0.blob_count[k]; ++i)
       for (int j = 0; j < ip.count; ++j) {
         const Triangulation tri =
             triangulate(c0, c1, f0.blobs[k][i], ip.px[j], options.method, options.max_reprojection_px);
-        if (tri.accepted) fits[fit_count++] = tri;
+        if (!tri.accepted) continue;
+        fit_blobs[fit_count] = {i, j};
+        fits[fit_count++] = tri;
       }
     if (fit_count == 0) {
       ++out.rejected_reprojection;
+      follow_one_camera();
       continue;
     }
-    const Triangulation* best = nullptr;
+    int best = -1;
     if (down) {
-      const double gate = kJumpGate_m + kMaxPenSpeed_m_s * (t - last_sample_t) * 1e-6;
+      const double gate = reach_m(t - last_seen_t, options.short_gap_us);
       for (int c = 0; c < fit_count; ++c)
         if ((fits[c].X - last_position).norm() <= gate &&
-            (!best || (fits[c].X - last_position).norm() < (best->X - last_position).norm()))
-          best = &fits[c];
-      if (!best) {
+            (best < 0 || (fits[c].X - last_position).norm() < (fits[best].X - last_position).norm()))
+          best = c;
+      // Seen again after a longer gap, but not where the pen could have got to: it was lifted and put
+      // down elsewhere, so a new stroke starts here.
+      if (best < 0 && t - last_seen_t > static_cast<double>(options.short_gap_us)) down = false;
+      if (best < 0 && down) {
         ++out.rejected_jump;
         continue;
       }
-    } else {
-      best = &fits[0];
+    }
+    if (!down) {
+      best = 0;
       for (int c = 1; c < fit_count; ++c) {
-        if ((fits[c].X - best->X).norm() > kJumpGate_m) best = nullptr;
-        if (!best) break;
-        if (fits[c].reprojection_error_px < best->reprojection_error_px) best = &fits[c];
+        if ((fits[c].X - fits[best].X).norm() > kJumpGate_m) best = -1;
+        if (best < 0) break;
+        if (fits[c].reprojection_error_px < fits[best].reprojection_error_px) best = c;
       }
-      if (!best) {
+      if (best < 0) {
         ++out.ambiguous;
         continue;
       }
@@ -491,14 +572,17 @@ PenTrack track_pen(const DeviceStreams& streams, const Camera& c0, const Camera&
       filter = OneEuroState{};
     }
     const int64_t t_us = std::llround(t);
-    const std::optional<Vec3> smooth = one_euro_step(filter, options.filter, t_us, best->X);
+    const Triangulation& tri = fits[best];
+    const std::optional<Vec3> smooth = one_euro_step(filter, options.filter, t_us, tri.X);
     if (!smooth) {
       ++out.rejected_filter;
       continue;
     }
-    out.samples.push_back({t_us, out.strokes - 1, static_cast<uint32_t>(k), best->X, *smooth, best->reprojection_error_px});
+    out.samples.push_back({t_us, out.strokes - 1, static_cast<uint32_t>(k), tri.X, *smooth, tri.reprojection_error_px});
     last_sample_t = t;
-    last_position = best->X;
+    last_seen_t = t;
+    last_position = tri.X;
+    pen_px = {f0.blobs[k][fit_blobs[best][0]], ip.px[fit_blobs[best][1]]};
   }
   return out;
 }

@@ -101,7 +101,14 @@ struct PenTrackOptions {
   // Tuned on the simulated rig (perf/RESULTS.md): the static error falls, the error at 0.5 m/s
   // grows by a few tenths of a millimetre of lag.
   OneEuroParams filter{.min_cutoff_hz = 1.0, .beta = 300.0, .derivative_cutoff_hz = 2.0};
-  int64_t max_gap_us = 60000;  // the pen stays down through shorter losses of the LED
+  // The pen stays down through losses of the LED by both cameras up to max_gap_us (a hand or the object
+  // hiding it from both) when it is seen again where a drawing hand could have moved it; after a gap
+  // longer than short_gap_us, a pen seen elsewhere starts a new stroke.
+  int64_t max_gap_us = 300000;
+  int64_t short_gap_us = 60000;
+  // ... and through losses by one camera up to max_bridge_us, followed on the ray of the camera that
+  // still sees it (the pen's blob there moving on from its last pixel).
+  int64_t max_bridge_us = 1000000;
 };
 
 struct PenSample {
@@ -121,9 +128,12 @@ struct PenTrack {
   size_t rejected_jump = 0;          // pen down, but every fitting pair far from the last position
   size_t ambiguous = 0;              // pen up, and fitting pairs that disagree (a stray blob on the LED's epipolar line)
   size_t rejected_filter = 0;        // samples the filter refused (non-finite, or time not advancing)
+  size_t bridged_frames = 0;         // pen down and seen by one camera only: followed on its ray, no sample
 };
 
-// The pen is down while both cameras see its LED (shorter gaps than max_gap_us are bridged).
+// The pen is down while both cameras see its LED; it stays down through gaps of both cameras shorter
+// than max_gap_us, and through gaps of one camera shorter than max_bridge_us while the other camera's
+// ray keeps passing near the pen (the stroke's polyline then joins the samples on either side).
 // Each camera 0 blob is paired with each interpolated camera 1 blob and triangulated; pairs
 // beyond the reprojection threshold are rejected, and of the rest the one nearest the pen's last
 // position is the pen, so a stray reflection in one camera is ignored. Samples are filtered per stroke.

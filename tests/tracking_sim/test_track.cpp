@@ -146,16 +146,25 @@ TEST_CASE("a stray blob on the pen's epipolar line in one camera is never taken 
 TEST_CASE("the pen goes up when the LED is gone longer than the gap, and pen_events writes strokes") {
   const Rig rig;
   DeviceStreams s;
-  auto seen = [](double t) { return t < 1.0 || (t >= 1.04 && t < 2.0) || t >= 2.5; };  // 40 ms and 500 ms dark
+  // Both cameras dark for 40 ms (bridged), camera 0 alone for 300 ms (a hand passing: followed on camera
+  // 1's ray), both for 500 ms (the pen lifted).
+  auto dark_both = [](double t) { return (t >= 1.0 && t < 1.04) || (t >= 2.0 && t < 2.5); };
+  auto dark_0 = [&](double t) { return dark_both(t) || (t >= 1.5 && t < 1.8); };
   for (double t = 0.0; t < 3.0; t += 0.010) {
-    if (seen(t))
+    if (!dark_0(t))
       push_frame(s.cameras[0], t * 1e6, {rig.c0.project(pen_path(t))});
     else
       push_frame(s.cameras[0], t * 1e6, {});
   }
-  for (double t = 0.005; t < 3.0; t += 0.010) push_frame(s.cameras[1], t * 1e6, {rig.c1.project(pen_path(t))});
+  for (double t = 0.005; t < 3.0; t += 0.010) {
+    if (!dark_both(t))
+      push_frame(s.cameras[1], t * 1e6, {rig.c1.project(pen_path(t))});
+    else
+      push_frame(s.cameras[1], t * 1e6, {});
+  }
   const PenTrack track = track_pen(s, rig.c0, rig.c1, 0.0, PenTrackOptions{});
   CHECK(track.strokes == 2);
+  CHECK(track.bridged_frames >= 25);
   const std::vector<InputEvent> ev = pen_events(track);
   REQUIRE(ev.size() == track.samples.size() + 4);
   CHECK(ev.front().kind == EventKind::Down);
@@ -178,6 +187,28 @@ TEST_CASE("the pen goes up when the LED is gone longer than the gap, and pen_eve
   }
   REQUIRE(stroke.size() > 10);
   for (size_t k = 1; k + 1 < stroke.size(); ++k) CHECK(std::abs((stroke[k] - stroke[k - 1]).norm() - 0.005) < 1e-4);
+}
+
+TEST_CASE("after both cameras lose the pen, it continues the stroke only where a hand could have moved it") {
+  const Rig rig;
+  for (const double jump_m : {0.0, 0.3}) {
+    INFO("jump " << jump_m);
+    // Both cameras dark for 200 ms; then the pen is seen on its path again, or 30 cm away from it.
+    auto where = [&](double t) -> Vec3 { return pen_path(t) + Vec3(t >= 1.2 ? jump_m : 0.0, 0, 0); };
+    auto dark = [](double t) { return t >= 1.0 && t < 1.2; };
+    DeviceStreams s;
+    for (double t = 0.0; t < 2.0; t += 0.010) {
+      if (dark(t)) push_frame(s.cameras[0], t * 1e6, {});
+      else push_frame(s.cameras[0], t * 1e6, {rig.c0.project(where(t))});
+    }
+    for (double t = 0.005; t < 2.0; t += 0.010) {
+      if (dark(t)) push_frame(s.cameras[1], t * 1e6, {});
+      else push_frame(s.cameras[1], t * 1e6, {rig.c1.project(where(t))});
+    }
+    const PenTrack track = track_pen(s, rig.c0, rig.c1, 0.0, PenTrackOptions{});
+    CHECK(track.strokes == (jump_m > 0 ? 2u : 1u));
+    CHECK(track.rejected_jump == 0);
+  }
 }
 
 TEST_CASE("bad device reports are counted and skipped; the good ones are kept") {

@@ -190,6 +190,7 @@ struct TrackArgs {
   std::optional<double> time_offset_ms;
   PenTrackOptions options;
   double max_gap_ms = static_cast<double>(PenTrackOptions{}.max_gap_us) * 1e-3;
+  double max_bridge_ms = static_cast<double>(PenTrackOptions{}.max_bridge_us) * 1e-3;
   double simplify_mm = 0, resample_mm = 0;
   double settle_s = 0.25;
 };
@@ -209,12 +210,14 @@ int run_track(const TrackArgs& a) {
   for (auto [value, name] : {std::pair{args.options.max_reprojection_px, "--max-reprojection-px"}, {f.min_cutoff_hz, "--min-cutoff"},
                              {f.derivative_cutoff_hz, "--dcutoff"}})
     if (!std::isfinite(value) || !(value > 0)) return fail(command, std::string(name) + " must be a positive number");
-  for (auto [value, name] : {std::pair{f.beta, "--beta"}, {args.max_gap_ms, "--max-gap-ms"}, {args.simplify_mm, "--simplify-mm"},
+  for (auto [value, name] : {std::pair{f.beta, "--beta"}, {args.max_gap_ms, "--max-gap-ms"}, {args.max_bridge_ms, "--max-bridge-ms"},
+                             {args.simplify_mm, "--simplify-mm"},
                              {args.resample_mm, "--resample-mm"}, {args.settle_s, "--settle-s"}})
     if (!std::isfinite(value) || value < 0) return fail(command, std::string(name) + " must be a non-negative number");
   if (args.time_offset_ms && !(std::abs(*args.time_offset_ms) < 1e6))
     return fail(command, "--time-offset-ms must be a finite number of milliseconds");
   args.options.max_gap_us = std::llround(args.max_gap_ms * 1e3);
+  args.options.max_bridge_us = std::llround(args.max_bridge_ms * 1e3);
 
   Result<std::string> rig_text = read_text_file(args.rig_path);
   if (!rig_text) return fail(command, rig_text.error());
@@ -263,6 +266,7 @@ int run_track(const TrackArgs& a) {
   out["rejected_jump"] = track.rejected_jump;
   out["ambiguous"] = track.ambiguous;
   out["rejected_filter"] = track.rejected_filter;
+  out["bridged_frames"] = track.bridged_frames;
   out["rejected_reports"] = streams.counts.rejected_reports();
   out["reports"] = report_counts_json(streams.counts, truth.rejected_lines);
   if (args.truth) {
@@ -354,7 +358,11 @@ void add_tracking_commands(CLI::App& app, Registry& registry) {
   t->add_option("--beta", tr->options.filter.beta, "One Euro filter: cutoff increase per m/s")->capture_default_str();
   t->add_option("--dcutoff", tr->options.filter.derivative_cutoff_hz, "One Euro filter: cutoff of the speed estimate, Hz")
       ->capture_default_str();
-  t->add_option("--max-gap-ms", tr->max_gap_ms, "the pen stays down through shorter losses of the LED")->capture_default_str();
+  t->add_option("--max-gap-ms", tr->max_gap_ms, "the pen stays down through shorter losses of the LED by both cameras")
+      ->capture_default_str();
+  t->add_option("--max-bridge-ms", tr->max_bridge_ms,
+                "the pen stays down through shorter losses by one camera, followed on the other camera's ray")
+      ->capture_default_str();
   t->add_option("--simplify-mm", tr->simplify_mm, "Ramer-Douglas-Peucker tolerance for the written strokes (0: off)")->capture_default_str();
   t->add_option("--resample-mm", tr->resample_mm, "arc-length spacing of the written strokes, after simplifying (0: off)")
       ->capture_default_str();
