@@ -1,8 +1,10 @@
 #pragma once
 // Hand-made curve networks for the reconstruction tests.
 #include <functional>
+#include <random>
 #include <vector>
 
+#include "engine/edit_command.hpp"
 #include "engine/mesh.hpp"
 
 namespace fire::test {
@@ -24,5 +26,9 @@ Mesh grid_network(uint32_t nx, uint32_t ny, uint32_t samples, const Height& heig
 // Catmull-Clark limit curves of the kept lines, sampled at the limit positions of their level-`levels`
 // vertices (2^levels samples per control edge). Its FIRE base mesh has the control grid's topology.
 Mesh limit_grid_network(uint32_t m, uint32_t levels, const Height& height);
+
+// A curve across a random live face between two random points of its border, bowed up. Mostly between
+// points inside two different edges; one in sixteen may end anywhere, which can make 2-sided faces.
+EditCommand random_split(const Mesh& m, std::mt19937_64& rng);
 
 }  // namespace fire::test
