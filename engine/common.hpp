@@ -1,6 +1,7 @@
 #pragma once
 // Types every part of FIRE shares: the point type and a checked result for the boundaries.
 #include <Eigen/Core>
+#include <cstdint>
 #include <optional>
 #include <span>
 #include <string>
@@ -9,6 +10,9 @@
 namespace fire {
 
 using Vec3 = Eigen::Vector3d;
+
+// "No element": the index every pool, map and topology array uses for an absent slot.
+inline constexpr uint32_t kNone = 0xFFFFFFFFu;
 
 // A value or the reason there is none. Used where input from outside can be wrong
 // (files, devices, user commands); inside the frame loop errors are data, not exceptions.

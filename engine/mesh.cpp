@@ -187,26 +187,42 @@ uint32_t Mesh::add_edge(uint32_t v0, uint32_t v1, std::span<const Vec3> polyline
   return e;
 }
 
-uint32_t Mesh::add_face(std::span<const uint32_t> loop) {
-  if (loop.empty()) return kNone;
+bool Mesh::loop_fits(std::span<const uint32_t> loop, uint32_t f) const {
+  if (loop.empty()) return false;
   for (size_t k = 0; k < loop.size(); ++k) {
-    uint32_t oe = loop[k];
-    if (!edge_alive(edge_of(oe)) || edges.face[edge_of(oe)][is_reversed(oe)] != kNone) return kNone;
-    if (head(oe) != tail(loop[(k + 1) % loop.size()])) return kNone;
+    const uint32_t oe = loop[k], e = edge_of(oe);
+    if (!edge_alive(e)) return false;
+    const uint32_t side = edges.face[e][is_reversed(oe)];
+    if (side != kNone && side != f) return false;
+    if (head(oe) != tail(loop[(k + 1) % loop.size()])) return false;
     for (size_t q = 0; q < k; ++q)
-      if (edge_of(loop[q]) == edge_of(oe)) return kNone;
+      if (edge_of(loop[q]) == e) return false;
   }
-  bool fresh = faces.free_list.empty();
-  uint32_t f = allocate(faces.free_list, faces.generation, faces.flags, faces.changes);
-  uint32_t offset = static_cast<uint32_t>(face_edges.size());
+  return true;
+}
+
+void Mesh::set_loop_sides(std::span<const uint32_t> loop, uint32_t face) {
   for (uint32_t oe : loop) {
-    face_edges.push_back(oe);
     auto fs = edges.face[edge_of(oe)];
-    fs[is_reversed(oe)] = f;
+    fs[is_reversed(oe)] = face;
     edges.face.set(edge_of(oe), fs);
     edges.changes.touch(edge_of(oe), frame_);
   }
+}
+
+uint32_t Mesh::append_loop(std::span<const uint32_t> loop, uint32_t face) {
+  const uint32_t offset = static_cast<uint32_t>(face_edges.size());
+  for (uint32_t oe : loop) face_edges.push_back(oe);
   face_edge_changes.note(offset, static_cast<uint32_t>(face_edges.size()), frame_);
+  set_loop_sides(loop, face);
+  return offset;
+}
+
+uint32_t Mesh::add_face(std::span<const uint32_t> loop) {
+  if (!loop_fits(loop, kNone)) return kNone;
+  const bool fresh = faces.free_list.empty();
+  const uint32_t f = allocate(faces.free_list, faces.generation, faces.flags, faces.changes);
+  const uint32_t offset = append_loop(loop, f);
   if (fresh) {
     faces.edge_offset.push_back(offset);
     faces.edge_count.push_back(static_cast<uint32_t>(loop.size()));
@@ -218,43 +234,16 @@ uint32_t Mesh::add_face(std::span<const uint32_t> loop) {
 }
 
 bool Mesh::set_face_loop(uint32_t f, std::span<const uint32_t> loop) {
-  if (loop.empty()) return false;
-  for (size_t k = 0; k < loop.size(); ++k) {
-    uint32_t oe = loop[k], e = edge_of(oe);
-    uint32_t side = edges.face[e][is_reversed(oe)];
-    if (!edge_alive(e) || (side != kNone && side != f)) return false;
-    if (head(oe) != tail(loop[(k + 1) % loop.size()])) return false;
-    for (size_t q = 0; q < k; ++q)
-      if (edge_of(loop[q]) == e) return false;
-  }
-  for (uint32_t oe : face_loop(f)) {
-    auto fs = edges.face[edge_of(oe)];
-    fs[is_reversed(oe)] = kNone;
-    edges.face.set(edge_of(oe), fs);
-    edges.changes.touch(edge_of(oe), frame_);
-  }
-  face_edge_changes.note(static_cast<uint32_t>(face_edges.size()), static_cast<uint32_t>(face_edges.size() + loop.size()),
-                        frame_);
-  faces.edge_offset.set(f, static_cast<uint32_t>(face_edges.size()));
+  if (!loop_fits(loop, f)) return false;
+  set_loop_sides(face_loop(f), kNone);
+  faces.edge_offset.set(f, append_loop(loop, f));
   faces.edge_count.set(f, static_cast<uint32_t>(loop.size()));
-  for (uint32_t oe : loop) {
-    face_edges.push_back(oe);
-    auto fs = edges.face[edge_of(oe)];
-    fs[is_reversed(oe)] = f;
-    edges.face.set(edge_of(oe), fs);
-    edges.changes.touch(edge_of(oe), frame_);
-  }
   faces.changes.touch(f, frame_);
   return true;
 }
 
 void Mesh::remove_face(uint32_t f) {
-  for (uint32_t oe : face_loop(f)) {
-    auto fs = edges.face[edge_of(oe)];
-    fs[is_reversed(oe)] = kNone;
-    edges.face.set(edge_of(oe), fs);
-    edges.changes.touch(edge_of(oe), frame_);
-  }
+  set_loop_sides(face_loop(f), kNone);
   release(f, faces.free_list, faces.generation, faces.flags, faces.changes);
 }
 

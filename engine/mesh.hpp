@@ -24,8 +24,6 @@
 
 namespace fire {
 
-inline constexpr uint32_t kNone = 0xFFFFFFFFu;
-
 // A typed reference that outlives a frame: the slot index plus the generation the slot had.
 template <class Tag>
 struct Handle {
@@ -204,6 +202,12 @@ class Mesh {
   CompactionRecord last_compaction_;
   void link_edge(uint32_t e);
   void unlink_edge(uint32_t e);
+  // Whether `loop` is a closed walk of live edges, none twice, whose sides are free or already f's.
+  bool loop_fits(std::span<const uint32_t> loop, uint32_t f) const;
+  // Names `face` (or kNone) on the side of each edge that the loop walks.
+  void set_loop_sides(std::span<const uint32_t> loop, uint32_t face);
+  // Appends the loop to face_edges for `face`, naming it on the edges; returns the loop's offset.
+  uint32_t append_loop(std::span<const uint32_t> loop, uint32_t face);
 };
 
 struct MeshMark {

@@ -26,8 +26,8 @@
 //      a factor 6 per solve on smooth data) to a surface through every sample, which phase 2's creep
 //      does not reach (test_reconstruct's exact grid). The fit keeps phase 3's solution only if its
 //      fitted points lie closer to the polylines (sum of squared distances) than phase 2's.
-//   Without phase 2 the split points freeze where phase 1 left them: pawn K=2 network_max 9.7e-4; with
-//   it 1.4e-4 (perf/RESULTS.md).
+//   Without phase 2 the split points freeze where phase 1 left them (perf/RESULTS.md has the pawn's
+//   network_max with and without it).
 // Each phase stops when no target moves more than `tolerance` times the base mesh's size.
 #include <memory>
 #include <vector>

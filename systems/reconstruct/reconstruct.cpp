@@ -63,8 +63,8 @@ Status check_reconstruction_input(const Mesh& net, const Options& options) {
   if (options.coons_steps < 1 || options.coons_steps > kMaxCoonsSteps)
     return Status::failure("the number of Coons steps must be 1 to " + std::to_string(kMaxCoonsSteps) + ", not " +
                            std::to_string(options.coons_steps));
-  if (options.levels < 1 || options.levels > kMaxLevels)
-    return Status::failure("the subdivision level must be 1 to " + std::to_string(kMaxLevels) + ", not " +
+  if (options.levels < 1 || options.levels > kMaxSurfaceLevels)
+    return Status::failure("the subdivision level must be 1 to " + std::to_string(kMaxSurfaceLevels) + ", not " +
                            std::to_string(options.levels));
   if (!(options.fairness >= 0 && options.fairness <= 1))
     return Status::failure("the fairness weight must be 0 to 1, not " + std::to_string(options.fairness));

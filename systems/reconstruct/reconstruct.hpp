@@ -30,12 +30,13 @@
 namespace fire::reconstruct {
 
 inline constexpr uint32_t kMaxCoonsSteps = 5;
-inline constexpr uint32_t kMaxLevels = 6;
+// Surface levels the options allow (the Catmull-Clark library itself refines further).
+inline constexpr uint32_t kMaxSurfaceLevels = 6;
 
 struct Options {
   Method method = Method::fire;
   uint32_t coons_steps = 1;                        // N, 1 .. kMaxCoonsSteps
-  uint32_t levels = 3;                             // L, 1 .. kMaxLevels
+  uint32_t levels = 3;                             // L, 1 .. kMaxSurfaceLevels
   Planarity planarity = Planarity::least_squares;  // the thesis's triquadrification measure
   // FIRE: weight of the fit's fairness term (systems/reconstruct/fit.hpp), 0 to 1. It chooses the face
   // interiors the curves leave open; larger is smoother, smaller follows exactly representable data

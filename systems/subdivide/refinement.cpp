@@ -412,9 +412,9 @@ class ChildBuilder {
 
 namespace detail {
 Result<Refinement> build_levels(const BaseTopology& base, const RefinementOptions& options) {
-  if (options.levels < 0 || options.levels > kMaxLevels)
+  if (options.levels < 0 || options.levels > kMaxRefinementLevels)
     return Result<Refinement>::failure("subdivision level " + std::to_string(options.levels) +
-                                       " is outside 0 .. " + std::to_string(kMaxLevels));
+                                       " is outside 0 .. " + std::to_string(kMaxRefinementLevels));
   if (Status valid = validate_base(base); !valid) return Result<Refinement>::failure(valid.error);
   if (Status fits = check_sizes(base, options.levels); !fits) return Result<Refinement>::failure(fits.error);
   Result<Level> base_level = build_base_level(base);

@@ -11,7 +11,7 @@
 // evaluate() applies them level by level, so moving the base points re-evaluates every level without
 // touching topology. stencil_table() writes the same stencils out as explicit (source, weight) rows and
 // factorize() composes them into last-level-from-base rows (for solvers that need the matrix); applying
-// those is 2-5x slower than evaluate() (perf/RESULTS.md has the figures).
+// those is slower than evaluate() (perf/RESULTS.md has the figures).
 //
 // Child components follow OpenSubdiv's uniform ordering (Vtr::Refinement with
 // orderVerticesFromFacesFirst = false), so level l of a Refinement has the same vertex, edge and
@@ -30,8 +30,6 @@
 #include "engine/common.hpp"
 
 namespace fire::subdivide {
-
-inline constexpr uint32_t kNone = 0xffffffffu;
 
 // The rule that moves a vertex, from its count of infinitely sharp incident edges (boundary edges
 // included): 0 smooth, 1 dart (moves like smooth), 2 crease, more than 2 corner. A boundary vertex with
@@ -96,12 +94,12 @@ struct StencilTable {
 };
 
 struct RefinementOptions {
-  int levels = 1;  // 0 .. kMaxLevels
+  int levels = 1;  // 0 .. kMaxRefinementLevels
   // The last level's edges and rings, needed for build_limit_stencils; without them only its faces are
   // built (what Far::TopologyRefiner builds by default).
   bool last_level_adjacency = true;
 };
-inline constexpr int kMaxLevels = 10;
+inline constexpr int kMaxRefinementLevels = 10;
 
 // Regular patches, for kMinPatchLevels to kMaxPatchLevels levels. A base quad whose corners are
 // smooth, of valence 4 and surrounded by quads stays a regular grid at every level (a uniform bicubic

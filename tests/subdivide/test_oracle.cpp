@@ -79,7 +79,7 @@ void compare_topology(const sd::Level& ours, const osd::Far::TopologyLevel& thei
     auto faces = theirs.GetEdgeFaces(int(e));
     m.check(uint32_t(verts[0]) == ours.edge_vertices[2 * e] && uint32_t(verts[1]) == ours.edge_vertices[2 * e + 1],
             "edge " + std::to_string(e) + " vertices");
-    const bool boundary = ours.edge_face(e, 1) == sd::kNone;
+    const bool boundary = ours.edge_face(e, 1) == fire::kNone;
     m.check(faces.size() == (boundary ? 1 : 2), "edge " + std::to_string(e) + " face count");
     for (int i = 0; i < faces.size() && i < 2; ++i)
       m.check(uint32_t(faces[i]) == ours.edge_face(e, uint32_t(i)), "edge " + std::to_string(e) + " faces");
@@ -99,7 +99,7 @@ void compare_topology(const sd::Level& ours, const osd::Far::TopologyLevel& thei
       m.check(uint32_t(ends[0] == int(v) ? ends[1] : ends[0]) == ours.ring_neighbors[r0 + i],
               name + " ring neighbour " + std::to_string(i));
       const uint32_t corner = ours.ring_corners[r0 + i];
-      if (corner == sd::kNone) continue;
+      if (corner == fire::kNone) continue;
       m.check(face_slot < uint32_t(faces.size()) && uint32_t(faces[int(face_slot)]) == ours.corner_face(corner),
               name + " ring face " + std::to_string(i));
       ++face_slot;

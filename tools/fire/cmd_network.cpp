@@ -118,7 +118,7 @@ void add_network_commands(CLI::App& app, Registry& registry) {
   replay->add_flag("--no-surface", o->no_surface, "run only input, sketch and split (no refine and subdivide)");
   replay->add_option("--levels", o->surface.levels, "subdivision levels of the surface")
       ->capture_default_str()
-      ->check(CLI::Range(1u, reconstruct::kMaxLevels));
+      ->check(CLI::Range(1u, reconstruct::kMaxSurfaceLevels));
   replay->add_option("--fairness", o->surface.fairness, "fairness weight of the surface fit, 0 to 1")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));

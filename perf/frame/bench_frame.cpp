@@ -1,0 +1,190 @@
+// The live frame's latency: replays drawings through every system of the session (input, sketch,
+// split, refine, subdivide) on one core and reports the time of each frame with input (thread CPU
+// time: the machine is shared) as p50, p99 and max, per system and for the whole frame, plus how many
+// frames pass from the pen-up that commits a curve to the first frame whose surface shows its faces
+// and to the frame where the surface has settled.
+//
+// Drawings: the bundled demo log (a dome, 14 faces) and a grid drawing of 200 faces on a wavy sheet
+// (a border, 19 long curves, then 180 short ones cell by cell), at subdivision levels 2 and 3.
+//
+//   bench_frame [--write-grid-log FILE]    (the grid drawing as an input log, for callgrind)
+#include <time.h>
+
+#include <algorithm>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "platform/files.hpp"
+#include "tools/fire/session.hpp"
+
+using namespace fire;
+
+namespace {
+
+int64_t thread_cpu_ns() {
+  timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return int64_t(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
+}
+
+double sheet(double x, double y) { return 0.015 * std::sin(12 * x) * std::cos(9 * y); }
+
+// The grid drawing: cells of 2 cm, 20 across and 10 up; strokes at 100 Hz, 5 mm apart, half a second
+// between strokes, with a fixed +-0.2 mm jitter inside every stroke.
+std::vector<InputEvent> grid_drawing(int nx, int ny) {
+  const double cell = 0.02, W = nx * cell, H = ny * cell;
+  std::vector<InputEvent> out;
+  int64_t t = 1'000'000;
+  uint64_t state = 12345;
+  auto jitter = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return (double(state >> 11) / 9007199254740992.0 - 0.5) * 0.0004;
+  };
+  auto event = [&](EventKind kind, const Vec3& p = Vec3::Zero()) {
+    InputEvent e;
+    e.t_us = t;
+    e.kind = kind;
+    e.p = p;
+    out.push_back(e);
+    t += 10'000;
+  };
+  auto stroke = [&](double ax, double ay, double bx, double by) {
+    const int n = std::max(2, int(std::hypot(bx - ax, by - ay) / 0.005) + 1);
+    event(EventKind::Down);
+    for (int i = 0; i < n; ++i) {
+      const double s = double(i) / (n - 1), x = ax + s * (bx - ax), y = ay + s * (by - ay);
+      const bool end = i == 0 || i == n - 1;
+      event(EventKind::Pen, Vec3(x + (end ? 0 : jitter()), y + (end ? 0 : jitter()), sheet(x, y)));
+    }
+    event(EventKind::Up);
+    t += 500'000;
+  };
+  stroke(0, 0, W, 0);
+  stroke(W, 0, W, H);
+  stroke(W, H, 0, H);
+  stroke(0, H, 0.0005, 0.0005);
+  for (int i = 1; i < nx; ++i) stroke(i * cell, 0, i * cell, H);
+  for (int i = 0; i < nx; ++i)
+    for (int j = 1; j < ny; ++j) stroke(i * cell, j * cell, (i + 1) * cell, j * cell);
+  return out;
+}
+
+struct Run {
+  std::vector<int64_t> frame_ns;              // every frame that ran
+  std::vector<std::vector<int64_t>> system_ns;  // per system, per frame
+  std::vector<std::string> names;
+  std::vector<int64_t> commit_frame_ns;       // frames that committed a curve
+  std::vector<int64_t> shown_after, settled_after;  // frames from a commit to shown / settled
+  size_t faces = 0, quads = 0, rejections = 0;
+  std::string problem;
+};
+
+Run replay(const std::vector<InputEvent>& events, uint32_t levels, double snap) {
+  World w;
+  w.log.events = events;
+  w.sketch_settings.snap_distance = snap;
+  w.surface_options.levels = levels;
+  std::vector<SystemSpec> systems = session_systems(w);
+  auto scheduler = Scheduler::build(std::move(systems), thread_cpu_ns);
+  Run run;
+  if (!scheduler) {
+    run.problem = scheduler.error();
+    return run;
+  }
+  // The replay loop of tools/fire/session.cpp, watching each frame for a commit and for the surface.
+  begin_frame(w, 0, w.log.events.front().t_us);
+  int64_t pending_commit = -1;  // frame index of a commit whose faces are not shown yet
+  while (w.cursor.next < w.log.events.size() || !w.sketch.pending.empty()) {
+    if (w.sketch.pending.empty() && w.log.events[w.cursor.next].t_us >= w.frame.end_us) {
+      const int64_t steps = (w.log.events[w.cursor.next].t_us - w.frame.begin_us) / kFrameStepUs;
+      begin_frame(w, w.frame.index + uint64_t(steps), w.frame.begin_us + steps * kFrameStepUs);
+    }
+    const size_t edits_before = w.history.undo_depth();
+    const uint64_t updates_before = w.surface_build.updates;
+    scheduler->run_frame();
+    const int64_t ns = scheduler->frame_timing().samples_ns.back();
+    if (w.history.undo_depth() > edits_before) {
+      run.commit_frame_ns.push_back(ns);
+      pending_commit = int64_t(w.frame.index);
+    }
+    if (pending_commit >= 0 && w.surface_build.updates > updates_before && w.surface.frame == w.frame.index) {
+      run.shown_after.push_back(int64_t(w.frame.index) - pending_commit);
+      if (w.surface.settled) run.settled_after.push_back(int64_t(w.frame.index) - pending_commit);
+      pending_commit = -1;
+    }
+    begin_frame(w, w.frame.index + 1, w.frame.end_us);
+  }
+  run.frame_ns = scheduler->frame_timing().samples_ns;
+  for (const SystemTiming& t : scheduler->timings()) {
+    run.names.push_back(t.name);
+    run.system_ns.push_back(t.samples_ns);
+  }
+  run.faces = w.mesh.face_count();
+  run.quads = w.surface.quad_count();
+  run.rejections = w.rejections.size();
+  run.problem = w.surface_build.problem;
+  return run;
+}
+
+double percentile_ms(std::vector<int64_t> v, double p) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  size_t rank = size_t(std::ceil(p / 100.0 * double(v.size())));
+  rank = std::clamp<size_t>(rank, 1, v.size());
+  return double(v[rank - 1]) / 1e6;
+}
+
+void report(const char* drawing, uint32_t levels, const Run& r) {
+  if (!r.problem.empty()) std::printf("%s L%u: the surface stopped following: %s\n", drawing, levels, r.problem.c_str());
+  std::printf("| %s | %u | %zu faces, %zu quads | %zu | %.2f | %.2f | %.2f | %.2f | %.2f | %" PRId64 " | %" PRId64 " |\n",
+              drawing, levels, r.faces, r.quads, r.frame_ns.size(), percentile_ms(r.frame_ns, 50),
+              percentile_ms(r.frame_ns, 99), percentile_ms(r.frame_ns, 100), percentile_ms(r.commit_frame_ns, 50),
+              percentile_ms(r.commit_frame_ns, 100),
+              r.shown_after.empty() ? -1 : *std::max_element(r.shown_after.begin(), r.shown_after.end()),
+              r.settled_after.empty() ? -1 : *std::max_element(r.settled_after.begin(), r.settled_after.end()));
+}
+
+void report_systems(const char* drawing, uint32_t levels, const Run& r) {
+  for (size_t s = 0; s < r.names.size(); ++s)
+    std::printf("| %s | %u | %s | %.3f | %.3f | %.3f |\n", drawing, levels, r.names[s].c_str(),
+                percentile_ms(r.system_ns[s], 50), percentile_ms(r.system_ns[s], 99), percentile_ms(r.system_ns[s], 100));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::vector<InputEvent> grid = grid_drawing(20, 10);
+  if (argc == 3 && std::strcmp(argv[1], "--write-grid-log") == 0) {
+    if (Status s = write_file_atomic(argv[2], format_input_log(grid)); !s) {
+      std::fprintf(stderr, "bench_frame: %s\n", s.error.c_str());
+      return 1;
+    }
+    return 0;
+  }
+  if (argc != 1) {
+    std::fprintf(stderr, "usage: bench_frame [--write-grid-log FILE]\n");
+    return 2;
+  }
+  auto demo = read_input_log(FIRE_SOURCE_DIR "/tools/demo/sketch.log");
+  if (!demo) {
+    std::fprintf(stderr, "bench_frame: %s\n", demo.error().c_str());
+    return 1;
+  }
+  std::printf("# bench_frame: every frame with input, thread CPU time, one core\n\n");
+  std::printf("| drawing | L | final | frames | p50 ms | p99 ms | max ms | commit p50 ms | commit max ms | "
+              "shown after (frames) | settled after (frames) |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::vector<std::pair<std::string, std::pair<uint32_t, Run>>> runs;
+  for (uint32_t levels : {2u, 3u}) {
+    runs.push_back({"demo dome", {levels, replay(demo->events, levels, SketchSettings{}.snap_distance)}});
+    report("demo dome", levels, runs.back().second.second);
+    runs.push_back({"grid 200", {levels, replay(grid, levels, 0.005)}});
+    report("grid 200", levels, runs.back().second.second);
+  }
+  std::printf("\n| drawing | L | system | p50 ms | p99 ms | max ms |\n|---|---|---|---|---|---|\n");
+  for (const auto& [name, lr] : runs) report_systems(name.c_str(), lr.first, lr.second);
+  return 0;
+}

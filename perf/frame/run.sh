@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# tools/run bench frame: the frame latency table (bench_frame), then instructions and cache misses per
+# system under callgrind (valgrind 3.19's cachegrind cannot split per function): one run of `fire
+# replay` per drawing with --cache-sim=yes, each system's inclusive cost read off callgrind_annotate.
+# Drawings under callgrind: the bundled demo (whole) and the grid drawing's first 30 strokes (the
+# whole one takes tens of minutes there).
+#   perf/frame/run.sh   (FIRE_BUILD_DIR selects the build folder, default build/)
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+build="${FIRE_BUILD_DIR:-$here/build}"
+"$build/perf/frame/bench_frame"
+
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+"$build/perf/frame/bench_frame" --write-grid-log "$tmp/grid.log"
+# The first 30 strokes: everything up to the 30th pen-up.
+awk '/ up$/ { n++ } { print } n == 30 { exit }' "$tmp/grid.log" >"$tmp/grid30.log"
+
+systems=(input_system sketch_system split_system refine_system subdivide_system)
+echo
+echo "| drawing | system | instructions | D1 misses | LL misses | D1 misses per 1000 instructions |"
+echo "|---|---|---|---|---|---|"
+for drawing in demo grid30; do
+  log="$here/tools/demo/sketch.log"
+  snap=0.01
+  [ "$drawing" = grid30 ] && { log="$tmp/grid30.log"; snap=0.005; }
+  echo "perf/frame/run.sh: callgrind over $drawing (a few minutes)" >&2
+  valgrind --tool=callgrind --cache-sim=yes --callgrind-out-file="$tmp/cg.$drawing" \
+    "$build/fire" replay "$log" --snap "$snap" >/dev/null 2>"$tmp/vg.$drawing" ||
+    { cat "$tmp/vg.$drawing" >&2; exit 1; }
+  callgrind_annotate --inclusive=yes "$tmp/cg.$drawing" >"$tmp/ann.$drawing"
+  # Event order in the annotation: Ir Dr Dw I1mr D1mr D1mw ILmr DLmr DLmw.
+  for s in "${systems[@]}"; do
+    line=$(grep -E "fire::${s}\(" "$tmp/ann.$drawing" | head -1 || true)
+    [ -n "$line" ] || { echo "| $drawing | ${s%_system} | not run | | | |"; continue; }
+    read -r ir dr dw i1 d1r d1w il dlr dlw _ <<<"$(tr -d ',' <<<"$line")"
+    awk -v d="$drawing" -v s="${s%_system}" -v ir="$ir" -v d1="$((d1r + d1w))" -v ll="$((dlr + dlw))" \
+      'BEGIN { printf "| %s | %s | %d | %d | %d | %.2f |\n", d, s, ir, d1, ll, ir ? 1000 * d1 / ir : 0 }'
+  done
+done
