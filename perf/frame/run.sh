@@ -24,15 +24,18 @@ for drawing in demo grid30; do
   snap=0.01
   [ "$drawing" = grid30 ] && { log="$tmp/grid30.log"; snap=0.005; }
   echo "perf/frame/run.sh: callgrind over $drawing (a few minutes)" >&2
+  # The same caches as perf/layouts: this VM reports a bogus L3, so LL is the per-core L2.
   valgrind --tool=callgrind --cache-sim=yes --callgrind-out-file="$tmp/cg.$drawing" \
+    --I1=32768,8,64 --D1=49152,12,64 --LL=1048576,8,64 \
     "$build/fire" replay "$log" --snap "$snap" >/dev/null 2>"$tmp/vg.$drawing" ||
     { cat "$tmp/vg.$drawing" >&2; exit 1; }
-  callgrind_annotate --inclusive=yes "$tmp/cg.$drawing" >"$tmp/ann.$drawing"
-  # Event order in the annotation: Ir Dr Dw I1mr D1mr D1mw ILmr DLmr DLmw.
+  callgrind_annotate --inclusive=yes --threshold=100 "$tmp/cg.$drawing" >"$tmp/ann.$drawing"
+  # Event order in the annotation: Ir Dr Dw I1mr D1mr D1mw ILmr DLmr DLmw, each count followed by its
+  # share in parentheses; a zero count is printed as ".".
   for s in "${systems[@]}"; do
     line=$(grep -E "fire::${s}\(" "$tmp/ann.$drawing" | head -1 || true)
     [ -n "$line" ] || { echo "| $drawing | ${s%_system} | not run | | | |"; continue; }
-    read -r ir dr dw i1 d1r d1w il dlr dlw _ <<<"$(tr -d ',' <<<"$line")"
+    read -r ir dr dw i1 d1r d1w il dlr dlw _ <<<"$(sed -E 's/\( *[0-9.]+%\)//g; s/,//g; s/ \. / 0 /g; s/ \. / 0 /g' <<<"$line")"
     awk -v d="$drawing" -v s="${s%_system}" -v ir="$ir" -v d1="$((d1r + d1w))" -v ll="$((dlr + dlw))" \
       'BEGIN { printf "| %s | %s | %d | %d | %d | %.2f |\n", d, s, ir, d1, ll, ir ? 1000 * d1 / ir : 0 }'
   done
