@@ -69,15 +69,15 @@ size_t om_edges = 0;
 // objects a long-running program allocates while it builds its points.
 std::vector<void*> junk;
 
-std::vector<uint32_t> perm;                // random order of point indices
-std::vector<int> perm_edge;                // the same order as (edge, index in its polyline) for OpenMesh
+std::vector<uint32_t> perm;  // random order of point indices
+std::vector<int> perm_edge;  // the same order as (edge, index in its polyline) for OpenMesh
 std::vector<uint32_t> perm_offset;
 
 volatile double sink;
 
 enum Variant { S1, S2, S3, S4, S5, S6, S3_FRESH, S4_FRESH, FIRE_POOL, OPENMESH, OPENMESH_FRESH, kVariants };
-const char* const kVariantNames[kVariants] = {"s1", "s2", "s3", "s4", "s5", "s6", "s3_fresh", "s4_fresh",
-                                              "fire", "openmesh", "openmesh_fresh"};
+const char* const kVariantNames[kVariants] = {
+    "s1", "s2", "s3", "s4", "s5", "s6", "s3_fresh", "s4_fresh", "fire", "openmesh", "openmesh_fresh"};
 enum Op { SEQ_READ, SEQ_WRITE, RAND_READ, RAND_WRITE, kOps };
 const char* const kOpNames[kOps] = {"seq_read", "seq_write", "rand_read", "rand_write"};
 
@@ -164,8 +164,7 @@ void setup(Variant v, size_t n) {
       }
       break;
     }
-    case kVariants:
-      break;
+    case kVariants: break;
   }
 }
 
@@ -215,60 +214,64 @@ const double* point_address(Variant v, size_t i) {
 // The loops are written out per layout, with the thesis's access expressions spelled in place, so that -O0
 // executes exactly those expressions; the macros only stamp out the four operations and two caching modes.
 // Inside them: i (flat layouts) or e, o (OpenMesh) name the point, k the iteration, t the value written.
-#define READ_BODY(X)                                        \
+#define READ_BODY(X) \
   for (int k = 0; k < iters; k++) acc += X(0) + X(1) + X(2);
-#define READ_CACHED_BODY(PTR)                                          \
-  {                                                                    \
-    const double* p = PTR;                                             \
-    for (int k = 0; k < iters; k++) acc += p[0] + p[1] + p[2];         \
+#define READ_CACHED_BODY(PTR)                                  \
+  {                                                            \
+    const double* p = PTR;                                     \
+    for (int k = 0; k < iters; k++) acc += p[0] + p[1] + p[2]; \
   }
-#define WRITE_BODY(W)                  \
-  for (int k = 0; k < iters; k++) {    \
-    const double t = base + k;         \
-    W(t)                               \
+#define WRITE_BODY(W)               \
+  for (int k = 0; k < iters; k++) { \
+    const double t = base + k;      \
+    W(t)                            \
   }
-#define WRITE_CACHED_BODY(PTR)         \
-  {                                    \
-    double* p = PTR;                   \
-    for (int k = 0; k < iters; k++) {  \
-      const double t = base + k;       \
-      p[0] = t;                        \
-      p[1] = t + 1.0;                  \
-      p[2] = t + 2.0;                  \
-    }                                  \
+#define WRITE_CACHED_BODY(PTR)        \
+  {                                   \
+    double* p = PTR;                  \
+    for (int k = 0; k < iters; k++) { \
+      const double t = base + k;      \
+      p[0] = t;                       \
+      p[1] = t + 1.0;                 \
+      p[2] = t + 2.0;                 \
+    }                                 \
   }
-#define FOR_SEQ(...) \
-  for (size_t i = first; i < first + m; i++) { __VA_ARGS__ }
-#define FOR_RAND(...)                 \
-  for (size_t r = first; r < first + m; r++) {    \
-    const size_t i = perm[r];         \
-    __VA_ARGS__                       \
+#define FOR_SEQ(...)                           \
+  for (size_t i = first; i < first + m; i++) { \
+    __VA_ARGS__                                \
   }
-#define FOR_EDGE_SEQ(...)                          \
+#define FOR_RAND(...)                          \
+  for (size_t r = first; r < first + m; r++) { \
+    const size_t i = perm[r];                  \
+    __VA_ARGS__                                \
+  }
+#define FOR_EDGE_SEQ(...)                                                        \
   for (size_t e = first / kPointsPerEdge; e < (first + m) / kPointsPerEdge; e++) \
-    for (size_t o = 0; o < kPointsPerEdge; o++) { __VA_ARGS__ }
-#define FOR_EDGE_RAND(...)               \
-  for (size_t r = first; r < first + m; r++) {       \
-    const int e = perm_edge[r];          \
-    const size_t o = perm_offset[r];     \
-    __VA_ARGS__                          \
+    for (size_t o = 0; o < kPointsPerEdge; o++) {                                \
+      __VA_ARGS__                                                                \
+    }
+#define FOR_EDGE_RAND(...)                     \
+  for (size_t r = first; r < first + m; r++) { \
+    const int e = perm_edge[r];                \
+    const size_t o = perm_offset[r];           \
+    __VA_ARGS__                                \
   }
 // One function per layout: op, cached, window [first, first + m), iterations, value written.
-#define LAYOUT_FN(NAME, SEQ, RAND, X, W, PTR)                                                        \
-  double NAME(Op op, bool cached, size_t first, size_t m, int iters, double base) {                 \
-    double acc = 0;                                                                                  \
-    switch (op) {                                                                                    \
-      case SEQ_READ:                                                                                 \
-        if (cached) SEQ(READ_CACHED_BODY(PTR)) else SEQ(READ_BODY(X)) break;                         \
-      case SEQ_WRITE:                                                                                \
-        if (cached) SEQ(WRITE_CACHED_BODY(PTR)) else SEQ(WRITE_BODY(W)) break;                       \
-      case RAND_READ:                                                                                \
-        if (cached) RAND(READ_CACHED_BODY(PTR)) else RAND(READ_BODY(X)) break;                       \
-      case RAND_WRITE:                                                                               \
-        if (cached) RAND(WRITE_CACHED_BODY(PTR)) else RAND(WRITE_BODY(W)) break;                     \
-      case kOps: break;                                                                              \
-    }                                                                                                \
-    return acc;                                                                                      \
+#define LAYOUT_FN(NAME, SEQ, RAND, X, W, PTR)                                       \
+  double NAME(Op op, bool cached, size_t first, size_t m, int iters, double base) { \
+    double acc = 0;                                                                 \
+    switch (op) {                                                                   \
+      case SEQ_READ:                                                                \
+        if (cached) SEQ(READ_CACHED_BODY(PTR)) else SEQ(READ_BODY(X)) break;        \
+      case SEQ_WRITE:                                                               \
+        if (cached) SEQ(WRITE_CACHED_BODY(PTR)) else SEQ(WRITE_BODY(W)) break;      \
+      case RAND_READ:                                                               \
+        if (cached) RAND(READ_CACHED_BODY(PTR)) else RAND(READ_BODY(X)) break;      \
+      case RAND_WRITE:                                                              \
+        if (cached) RAND(WRITE_CACHED_BODY(PTR)) else RAND(WRITE_BODY(W)) break;    \
+      case kOps: break;                                                             \
+    }                                                                               \
+    return acc;                                                                     \
   }
 #define W3(X, t)  \
   X(0) = t;       \
