@@ -51,7 +51,7 @@ TEST_CASE("the demo log replays to the same pools every time", "[replay]") {
     REQUIRE(w->mesh.validate() == "");
     CHECK(w->mesh.face_count() == 14);
     CHECK(w->rejections.size() == 1);
-    CHECK(s.timings().size() == 3);
+    CHECK(s.timings().size() == 4);  // input, sketch, split, snap
     hash = w->mesh.hash();
   }
   CHECK(hashes[0] == hashes[1]);
@@ -137,7 +137,7 @@ TEST_CASE("the demo log exercises every split case, an undo, a redo and a delete
   };
   Scheduler s(fake_clock);
   s.add("input", [&] { input_system(w->log, w->frame, w->cursor, w->frame_events); });
-  s.add("sketch", [&] { sketch_system(w->frame_events, w->mesh, w->sketch_settings, w->sketch, w->requests, w->rejections); });
+  s.add("sketch", [&] { sketch_system(w->frame_events, w->mesh, w->snap, w->sketch_settings, w->sketch, w->requests, w->rejections); });
   s.add("probe", [&] {
     for (const EditRequest& r : w->requests) {
       if (r.kind == RequestKind::Undo) ++seen["undo"];
@@ -147,6 +147,7 @@ TEST_CASE("the demo log exercises every split case, an undo, a redo and a delete
     }
   });
   s.add("split", [&] { split_system(w->requests, w->mesh, w->history, w->rejections); });
+  s.add("snap", [&] { sync_snap_index(*w); });
   replay_headless(*w, s);
   REQUIRE(w->rejections.size() == 1);  // the one stroke meant to be rejected
   for (const char* kind : {"edge-edge", "edge-vertex", "vertex-edge", "vertex-vertex", "undo", "redo", "delete"}) {

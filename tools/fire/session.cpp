@@ -7,9 +7,17 @@ namespace fire {
 Scheduler make_scheduler(World& w, Scheduler::Clock clock) {
   Scheduler s(clock);
   s.add("input", [&w] { input_system(w.log, w.frame, w.cursor, w.frame_events); });
-  s.add("sketch", [&w] { sketch_system(w.frame_events, w.mesh, w.sketch_settings, w.sketch, w.requests, w.rejections); });
+  s.add("sketch", [&w] { sketch_system(w.frame_events, w.mesh, w.snap, w.sketch_settings, w.sketch, w.requests, w.rejections); });
   s.add("split", [&w] { split_system(w.requests, w.mesh, w.history, w.rejections); });
+  s.add("snap", [&w] { sync_snap_index(w); });
   return s;
+}
+
+void sync_snap_index(World& w) {
+  // The index is the only reader of the dirty tags in a session, so it clears them; change stamps will
+  // replace the tags here.
+  w.snap.update(w.mesh, changed_slots(w.mesh.edges.dirty));
+  w.mesh.clear_dirty();
 }
 
 void replay_headless(World& w, Scheduler& scheduler) {
