@@ -1,7 +1,8 @@
 #include "engine/snap_index.hpp"
 
 #include <algorithm>
-#include <array>
+#include <bit>
+#include <cmath>
 #include <utility>
 
 namespace fire {
@@ -14,8 +15,8 @@ double widen(double squared) { return squared * (1.0 + 1e-9); }
 
 double bound_of(double distance) { return widen(distance * distance); }
 
-// Tree height stays logarithmic (AVL balance on insertion and removal, median splits when built), so a
-// fixed stack covers any pool that fits in 32-bit slots.
+// Tree height stays logarithmic (depth_limit below), so a fixed stack covers any pool that fits in
+// 32-bit slots.
 constexpr size_t kStack = 256;
 
 // The exhaustive searches' order on equal distance: lower edge slot, then lower point index.
@@ -42,26 +43,42 @@ std::vector<uint32_t> changed_slots(std::span<const uint8_t> dirty) {
 
 namespace {
 
-void merge_into(double (&lo)[3], double (&hi)[3], const double (&blo)[3], const double (&bhi)[3]) {
+float round_down(double x) {
+  const float f = static_cast<float>(x);
+  return double(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+}
+
+float round_up(double x) {
+  const float f = static_cast<float>(x);
+  return double(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+}
+
+template <class B>
+void merge_into(B& into, const B& b) {
   for (int a = 0; a < 3; ++a) {
-    lo[a] = std::min(lo[a], blo[a]);
-    hi[a] = std::max(hi[a], bhi[a]);
+    into.lo[a] = std::min(into.lo[a], b.lo[a]);
+    into.hi[a] = std::max(into.hi[a], b.hi[a]);
   }
 }
 
-double half_area(const double (&lo)[3], const double (&hi)[3]) {
-  const double x = hi[0] - lo[0], y = hi[1] - lo[1], z = hi[2] - lo[2];
+template <class B>
+double half_area(const B& b) {
+  const double x = double(b.hi[0]) - b.lo[0], y = double(b.hi[1]) - b.lo[1], z = double(b.hi[2]) - b.lo[2];
   return x * y + y * z + z * x;
 }
 
-double squared_gap(const double (&lo)[3], const double (&hi)[3], const Vec3& p) {
+template <class B>
+double squared_gap(const B& b, const Vec3& p) {
   double s = 0;
   for (int a = 0; a < 3; ++a) {
-    const double g = std::max({lo[a] - p[a], 0.0, p[a] - hi[a]});
+    const double g = std::max(std::max(double(b.lo[a]) - p[a], p[a] - double(b.hi[a])), 0.0);
     s += g * g;
   }
   return s;
 }
+
+// The depth a subtree with this many leaves may reach before it is rebuilt.
+int32_t depth_limit(uint32_t leaves) { return 2 * int32_t(std::bit_width(leaves)) + 2; }
 
 }  // namespace
 
@@ -86,11 +103,9 @@ bool SnapIndex::same_polyline(uint32_t e, std::span<const Vec3> line) const {
 void SnapIndex::remove_edge(uint32_t e) {
   if (e >= edge_leaves_.size() || edge_leaves_[e].empty()) return;
   for (uint32_t r : edge_leaves_[e]) {
-    Leaf& l = leaves_[r];
-    remove_leaf(l.node);
-    free_node(l.node);
-    points_ -= l.count;
-    l.edge = kNone;
+    remove_leaf(r | kLeafRef);
+    points_ -= leaves_[r].count;
+    leaves_[r].edge = kNone;
     free_leaves_.push_back(r);
   }
   edge_leaves_[e].clear();
@@ -112,28 +127,25 @@ void SnapIndex::add_leaves(uint32_t e, std::span<const Vec3> line, std::vector<u
     l.edge = e;
     l.first = first;
     l.count = std::min<uint32_t>(kLeafPoints, static_cast<uint32_t>(line.size()) - first);
-    const uint32_t n = new_node();
-    Node& node = nodes_[n];
-    node.child[0] = kNone;
-    node.child[1] = r;
-    node.height = 0;
-    for (int a = 0; a < 3; ++a) {
-      node.box.lo[a] = line[first][a];
-      node.box.hi[a] = line[first][a];
-    }
+    l.parent = kNone;
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) lo[a] = hi[a] = line[first][a];
     for (uint32_t i = 0; i < l.count; ++i) {
       const Vec3& q = line[first + i];
       l.x[i] = q.x();
       l.y[i] = q.y();
       l.z[i] = q.z();
       for (int a = 0; a < 3; ++a) {
-        node.box.lo[a] = std::min(node.box.lo[a], q[a]);
-        node.box.hi[a] = std::max(node.box.hi[a], q[a]);
+        lo[a] = std::min(lo[a], q[a]);
+        hi[a] = std::max(hi[a], q[a]);
       }
     }
-    l.node = n;
+    for (int a = 0; a < 3; ++a) {
+      l.box.lo[a] = round_down(lo[a]);
+      l.box.hi[a] = round_up(hi[a]);
+    }
     edge_leaves_[e].push_back(r);
-    fresh.push_back(n);
+    fresh.push_back(r);
     points_ += l.count;
   }
   ++edges_;
@@ -161,7 +173,7 @@ void SnapIndex::update(const Mesh& mesh, std::span<const uint32_t> changed_edge_
     rebuild();
     return;
   }
-  for (uint32_t n : fresh) insert_leaf(n);
+  for (uint32_t r : fresh) insert_leaf(r | kLeafRef);
 }
 
 void SnapIndex::remap(const CompactionMap& map) {
@@ -182,6 +194,11 @@ void SnapIndex::remap(const CompactionMap& map) {
 
 // ---- the tree
 
+uint32_t SnapIndex::height() const {
+  if (root_ == kNone) return 0;
+  return uint32_t(height_of(root_)) + 1;
+}
+
 uint32_t SnapIndex::new_node() {
   if (!free_nodes_.empty()) {
     const uint32_t n = free_nodes_.back();
@@ -189,201 +206,208 @@ uint32_t SnapIndex::new_node() {
     return n;
   }
   nodes_.emplace_back();
+  parent_.push_back(kNone);
+  height_.push_back(0);
+  leaves_under_.push_back(0);
   return static_cast<uint32_t>(nodes_.size() - 1);
 }
 
-void SnapIndex::free_node(uint32_t n) { free_nodes_.push_back(n); }
+SnapIndex::Box SnapIndex::box_of(uint32_t ref) const {
+  if (ref & kLeafRef) return leaves_[ref & ~kLeafRef].box;
+  Box b = nodes_[ref].box[0];
+  merge_into(b, nodes_[ref].box[1]);
+  return b;
+}
+
+void SnapIndex::replace_child(uint32_t parent, uint32_t old_ref, uint32_t new_ref, const Box& box) {
+  if (parent == kNone) {
+    root_ = new_ref;
+    return;
+  }
+  Node& p = nodes_[parent];
+  const int s = p.child[0] == old_ref ? 0 : 1;
+  p.child[s] = new_ref;
+  p.box[s] = box;
+}
 
 // Picks the sibling that adds the least box area over the path (the surface area heuristic, greedily
-// down the tree), pairs the leaf with it under a new node and rebalances on the way up.
+// down the tree) and pairs the leaf with it under a new node.
 void SnapIndex::insert_leaf(uint32_t leaf) {
-  nodes_[leaf].parent = kNone;
+  parent_of(leaf) = kNone;
   if (root_ == kNone) {
     root_ = leaf;
     return;
   }
-  const Box lb = nodes_[leaf].box;  // a copy: new_node() below may move the nodes
+  const Box lb = box_of(leaf);
   uint32_t i = root_;
-  while (nodes_[i].child[0] != kNone) {
+  Box ib = box_of(root_);
+  while (!(i & kLeafRef)) {
     const Node& n = nodes_[i];
-    Box merged = n.box;
-    merge_into(merged.lo, merged.hi, lb.lo, lb.hi);
-    const double area = half_area(n.box.lo, n.box.hi), combined = half_area(merged.lo, merged.hi);
-    const double here = 2 * combined, inherited = 2 * (combined - area);
+    Box merged = ib;
+    merge_into(merged, lb);
+    const double combined = half_area(merged);
+    const double here = 2 * combined, inherited = 2 * (combined - half_area(ib));
     double cost[2];
     for (int s = 0; s < 2; ++s) {
-      const Node& c = nodes_[n.child[s]];
-      Box b = c.box;
-      merge_into(b.lo, b.hi, lb.lo, lb.hi);
-      cost[s] = half_area(b.lo, b.hi) + inherited - (c.child[0] != kNone ? half_area(c.box.lo, c.box.hi) : 0.0);
+      Box b = n.box[s];
+      merge_into(b, lb);
+      cost[s] = half_area(b) + inherited - (n.child[s] & kLeafRef ? 0.0 : half_area(n.box[s]));
     }
     if (here < cost[0] && here < cost[1]) break;
-    i = n.child[cost[0] <= cost[1] ? 0 : 1];
+    const int s = cost[0] <= cost[1] ? 0 : 1;
+    ib = n.box[s];
+    i = n.child[s];
   }
-  const uint32_t sibling = i, old_parent = nodes_[sibling].parent;
+  const uint32_t sibling = i, old_parent = parent_of(sibling);
   const uint32_t p = new_node();
-  Node& np = nodes_[p];
-  np.parent = old_parent;
-  np.child[0] = sibling;
-  np.child[1] = leaf;
-  np.box = nodes_[sibling].box;
-  merge_into(np.box.lo, np.box.hi, lb.lo, lb.hi);
-  np.height = nodes_[sibling].height + 1;
-  nodes_[sibling].parent = p;
-  nodes_[leaf].parent = p;
-  if (old_parent == kNone) {
-    root_ = p;
-  } else {
-    Node& op = nodes_[old_parent];
-    op.child[op.child[0] == sibling ? 0 : 1] = p;
-  }
-  refit_up(old_parent);
+  nodes_[p] = {{ib, lb}, {sibling, leaf}};
+  parent_[p] = old_parent;
+  parent_of(sibling) = p;
+  parent_of(leaf) = p;
+  Box pb = ib;
+  merge_into(pb, lb);
+  replace_child(old_parent, sibling, p, pb);
+  refit_up(p, true);
 }
 
-// Takes the leaf out and puts its sibling in its parent's place; the caller frees the leaf node.
+// Puts the leaf's sibling in its parent's place.
 void SnapIndex::remove_leaf(uint32_t leaf) {
   if (leaf == root_) {
     root_ = kNone;
     return;
   }
-  const uint32_t p = nodes_[leaf].parent, gp = nodes_[p].parent;
-  const uint32_t sibling = nodes_[p].child[nodes_[p].child[0] == leaf ? 1 : 0];
-  nodes_[sibling].parent = gp;
-  if (gp == kNone) {
-    root_ = sibling;
-  } else {
-    Node& g = nodes_[gp];
-    g.child[g.child[0] == p ? 0 : 1] = sibling;
-  }
-  free_node(p);
-  refit_up(gp);
+  const uint32_t p = parent_of(leaf), gp = parent_[p];
+  const int s = nodes_[p].child[0] == leaf ? 1 : 0;
+  const uint32_t sibling = nodes_[p].child[s];
+  const Box sb = nodes_[p].box[s];
+  parent_of(sibling) = gp;
+  replace_child(gp, p, sibling, sb);
+  free_nodes_.push_back(p);
+  if (gp != kNone) refit_up(gp, true);
 }
 
-void SnapIndex::refit_up(uint32_t i) {
-  while (i != kNone) {
-    i = balance(i);
-    Node& n = nodes_[i];
-    const Node &a = nodes_[n.child[0]], &b = nodes_[n.child[1]];
-    n.height = 1 + std::max(a.height, b.height);
-    n.box = a.box;
-    merge_into(n.box.lo, n.box.hi, b.box.lo, b.box.hi);
-    i = n.parent;
+// Boxes, heights and leaf counts from `node` to the root; then the highest subtree on that path that is
+// too deep for its leaves is rebuilt.
+void SnapIndex::refit_up(uint32_t i, bool rebuild_unbalanced) {
+  uint32_t scapegoat = kNone;
+  for (; i != kNone; i = parent_[i]) {
+    const Node& n = nodes_[i];
+    height_[i] = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
+    leaves_under_[i] = leaves_of(n.child[0]) + leaves_of(n.child[1]);
+    if (height_[i] > depth_limit(leaves_under_[i])) scapegoat = i;
+    const uint32_t p = parent_[i];
+    if (p != kNone) nodes_[p].box[nodes_[p].child[0] == i ? 0 : 1] = box_of(i);
   }
-}
-
-// AVL rotation: when one child of `a` is taller by two or more, that child takes a's place, a takes the
-// child's shorter grandchild, and the taller grandchild stays. Returns the node now at a's place.
-uint32_t SnapIndex::balance(uint32_t a) {
-  Node& A = nodes_[a];
-  if (A.child[0] == kNone || A.height < 2) return a;
-  const int32_t diff = nodes_[A.child[1]].height - nodes_[A.child[0]].height;
-  if (diff >= -1 && diff <= 1) return a;
-  const int s = diff > 1 ? 1 : 0;
-  const uint32_t x = A.child[s];
-  Node& X = nodes_[x];
-  const uint32_t f = X.child[0], g = X.child[1];
-  const bool f_taller = nodes_[f].height > nodes_[g].height;
-  const uint32_t tall = f_taller ? f : g, short_ = f_taller ? g : f;
-
-  X.parent = A.parent;
-  if (X.parent == kNone) {
-    root_ = x;
-  } else {
-    Node& P = nodes_[X.parent];
-    P.child[P.child[0] == a ? 0 : 1] = x;
-  }
-  X.child[0] = a;
-  X.child[1] = tall;
-  A.parent = x;
-  A.child[s] = short_;
-  nodes_[short_].parent = a;
-
-  const Node &a0 = nodes_[A.child[0]], &a1 = nodes_[A.child[1]];
-  A.box = a0.box;
-  merge_into(A.box.lo, A.box.hi, a1.box.lo, a1.box.hi);
-  A.height = 1 + std::max(a0.height, a1.height);
-  X.box = A.box;
-  merge_into(X.box.lo, X.box.hi, nodes_[tall].box.lo, nodes_[tall].box.hi);
-  X.height = 1 + std::max(A.height, nodes_[tall].height);
-  return x;
+  if (rebuild_unbalanced && scapegoat != kNone) rebuild_subtree(scapegoat);
 }
 
 void SnapIndex::rebuild() {
   nodes_.clear();
+  parent_.clear();
+  height_.clear();
+  leaves_under_.clear();
   free_nodes_.clear();
-  std::vector<uint32_t> tree_leaves;
-  for (uint32_t r = 0; r < leaves_.size(); ++r) {
-    Leaf& l = leaves_[r];
-    if (l.edge == kNone) continue;
-    const uint32_t n = new_node();
-    Node& node = nodes_[n];
-    node.child[0] = kNone;
-    node.child[1] = r;
-    node.height = 0;
-    for (int a = 0; a < 3; ++a) node.box.lo[a] = node.box.hi[a] = a == 0 ? l.x[0] : a == 1 ? l.y[0] : l.z[0];
-    for (uint32_t i = 0; i < l.count; ++i) {
-      const double q[3] = {l.x[i], l.y[i], l.z[i]};
-      for (int a = 0; a < 3; ++a) {
-        node.box.lo[a] = std::min(node.box.lo[a], q[a]);
-        node.box.hi[a] = std::max(node.box.hi[a], q[a]);
-      }
-    }
-    l.node = n;
-    tree_leaves.push_back(n);
+  std::vector<Item> items;
+  for (uint32_t r = 0; r < leaves_.size(); ++r)
+    if (leaves_[r].edge != kNone) items.push_back({r | kLeafRef, leaves_[r].box});
+  root_ = kNone;
+  if (items.size() == 1) {
+    root_ = items[0].ref;
+    parent_of(root_) = kNone;
+  } else if (items.size() > 1) {
+    root_ = new_node();
+    build(items, root_, kNone);
   }
-  root_ = tree_leaves.empty() ? kNone : build(tree_leaves, kNone);
 }
 
-// Top-down: split at the median of the box centres along the axis where they spread most.
-uint32_t SnapIndex::build(std::span<uint32_t> leaves, uint32_t parent) {
-  if (leaves.size() == 1) {
-    nodes_[leaves[0]].parent = parent;
-    return leaves[0];
+// Rebuilds the subtree in place: `top` keeps its slot and its box, since it holds the same leaves.
+void SnapIndex::rebuild_subtree(uint32_t top) {
+  std::vector<Item> items;
+  std::vector<uint32_t> stack = {top};
+  while (!stack.empty()) {
+    const uint32_t i = stack.back();
+    stack.pop_back();
+    for (int s = 0; s < 2; ++s) {
+      const uint32_t c = nodes_[i].child[s];
+      if (c & kLeafRef) items.push_back({c, nodes_[i].box[s]});
+      else stack.push_back(c);
+    }
+    if (i != top) free_nodes_.push_back(i);
   }
+  build(items, top, parent_[top]);
+  refit_up(parent_[top], false);
+}
+
+// Top-down into inner node `node` (at least two items): split at the median of the box centres along the
+// axis where they spread most.
+void SnapIndex::build(std::span<Item> items, uint32_t node, uint32_t parent) {
+  parent_[node] = parent;
   double lo[3], hi[3];
   for (int a = 0; a < 3; ++a) {
     lo[a] = std::numeric_limits<double>::infinity();
     hi[a] = -lo[a];
   }
-  auto centre = [&](uint32_t n, int a) { return nodes_[n].box.lo[a] + nodes_[n].box.hi[a]; };
-  for (uint32_t n : leaves)
+  auto centre = [](const Item& it, int a) { return double(it.box.lo[a]) + double(it.box.hi[a]); };
+  for (const Item& it : items)
     for (int a = 0; a < 3; ++a) {
-      lo[a] = std::min(lo[a], centre(n, a));
-      hi[a] = std::max(hi[a], centre(n, a));
+      lo[a] = std::min(lo[a], centre(it, a));
+      hi[a] = std::max(hi[a], centre(it, a));
     }
   int axis = 0;
   for (int a = 1; a < 3; ++a)
     if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
-  const size_t mid = leaves.size() / 2;
-  std::nth_element(leaves.begin(), leaves.begin() + static_cast<std::ptrdiff_t>(mid), leaves.end(),
-                   [&](uint32_t x, uint32_t y) { return centre(x, axis) < centre(y, axis); });
-  const uint32_t n = new_node();
-  nodes_[n].parent = parent;
-  const uint32_t c0 = build(leaves.first(mid), n), c1 = build(leaves.subspan(mid), n);
-  Node& node = nodes_[n];
-  node.child[0] = c0;
-  node.child[1] = c1;
-  node.height = 1 + std::max(nodes_[c0].height, nodes_[c1].height);
-  node.box = nodes_[c0].box;
-  merge_into(node.box.lo, node.box.hi, nodes_[c1].box.lo, nodes_[c1].box.hi);
-  return n;
+  const size_t mid = items.size() / 2;
+  std::nth_element(items.begin(), items.begin() + static_cast<std::ptrdiff_t>(mid), items.end(),
+                   [&](const Item& x, const Item& y) { return centre(x, axis) < centre(y, axis); });
+  const std::span<Item> half[2] = {items.first(mid), items.subspan(mid)};
+  for (int s = 0; s < 2; ++s) {
+    uint32_t ref;
+    Box box;
+    if (half[s].size() == 1) {
+      ref = half[s][0].ref;
+      box = half[s][0].box;
+      parent_of(ref) = node;
+    } else {
+      ref = new_node();
+      build(half[s], ref, node);
+      box = box_of(ref);
+    }
+    nodes_[node].child[s] = ref;
+    nodes_[node].box[s] = box;
+  }
+  const Node& n = nodes_[node];
+  height_[node] = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
+  leaves_under_[node] = leaves_of(n.child[0]) + leaves_of(n.child[1]);
 }
 
 // ---- queries
+
+// Starts loading what a child reference points at while the current node is still being worked on.
+void SnapIndex::prefetch(uint32_t ref) const {
+  if (ref & kLeafRef) {
+    const char* l = reinterpret_cast<const char*>(&leaves_[ref & ~kLeafRef]);
+    for (size_t b = 0; b < sizeof(Leaf); b += 64) __builtin_prefetch(l + b);
+  } else {
+    __builtin_prefetch(&nodes_[ref]);
+  }
+}
 
 SnapHit SnapIndex::nearest(const Vec3& p, double radius) const {
   SnapHit best;
   if (root_ == kNone) return best;
   double bound = bound_of(radius);
-  std::array<std::pair<uint32_t, double>, kStack> stack;
+  struct Pending {
+    uint32_t ref;
+    double gap;
+  };
+  Pending stack[kStack];  // left uninitialised: a query must not pay for clearing it
   size_t top = 0;
-  stack[top++] = {root_, squared_gap(nodes_[root_].box.lo, nodes_[root_].box.hi, p)};
+  stack[top++] = {root_, squared_gap(box_of(root_), p)};
   while (top > 0) {
-    const auto [i, gap] = stack[--top];
+    const auto [ref, gap] = stack[--top];
     if (gap > bound) continue;
-    const Node& n = nodes_[i];
-    if (n.child[0] == kNone) {
-      const Leaf& l = leaves_[n.child[1]];
+    if (ref & kLeafRef) {
+      const Leaf& l = leaves_[ref & ~kLeafRef];
       for (uint32_t k = 0; k < l.count; ++k) {
         const double dx = l.x[k] - p.x(), dy = l.y[k] - p.y(), dz = l.z[k] - p.z();
         if (dx * dx + dy * dy + dz * dz > bound) continue;
@@ -396,13 +420,16 @@ SnapHit SnapIndex::nearest(const Vec3& p, double radius) const {
       }
       continue;
     }
-    const double g0 = squared_gap(nodes_[n.child[0]].box.lo, nodes_[n.child[0]].box.hi, p);
-    const double g1 = squared_gap(nodes_[n.child[1]].box.lo, nodes_[n.child[1]].box.hi, p);
+    const Node& n = nodes_[ref];
+    const double g0 = squared_gap(n.box[0], p), g1 = squared_gap(n.box[1], p);
     // The nearer child goes on top, so it is searched first and tightens the bound for the other.
     const int nearer = g1 < g0 ? 1 : 0;
     const double gn = nearer ? g1 : g0, gf = nearer ? g0 : g1;
     if (gf <= bound) stack[top++] = {n.child[1 - nearer], gf};
-    if (gn <= bound) stack[top++] = {n.child[nearer], gn};
+    if (gn <= bound) {
+      stack[top++] = {n.child[nearer], gn};
+      prefetch(n.child[nearer]);
+    }
   }
   return best;
 }
@@ -417,7 +444,7 @@ SnapHit SnapIndex::nearest_on_face(const Mesh& mesh, uint32_t f, const Vec3& p, 
     if (e >= edge_leaves_.size()) continue;
     for (uint32_t r : edge_leaves_[e]) {
       const Leaf& l = leaves_[r];
-      if (squared_gap(nodes_[l.node].box.lo, nodes_[l.node].box.hi, p) > bound) continue;
+      if (squared_gap(l.box, p) > bound) continue;
       for (uint32_t k = 0; k < l.count; ++k) {
         const Vec3 q(l.x[k], l.y[k], l.z[k]);
         const double d = (q - p).norm();
@@ -435,18 +462,18 @@ void SnapIndex::nearest_per_edge(const Vec3& p, double radius, std::vector<SnapH
   out.clear();
   if (root_ == kNone) return;
   const double bound = bound_of(radius);
-  std::array<uint32_t, kStack> stack;
+  uint32_t stack[kStack];
   size_t top = 0;
-  stack[top++] = root_;
+  if (squared_gap(box_of(root_), p) <= bound) stack[top++] = root_;
   while (top > 0) {
-    const Node& n = nodes_[stack[--top]];
-    if (squared_gap(n.box.lo, n.box.hi, p) > bound) continue;
-    if (n.child[0] != kNone) {
-      stack[top++] = n.child[0];
-      stack[top++] = n.child[1];
+    const uint32_t ref = stack[--top];
+    if (!(ref & kLeafRef)) {
+      const Node& n = nodes_[ref];
+      for (int s = 0; s < 2; ++s)
+        if (squared_gap(n.box[s], p) <= bound) stack[top++] = n.child[s];
       continue;
     }
-    const Leaf& l = leaves_[n.child[1]];
+    const Leaf& l = leaves_[ref & ~kLeafRef];
     for (uint32_t k = 0; k < l.count; ++k) {
       const Vec3 q(l.x[k], l.y[k], l.z[k]);
       const double d = (q - p).norm();
@@ -463,28 +490,35 @@ void SnapIndex::nearest_per_edge(const Vec3& p, double radius, std::vector<SnapH
 
 // ---- checks
 
-std::string SnapIndex::validate_node(uint32_t i, uint32_t parent, size_t& leaves) const {
-  const Node& n = nodes_[i];
-  if (n.parent != parent) return "node " + std::to_string(i) + " has a wrong parent";
-  if (n.child[0] == kNone) {
-    const Leaf& l = leaves_[n.child[1]];
-    if (l.node != i || l.edge == kNone) return "tree leaf " + std::to_string(i) + " names a wrong record";
+namespace {
+bool same_box(const float (&alo)[3], const float (&ahi)[3], const float (&blo)[3], const float (&bhi)[3]) {
+  return std::equal(alo, alo + 3, blo) && std::equal(ahi, ahi + 3, bhi);
+}
+}  // namespace
+
+std::string SnapIndex::validate_ref(uint32_t ref, uint32_t parent, const Box& box, size_t& leaves) const {
+  const Box own = box_of(ref);
+  if (!same_box(own.lo, own.hi, box.lo, box.hi)) return "a box held by a parent is not its child's";
+  if (ref & kLeafRef) {
+    const Leaf& l = leaves_[ref & ~kLeafRef];
+    if (l.parent != parent || l.edge == kNone) return "a leaf record has a wrong parent or is free";
     for (uint32_t k = 0; k < l.count; ++k) {
       const double q[3] = {l.x[k], l.y[k], l.z[k]};
       for (int a = 0; a < 3; ++a)
-        if (q[a] < n.box.lo[a] || q[a] > n.box.hi[a]) return "a point lies outside its leaf's box";
+        if (q[a] < l.box.lo[a] || q[a] > l.box.hi[a]) return "a point lies outside its leaf's box";
     }
     ++leaves;
-    return n.height == 0 ? "" : "a tree leaf has a height";
+    return "";
   }
-  for (int s = 0; s < 2; ++s) {
-    const Node& c = nodes_[n.child[s]];
-    for (int a = 0; a < 3; ++a)
-      if (c.box.lo[a] < n.box.lo[a] || c.box.hi[a] > n.box.hi[a]) return "a child's box sticks out of its parent's";
-    if (auto why = validate_node(n.child[s], i, leaves); !why.empty()) return why;
-  }
-  const int32_t h0 = nodes_[n.child[0]].height, h1 = nodes_[n.child[1]].height;
-  if (n.height != 1 + std::max(h0, h1)) return "node " + std::to_string(i) + " has a wrong height";
+  if (parent_[ref] != parent) return "node " + std::to_string(ref) + " has a wrong parent";
+  const Node& n = nodes_[ref];
+  for (int s = 0; s < 2; ++s)
+    if (auto why = validate_ref(n.child[s], ref, n.box[s], leaves); !why.empty()) return why;
+  if (height_[ref] != 1 + std::max(height_of(n.child[0]), height_of(n.child[1])))
+    return "node " + std::to_string(ref) + " has a wrong height";
+  if (leaves_under_[ref] != leaves_of(n.child[0]) + leaves_of(n.child[1]))
+    return "node " + std::to_string(ref) + " has a wrong count";
+  if (height_[ref] > depth_limit(leaves_under_[ref])) return "node " + std::to_string(ref) + " is too deep for its leaves";
   return "";
 }
 
@@ -503,7 +537,7 @@ std::string SnapIndex::validate(const Mesh& mesh) const {
   if (points != points_ || edges != edges_) return "the point or edge count is off";
   size_t leaves = 0;
   if (root_ != kNone)
-    if (auto why = validate_node(root_, kNone, leaves); !why.empty()) return why;
+    if (auto why = validate_ref(root_, kNone, box_of(root_), leaves); !why.empty()) return why;
   if (leaves != leaves_.size() - free_leaves_.size()) return "the tree does not hold every leaf record";
   return "";
 }

@@ -3,8 +3,10 @@
 // edges, kept in step with the mesh by incremental updates instead of rebuilds.
 //
 // Leaves are runs of up to kLeafPoints consecutive points of one polyline (a curve is spatially coherent
-// along its length, so a run's box is thin); inner nodes form a dynamic AABB tree that stays balanced
-// under insertion and removal of leaves. The index holds its own copy of the points, so it answers
+// along its length, so a run's box is thin); inner nodes form a dynamic AABB tree: a new leaf goes next to
+// the sibling that adds the least box area, and a subtree that grows too deep for its size is rebuilt
+// top-down (as a scapegoat tree does), which keeps the depth logarithmic without rotations that would
+// pair far-apart subtrees. The index holds its own copy of the points, so it answers
 // between syncs without reading the mesh, and compaction only relabels edges.
 //
 // Answers and tie-breaks equal the exhaustive searches of the sketch system: distances are computed with
@@ -58,43 +60,61 @@ class SnapIndex {
 
   size_t point_count() const { return points_; }
   size_t edge_count() const { return edges_; }
+  // Nodes on the longest path from the root to a leaf record, counting both (0 when empty).
+  uint32_t height() const;
   // Empty when the index holds exactly the live edges of `mesh` with their polylines and the tree is sound.
   std::string validate(const Mesh& mesh) const;
 
  private:
+  // Single precision rounded outwards: fewer bytes per node, and a box still holds its points.
   struct Box {
-    double lo[3], hi[3];
+    float lo[3], hi[3];
   };
-  struct Node {
-    Box box;
-    uint32_t child[2];  // child[0] == kNone for a tree leaf, whose child[1] is the leaf record
-    uint32_t parent;
-    int32_t height;     // 0 for a tree leaf
+  // An inner node holds its children's boxes, so a query decides on both children from the one node it
+  // has loaded, as a k-d tree decides from its split plane. A child is an inner node or a leaf record
+  // (kLeafRef set).
+  struct alignas(64) Node {  // one cache line
+    Box box[2];
+    uint32_t child[2];
   };
+  static constexpr uint32_t kLeafRef = 0x80000000u;
   struct Leaf {
-    uint32_t edge, first, count, node;
+    Box box;
+    uint32_t edge, first, count, parent;  // parent: inner node, or kNone at the root
     double x[kLeafPoints], y[kLeafPoints], z[kLeafPoints];
+  };
+  struct Item {  // a child reference with its box, while building
+    uint32_t ref;
+    Box box;
   };
 
   bool same_polyline(uint32_t e, std::span<const Vec3> line) const;
   void remove_edge(uint32_t e);
   void add_leaves(uint32_t e, std::span<const Vec3> line, std::vector<uint32_t>& fresh);
   uint32_t new_node();
-  void free_node(uint32_t n);
-  void insert_leaf(uint32_t node);
-  void remove_leaf(uint32_t node);
-  uint32_t balance(uint32_t a);
-  void refit_up(uint32_t n);
+  uint32_t& parent_of(uint32_t ref) { return ref & kLeafRef ? leaves_[ref & ~kLeafRef].parent : parent_[ref]; }
+  int32_t height_of(uint32_t ref) const { return ref & kLeafRef ? 0 : height_[ref]; }
+  uint32_t leaves_of(uint32_t ref) const { return ref & kLeafRef ? 1 : leaves_under_[ref]; }
+  Box box_of(uint32_t ref) const;
+  void replace_child(uint32_t parent, uint32_t old_ref, uint32_t new_ref, const Box& box);
+  void insert_leaf(uint32_t ref);
+  void remove_leaf(uint32_t ref);
+  void refit_up(uint32_t node, bool rebuild_unbalanced);
   void rebuild();
-  uint32_t build(std::span<uint32_t> leaves, uint32_t parent);
-  std::string validate_node(uint32_t n, uint32_t parent, size_t& leaves) const;
+  void rebuild_subtree(uint32_t node);
+  void build(std::span<Item> items, uint32_t node, uint32_t parent);
+  void prefetch(uint32_t ref) const;
+  std::string validate_ref(uint32_t ref, uint32_t parent, const Box& box, size_t& leaves) const;
 
   std::vector<Node> nodes_;
+  std::vector<uint32_t> parent_;
+  std::vector<int32_t> height_;  // edges to the deepest leaf record below
+  std::vector<uint32_t> leaves_under_;
   std::vector<uint32_t> free_nodes_;
   std::vector<Leaf> leaves_;
   std::vector<uint32_t> free_leaves_;
   std::vector<std::vector<uint32_t>> edge_leaves_;  // per edge slot: its leaf records in point order
-  uint32_t root_ = kNone;
+  uint32_t root_ = kNone;                           // a child reference
   size_t points_ = 0, edges_ = 0;
 };
 
