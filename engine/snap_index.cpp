@@ -165,15 +165,20 @@ void SnapIndex::update(const Mesh& mesh, std::span<const uint32_t> changed_edge_
     remove_edge(e);
     add_leaves(e, line, fresh);
   }
-  if (fresh.empty()) return;
   const size_t held = leaves_.size() - free_leaves_.size() - fresh.size();
   // Inserting one by one costs a descent each and leaves a looser tree than a top-down build; when most
   // of the index is new (loading, a first sync, an undo that touched everything) build it whole.
-  if (fresh.size() > held) {
+  if (!fresh.empty() && fresh.size() > held) {
     rebuild();
     return;
   }
-  for (uint32_t r : fresh) insert_leaf(r | kLeafRef);
+  // Removals refit once for all; each insertion refits (and rebalances) before the next descends, or a
+  // curve's leaves would pile up in one deep chain.
+  refit_touched();
+  for (uint32_t r : fresh) {
+    insert_leaf(r | kLeafRef);
+    refit_touched();
+  }
 }
 
 void SnapIndex::remap(const CompactionMap& map) {
@@ -190,6 +195,7 @@ void SnapIndex::remap(const CompactionMap& map) {
     moved[to] = std::move(edge_leaves_[e]);
   }
   edge_leaves_ = std::move(moved);
+  refit_touched();
 }
 
 // ---- the tree
@@ -206,6 +212,7 @@ uint32_t SnapIndex::new_node() {
     return n;
   }
   nodes_.emplace_back();
+  marked_.push_back(0);
   parent_.push_back(kNone);
   height_.push_back(0);
   leaves_under_.push_back(0);
@@ -231,7 +238,8 @@ void SnapIndex::replace_child(uint32_t parent, uint32_t old_ref, uint32_t new_re
 }
 
 // Picks the sibling that adds the least box area over the path (the surface area heuristic, greedily
-// down the tree) and pairs the leaf with it under a new node.
+// down the tree), growing the boxes on the way, and pairs the leaf with it under a new node. Heights and
+// counts above wait for refit_touched().
 void SnapIndex::insert_leaf(uint32_t leaf) {
   parent_of(leaf) = kNone;
   if (root_ == kNone) {
@@ -242,7 +250,7 @@ void SnapIndex::insert_leaf(uint32_t leaf) {
   uint32_t i = root_;
   Box ib = box_of(root_);
   while (!(i & kLeafRef)) {
-    const Node& n = nodes_[i];
+    Node& n = nodes_[i];
     Box merged = ib;
     merge_into(merged, lb);
     const double combined = half_area(merged);
@@ -256,6 +264,7 @@ void SnapIndex::insert_leaf(uint32_t leaf) {
     if (here < cost[0] && here < cost[1]) break;
     const int s = cost[0] <= cost[1] ? 0 : 1;
     ib = n.box[s];
+    merge_into(n.box[s], lb);
     i = n.child[s];
   }
   const uint32_t sibling = i, old_parent = parent_of(sibling);
@@ -267,10 +276,10 @@ void SnapIndex::insert_leaf(uint32_t leaf) {
   Box pb = ib;
   merge_into(pb, lb);
   replace_child(old_parent, sibling, p, pb);
-  refit_up(p, true);
+  touched_.push_back(p);
 }
 
-// Puts the leaf's sibling in its parent's place.
+// Puts the leaf's sibling in its parent's place; boxes, heights and counts above wait for refit_touched().
 void SnapIndex::remove_leaf(uint32_t leaf) {
   if (leaf == root_) {
     root_ = kNone;
@@ -283,22 +292,56 @@ void SnapIndex::remove_leaf(uint32_t leaf) {
   parent_of(sibling) = gp;
   replace_child(gp, p, sibling, sb);
   free_nodes_.push_back(p);
-  if (gp != kNone) refit_up(gp, true);
+  parent_[p] = kFreed;
+  if (gp != kNone) touched_.push_back(gp);
 }
 
-// Boxes, heights and leaf counts from `node` to the root; then the highest subtree on that path that is
-// too deep for its leaves is rebuilt.
-void SnapIndex::refit_up(uint32_t i, bool rebuild_unbalanced) {
-  uint32_t scapegoat = kNone;
+// Boxes, heights and leaf counts from node i to the root.
+void SnapIndex::refit_up(uint32_t i) {
   for (; i != kNone; i = parent_[i]) {
     const Node& n = nodes_[i];
     height_[i] = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
     leaves_under_[i] = leaves_of(n.child[0]) + leaves_of(n.child[1]);
-    if (height_[i] > depth_limit(leaves_under_[i])) scapegoat = i;
     const uint32_t p = parent_[i];
     if (p != kNone) nodes_[p].box[nodes_[p].child[0] == i ? 0 : 1] = box_of(i);
   }
-  if (rebuild_unbalanced && scapegoat != kNone) rebuild_subtree(scapegoat);
+}
+
+// One pass over the union of the paths from the touched nodes to the root, children before parents, so a
+// curve's leaves, which share most of their paths, refit each shared node once. Then the highest subtrees
+// grown too deep for their leaves are rebuilt.
+void SnapIndex::refit_touched() {
+  if (touched_.empty()) return;
+  marked_list_.clear();
+  for (uint32_t t : touched_) {
+    if (parent_[t] == kFreed) continue;
+    for (; t != kNone && !marked_[t]; t = parent_[t]) {
+      marked_[t] = 1;
+      marked_list_.push_back(t);
+    }
+  }
+  touched_.clear();
+  unbalanced_.clear();
+  if (root_ != kNone && !(root_ & kLeafRef) && marked_[root_]) refit_marked(root_, unbalanced_);
+  for (uint32_t m : marked_list_) marked_[m] = 0;
+  for (uint32_t n : unbalanced_) rebuild_subtree(n);
+}
+
+void SnapIndex::refit_marked(uint32_t i, std::vector<uint32_t>& unbalanced) {
+  const size_t below = unbalanced.size();
+  Node& n = nodes_[i];
+  for (int s = 0; s < 2; ++s) {
+    const uint32_t c = n.child[s];
+    if (c & kLeafRef || !marked_[c]) continue;
+    refit_marked(c, unbalanced);
+    n.box[s] = box_of(c);
+  }
+  height_[i] = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
+  leaves_under_[i] = leaves_of(n.child[0]) + leaves_of(n.child[1]);
+  if (height_[i] > depth_limit(leaves_under_[i])) {
+    unbalanced.resize(below);  // rebuilding this subtree rebuilds those inside it
+    unbalanced.push_back(i);
+  }
 }
 
 void SnapIndex::rebuild() {
@@ -306,7 +349,9 @@ void SnapIndex::rebuild() {
   parent_.clear();
   height_.clear();
   leaves_under_.clear();
+  marked_.clear();
   free_nodes_.clear();
+  touched_.clear();
   std::vector<Item> items;
   for (uint32_t r = 0; r < leaves_.size(); ++r)
     if (leaves_[r].edge != kNone) items.push_back({r | kLeafRef, leaves_[r].box});
@@ -335,7 +380,7 @@ void SnapIndex::rebuild_subtree(uint32_t top) {
     if (i != top) free_nodes_.push_back(i);
   }
   build(items, top, parent_[top]);
-  refit_up(parent_[top], false);
+  refit_up(parent_[top]);
 }
 
 // Top-down into inner node `node` (at least two items): split at the median of the box centres along the

@@ -78,6 +78,7 @@ class SnapIndex {
     uint32_t child[2];
   };
   static constexpr uint32_t kLeafRef = 0x80000000u;
+  static constexpr uint32_t kFreed = kNone - 1;  // parent_ of a node on the free list
   struct Leaf {
     Box box;
     uint32_t edge, first, count, parent;  // parent: inner node, or kNone at the root
@@ -99,7 +100,9 @@ class SnapIndex {
   void replace_child(uint32_t parent, uint32_t old_ref, uint32_t new_ref, const Box& box);
   void insert_leaf(uint32_t ref);
   void remove_leaf(uint32_t ref);
-  void refit_up(uint32_t node, bool rebuild_unbalanced);
+  void refit_up(uint32_t node);
+  void refit_touched();
+  void refit_marked(uint32_t node, std::vector<uint32_t>& unbalanced);
   void rebuild();
   void rebuild_subtree(uint32_t node);
   void build(std::span<Item> items, uint32_t node, uint32_t parent);
@@ -110,6 +113,10 @@ class SnapIndex {
   std::vector<uint32_t> parent_;
   std::vector<int32_t> height_;  // edges to the deepest leaf record below
   std::vector<uint32_t> leaves_under_;
+  std::vector<uint32_t> touched_;  // nodes whose subtree changed since the last refit
+  // Scratch of refit_touched(), kept to spare allocations; marked_ is all clear between calls.
+  std::vector<uint8_t> marked_;
+  std::vector<uint32_t> marked_list_, unbalanced_;
   std::vector<uint32_t> free_nodes_;
   std::vector<Leaf> leaves_;
   std::vector<uint32_t> free_leaves_;
