@@ -45,7 +45,8 @@ class SnapIndex {
   // new polyline, or new; slots the mesh no longer has (truncated by undo) are dropped as well. A slot
   // whose polyline is unchanged costs a comparison.
   void update(const Mesh& mesh, std::span<const uint32_t> changed_edge_slots);
-  // Relabels the edges after Mesh::compact (no geometry is touched).
+  // Relabels the edges after Mesh::compact (no geometry is touched), so update() must have seen the frame
+  // before compaction.
   void remap(const CompactionMap& map);
   void clear();
 
