@@ -1,29 +1,12 @@
 #include "systems/sketch/sketch.hpp"
 
+#include <algorithm>
+#include <iterator>
 #include <limits>
 
 namespace fire {
 
 namespace {
-
-struct Nearest {
-  CurveEnd end;
-  double distance = std::numeric_limits<double>::infinity();
-};
-
-// Nearest polyline point on face f's boundary; on ties the earlier point wins, so vertices (point 0) win.
-Nearest nearest_on_face(const Mesh& m, uint32_t f, const Vec3& p) {
-  Nearest best;
-  for (uint32_t oe : m.face_loop(f)) {
-    uint32_t e = edge_of(oe);
-    auto line = m.polyline(e);
-    for (uint32_t k = 0; k < line.size(); ++k) {
-      double d = (line[k] - p).norm();
-      if (d < best.distance) best = {{e, k}, d};
-    }
-  }
-  return best;
-}
 
 // Moves a stroke so that it starts at `start` and ends at `end`, spreading each end's correction along the
 // stroke by arc length: snapping then bends the whole curve a little instead of kinking its last sample,
@@ -56,40 +39,44 @@ std::pair<uint32_t, uint32_t> border_ends(const Mesh& m) {
 
 }  // namespace
 
-Snap snap_to_face(const Mesh& m, const Vec3& start, const Vec3& end, double limit) {
+Snap snap_to_face(const Mesh& m, const SnapIndex& index, const Vec3& start, const Vec3& end, double limit) {
+  // Only faces with a boundary point within `limit` of both ends can be chosen: those of the edges near both.
+  std::vector<SnapHit> near_start, near_end;
+  index.nearest_per_edge(start, limit, near_start);
+  index.nearest_per_edge(end, limit, near_end);
+  auto faces_of = [&](const std::vector<SnapHit>& hits) {
+    std::vector<uint32_t> out;
+    for (const SnapHit& h : hits)
+      for (uint32_t f : m.edges.face[h.edge])
+        if (f != kNone) out.push_back(f);
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  };
+  const std::vector<uint32_t> a_faces = faces_of(near_start), b_faces = faces_of(near_end);
+  std::vector<uint32_t> candidates;
+  std::set_intersection(a_faces.begin(), a_faces.end(), b_faces.begin(), b_faces.end(), std::back_inserter(candidates));
+
   Snap best;
   double best_cost = std::numeric_limits<double>::infinity();
-  for (uint32_t f = 0; f < m.face_slots(); ++f) {
+  for (uint32_t f : candidates) {
     if (!m.face_alive(f)) continue;
-    Nearest a = nearest_on_face(m, f, start), b = nearest_on_face(m, f, end);
-    if (a.distance > limit || b.distance > limit) continue;
-    double cost = a.distance + b.distance;
+    const SnapHit a = index.nearest_on_face(m, f, start, limit), b = index.nearest_on_face(m, f, end, limit);
+    if (!a.found() || !b.found()) continue;
+    const double cost = a.distance + b.distance;
     if (cost < best_cost) {
       best_cost = cost;
-      best = {f, a.end, b.end, a.distance, b.distance};
+      best = {f, {a.edge, a.point}, {b.edge, b.point}, a.distance, b.distance};
     }
   }
   return best;
 }
 
-uint32_t pick_edge(const Mesh& m, const Vec3& p, double limit) {
-  uint32_t best = kNone;
-  double best_d = limit;
-  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
-    if (!m.edge_alive(e)) continue;
-    for (const Vec3& q : m.polyline(e)) {
-      double d = (q - p).norm();
-      if (d <= best_d && (best == kNone || d < best_d)) {
-        best_d = d;
-        best = e;
-      }
-    }
-  }
-  return best;
-}
+uint32_t pick_edge(const SnapIndex& index, const Vec3& p, double limit) { return index.nearest(p, limit).edge; }
 
-void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh, const SketchSettings& settings,
-                   SketchState& state, std::vector<EditRequest>& requests, std::vector<Rejection>& rejections) {
+void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh, const SnapIndex& snap,
+                   const SketchSettings& settings, SketchState& state, std::vector<EditRequest>& requests,
+                   std::vector<Rejection>& rejections) {
   requests.clear();
   // At most one request per frame, so every request is placed on the mesh as the previous one left it;
   // events after it wait in `pending` for the next frame.
@@ -142,7 +129,7 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           blend_ends(r.command.points, mesh.vertices.position[last],
                      r.command.kind == EditKind::CloseBorder ? first_position : r.command.points.back());
         } else {
-          Snap s = snap_to_face(mesh, r.command.points.front(), r.command.points.back(), settings.snap_distance);
+          Snap s = snap_to_face(mesh, snap, r.command.points.front(), r.command.points.back(), settings.snap_distance);
           if (s.face == kNone) {
             reject("the stroke does not start and end on the boundary of one face (no face has both ends within " +
                    std::to_string(settings.snap_distance) + ")");
@@ -175,7 +162,7 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           r.command.kind = EditKind::CloseBorder;
           r.command.snap_distance = settings.snap_distance;
         } else {
-          uint32_t e = pick_edge(mesh, ev.p, settings.snap_distance);
+          uint32_t e = pick_edge(snap, ev.p, settings.snap_distance);
           if (e == kNone) {
             reject("delete: no curve within " + std::to_string(settings.snap_distance) + " of the picked point");
             break;

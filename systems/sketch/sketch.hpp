@@ -1,14 +1,16 @@
 #pragma once
 // The sketch system: turns pen strokes and user commands into edit requests (thesis 5.4 and 5.5).
 // A stroke is the pen samples between `down` and `up`. Its ends are snapped to the nearest polyline
-// point of a face that holds both ends (exhaustive search, thesis 5.5.1); strokes that cannot be
-// placed are rejected with a reason, and nothing already drawn changes.
+// point of a face that holds both ends, found through the snapping index (engine/snap_index.hpp), which
+// gives the answers of an exhaustive search (thesis 5.5.1); strokes that cannot be placed are rejected
+// with a reason, and nothing already drawn changes.
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "engine/input_log.hpp"
 #include "engine/mesh.hpp"
+#include "engine/snap_index.hpp"
 #include "engine/edit_command.hpp"
 
 namespace fire {
@@ -31,13 +33,15 @@ struct Snap {
   double start_distance = 0, end_distance = 0;
 };
 
-// The face whose boundary passes closest to both points (sum of distances), each within `limit`.
-Snap snap_to_face(const Mesh& mesh, const Vec3& start, const Vec3& end, double limit);
-// The live edge with a polyline point nearest to p within `limit`, or kNone.
-uint32_t pick_edge(const Mesh& mesh, const Vec3& p, double limit);
+// The face whose boundary passes closest to both points (sum of distances), each within `limit`; on equal
+// sums the lowest face slot, and on each boundary the point first in loop order. `index` is in step with `mesh`.
+Snap snap_to_face(const Mesh& mesh, const SnapIndex& index, const Vec3& start, const Vec3& end, double limit);
+// The live edge with a polyline point nearest to p within `limit` (the lowest slot on ties), or kNone.
+uint32_t pick_edge(const SnapIndex& index, const Vec3& p, double limit);
 
-// Emits at most one request per frame (see `pending`).
-void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh, const SketchSettings& settings,
-                   SketchState& state, std::vector<EditRequest>& requests, std::vector<Rejection>& rejections);
+// Emits at most one request per frame (see `pending`). `snap` is in step with `mesh`.
+void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh, const SnapIndex& snap,
+                   const SketchSettings& settings, SketchState& state, std::vector<EditRequest>& requests,
+                   std::vector<Rejection>& rejections);
 
 }  // namespace fire

@@ -51,7 +51,7 @@ TEST_CASE("the demo log replays to the same pools every time", "[replay]") {
     REQUIRE(w->mesh.validate() == "");
     CHECK(w->mesh.face_count() == 14);
     CHECK(w->rejections.size() == 1);
-    CHECK(s.timings().size() == 5);
+    CHECK(s.timings().size() == 6);  // input, sketch, split, refine, subdivide, snap
     CHECK(w->surface.quad_count() > 0);
     CHECK(w->surface_build.problem == "");
     hash = world_hash(*w);

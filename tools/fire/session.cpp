@@ -15,8 +15,9 @@ std::vector<SystemSpec> session_systems(World& w) {
   systems.push_back({"input", {"log", "frame"}, {"frame_events"}, {}, [&w] {
                        input_system(w.log, w.frame, w.cursor, w.frame_events);
                      }});
-  systems.push_back({"sketch", {"frame_events", "sketch_settings"}, {"requests", "rejections"}, {"mesh"}, [&w] {
-                       sketch_system(w.frame_events, w.mesh, w.sketch_settings, w.sketch, w.requests, w.rejections);
+  systems.push_back({"sketch", {"frame_events", "sketch_settings"}, {"requests", "rejections"}, {"mesh", "snap"}, [&w] {
+                       sketch_system(w.frame_events, w.mesh, w.snap, w.sketch_settings, w.sketch, w.requests,
+                                     w.rejections);
                      }});
   systems.push_back({"split", {"requests"}, {"mesh", "rejections"}, {}, [&w] {
                        split_system(w.requests, w.mesh, w.history, w.rejections);
@@ -27,6 +28,8 @@ std::vector<SystemSpec> session_systems(World& w) {
   systems.push_back({"subdivide", {"base_mesh", "surface_options", "frame"}, {"surface"}, {}, [&w] {
                        if (w.build_surface) subdivide_system(w.surface_options, w.frame, w.surface_build, w.surface);
                      }});
+  // The sync point: consumers of the frame's writes that later frames read.
+  systems.push_back({"snap", {"mesh"}, {"snap"}, {}, [&w] { w.snap.sync(w.mesh); }});
   return systems;
 }
 

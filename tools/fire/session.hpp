@@ -2,7 +2,7 @@
 // A drawing session: the world's data and the per-frame system order of the design card, used by
 // `fire replay` headless (and by the live app).
 //
-//   input -> sketch -> split -> refine -> subdivide
+//   input -> sketch -> split -> refine -> subdivide -> snap (the sync point: the snapping index)
 //
 // Each system is declared with the world data it reads and writes (names below), so the scheduler can
 // refuse an order in which a system reads what a later one writes in the same frame.
@@ -13,6 +13,7 @@
 #include "engine/input_log.hpp"
 #include "engine/mesh.hpp"
 #include "engine/scheduler.hpp"
+#include "engine/snap_index.hpp"
 #include "engine/surface.hpp"
 #include "systems/input/input.hpp"
 #include "systems/reconstruct/reconstruct.hpp"
@@ -34,6 +35,7 @@ struct World {
   std::vector<Rejection> rejections;
   // split
   Mesh mesh;
+  SnapIndex snap;  // in step with `mesh` from the end of each frame
   EditHistory history;
   // refine, subdivide
   bool build_surface = true;

@@ -1,0 +1,605 @@
+#include "engine/snap_index.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <utility>
+
+namespace fire {
+
+namespace {
+
+// Pruning compares squared distances summed in another order than Eigen's norm(); widening the bound by
+// far more than that rounding keeps every point that could tie with the best one.
+double widen(double squared) { return squared * (1.0 + 1e-9); }
+
+double bound_of(double distance) { return widen(distance * distance); }
+
+// Tree height stays logarithmic (depth_limit below), so a fixed stack covers any pool that fits in
+// 32-bit slots.
+constexpr size_t kStack = 256;
+
+// The exhaustive searches' order on equal distance: lower edge slot, then lower point index.
+bool before(double d, uint32_t e, uint32_t k, const SnapHit& best) {
+  if (d != best.distance) return d < best.distance;
+  return e != best.edge ? e < best.edge : k < best.point;
+}
+
+}  // namespace
+
+std::vector<uint32_t> changed_slots(std::span<const Frame> stamps, Frame seen) {
+  std::vector<uint32_t> out;
+  for (uint32_t i = 0; i < stamps.size(); ++i)
+    if (stamps[i] > seen) out.push_back(i);
+  return out;
+}
+
+
+namespace {
+
+float round_down(double x) {
+  const float f = static_cast<float>(x);
+  return double(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+}
+
+float round_up(double x) {
+  const float f = static_cast<float>(x);
+  return double(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+}
+
+template <class B>
+void merge_into(B& into, const B& b) {
+  for (int a = 0; a < 3; ++a) {
+    into.lo[a] = std::min(into.lo[a], b.lo[a]);
+    into.hi[a] = std::max(into.hi[a], b.hi[a]);
+  }
+}
+
+template <class B>
+double half_area(const B& b) {
+  const double x = double(b.hi[0]) - b.lo[0], y = double(b.hi[1]) - b.lo[1], z = double(b.hi[2]) - b.lo[2];
+  return x * y + y * z + z * x;
+}
+
+template <class B>
+double squared_gap(const B& b, const Vec3& p) {
+  double s = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double g = std::max(std::max(double(b.lo[a]) - p[a], p[a] - double(b.hi[a])), 0.0);
+    s += g * g;
+  }
+  return s;
+}
+
+// The depth a subtree with this many leaves may reach before it is rebuilt.
+int32_t depth_limit(uint32_t leaves) { return 2 * int32_t(std::bit_width(leaves)) + 2; }
+
+}  // namespace
+
+// ---- updates
+
+void SnapIndex::clear() { *this = SnapIndex(); }
+
+bool SnapIndex::same_polyline(uint32_t e, std::span<const Vec3> line) const {
+  size_t n = 0;
+  for (uint32_t r : edge_leaves_[e]) {
+    const Leaf& l = leaves_[r];
+    if (l.first != n || l.first + l.count > line.size()) return false;
+    for (uint32_t i = 0; i < l.count; ++i) {
+      const Vec3& q = line[l.first + i];
+      if (q.x() != l.x[i] || q.y() != l.y[i] || q.z() != l.z[i]) return false;
+    }
+    n += l.count;
+  }
+  return n == line.size();
+}
+
+void SnapIndex::remove_edge(uint32_t e) {
+  if (e >= edge_leaves_.size() || edge_leaves_[e].empty()) return;
+  for (uint32_t r : edge_leaves_[e]) {
+    remove_leaf(r | kLeafRef);
+    points_ -= leaves_[r].count;
+    leaves_[r].edge = kNone;
+    free_leaves_.push_back(r);
+  }
+  edge_leaves_[e].clear();
+  --edges_;
+}
+
+void SnapIndex::add_leaves(uint32_t e, std::span<const Vec3> line, std::vector<uint32_t>& fresh) {
+  if (edge_leaves_.size() <= e) edge_leaves_.resize(e + 1);
+  for (uint32_t first = 0; first < line.size(); first += kLeafPoints) {
+    uint32_t r;
+    if (!free_leaves_.empty()) {
+      r = free_leaves_.back();
+      free_leaves_.pop_back();
+    } else {
+      r = static_cast<uint32_t>(leaves_.size());
+      leaves_.emplace_back();
+    }
+    Leaf& l = leaves_[r];
+    l.edge = e;
+    l.first = first;
+    l.count = std::min<uint32_t>(kLeafPoints, static_cast<uint32_t>(line.size()) - first);
+    l.parent = kNone;
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) lo[a] = hi[a] = line[first][a];
+    for (uint32_t i = 0; i < l.count; ++i) {
+      const Vec3& q = line[first + i];
+      l.x[i] = q.x();
+      l.y[i] = q.y();
+      l.z[i] = q.z();
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], q[a]);
+        hi[a] = std::max(hi[a], q[a]);
+      }
+    }
+    for (int a = 0; a < 3; ++a) {
+      l.box.lo[a] = round_down(lo[a]);
+      l.box.hi[a] = round_up(hi[a]);
+    }
+    edge_leaves_[e].push_back(r);
+    fresh.push_back(r);
+    points_ += l.count;
+  }
+  ++edges_;
+}
+
+void SnapIndex::update(const Mesh& mesh, std::span<const uint32_t> changed_edge_slots) {
+  for (size_t e = mesh.edge_slots(); e < edge_leaves_.size(); ++e) remove_edge(static_cast<uint32_t>(e));
+  if (edge_leaves_.size() > mesh.edge_slots()) edge_leaves_.resize(mesh.edge_slots());
+  std::vector<uint32_t> fresh;
+  for (uint32_t e : changed_edge_slots) {
+    if (!mesh.edge_alive(e)) {
+      remove_edge(e);
+      continue;
+    }
+    const auto line = mesh.polyline(e);
+    if (e < edge_leaves_.size() && !edge_leaves_[e].empty() && same_polyline(e, line)) continue;
+    remove_edge(e);
+    add_leaves(e, line, fresh);
+  }
+  const size_t held = leaves_.size() - free_leaves_.size() - fresh.size();
+  // Inserting one by one costs a descent each and leaves a looser tree than a top-down build; when most
+  // of the index is new (loading, a first sync, an undo that touched everything) build it whole.
+  if (!fresh.empty() && fresh.size() > held) {
+    rebuild();
+    return;
+  }
+  // Removals refit once for all; each insertion refits (and rebalances) before the next descends, or a
+  // curve's leaves would pile up in one deep chain.
+  refit_touched();
+  for (uint32_t r : fresh) {
+    insert_leaf(r | kLeafRef);
+    refit_touched();
+  }
+}
+
+void SnapIndex::sync(const Mesh& mesh) {
+  const uint64_t compactions = mesh.last_compaction().count;
+  if (synced_ && compactions == synced_compactions_ + 1) {
+    // Compaction keeps each survivor's stamp, so after relabelling only real changes are re-read.
+    remap(mesh.last_compaction().map);
+  } else if (!synced_ || compactions != synced_compactions_) {
+    clear();
+    std::vector<uint32_t> all(mesh.edge_slots());
+    for (uint32_t e = 0; e < all.size(); ++e) all[e] = e;
+    update(mesh, all);
+    synced_ = true;
+    synced_frame_ = mesh.frame();
+    synced_compactions_ = compactions;
+    return;
+  }
+  update(mesh, changed_slots(mesh.edges.changes.stamp, synced_frame_));
+  synced_ = true;
+  synced_frame_ = mesh.frame();
+  synced_compactions_ = compactions;
+}
+
+void SnapIndex::remap(const CompactionMap& map) {
+  std::vector<std::vector<uint32_t>> moved(
+      static_cast<size_t>(std::count_if(map.edge.begin(), map.edge.end(), [](uint32_t x) { return x != kNone; })));
+  for (uint32_t e = 0; e < edge_leaves_.size(); ++e) {
+    if (edge_leaves_[e].empty()) continue;
+    const uint32_t to = e < map.edge.size() ? map.edge[e] : kNone;
+    if (to == kNone) {
+      remove_edge(e);
+      continue;
+    }
+    for (uint32_t r : edge_leaves_[e]) leaves_[r].edge = to;
+    moved[to] = std::move(edge_leaves_[e]);
+  }
+  edge_leaves_ = std::move(moved);
+  refit_touched();
+}
+
+// ---- the tree
+
+uint32_t SnapIndex::height() const {
+  if (root_ == kNone) return 0;
+  return uint32_t(height_of(root_)) + 1;
+}
+
+uint32_t SnapIndex::new_node() {
+  if (!free_nodes_.empty()) {
+    const uint32_t n = free_nodes_.back();
+    free_nodes_.pop_back();
+    return n;
+  }
+  nodes_.emplace_back();
+  marked_.push_back(0);
+  parent_.push_back(kNone);
+  height_.push_back(0);
+  leaves_under_.push_back(0);
+  return static_cast<uint32_t>(nodes_.size() - 1);
+}
+
+SnapIndex::Box SnapIndex::box_of(uint32_t ref) const {
+  if (ref & kLeafRef) return leaves_[ref & ~kLeafRef].box;
+  Box b = nodes_[ref].box[0];
+  merge_into(b, nodes_[ref].box[1]);
+  return b;
+}
+
+void SnapIndex::replace_child(uint32_t parent, uint32_t old_ref, uint32_t new_ref, const Box& box) {
+  if (parent == kNone) {
+    root_ = new_ref;
+    return;
+  }
+  Node& p = nodes_[parent];
+  const int s = p.child[0] == old_ref ? 0 : 1;
+  p.child[s] = new_ref;
+  p.box[s] = box;
+}
+
+// Picks the sibling that adds the least box area over the path (the surface area heuristic, greedily
+// down the tree), growing the boxes on the way, and pairs the leaf with it under a new node. Heights and
+// counts above wait for refit_touched().
+void SnapIndex::insert_leaf(uint32_t leaf) {
+  parent_of(leaf) = kNone;
+  if (root_ == kNone) {
+    root_ = leaf;
+    return;
+  }
+  const Box lb = box_of(leaf);
+  uint32_t i = root_;
+  Box ib = box_of(root_);
+  while (!(i & kLeafRef)) {
+    Node& n = nodes_[i];
+    Box merged = ib;
+    merge_into(merged, lb);
+    const double combined = half_area(merged);
+    const double here = 2 * combined, inherited = 2 * (combined - half_area(ib));
+    double cost[2];
+    for (int s = 0; s < 2; ++s) {
+      Box b = n.box[s];
+      merge_into(b, lb);
+      cost[s] = half_area(b) + inherited - (n.child[s] & kLeafRef ? 0.0 : half_area(n.box[s]));
+    }
+    if (here < cost[0] && here < cost[1]) break;
+    const int s = cost[0] <= cost[1] ? 0 : 1;
+    ib = n.box[s];
+    merge_into(n.box[s], lb);
+    i = n.child[s];
+  }
+  const uint32_t sibling = i, old_parent = parent_of(sibling);
+  const uint32_t p = new_node();
+  nodes_[p] = {{ib, lb}, {sibling, leaf}};
+  parent_[p] = old_parent;
+  parent_of(sibling) = p;
+  parent_of(leaf) = p;
+  Box pb = ib;
+  merge_into(pb, lb);
+  replace_child(old_parent, sibling, p, pb);
+  touched_.push_back(p);
+}
+
+// Puts the leaf's sibling in its parent's place; boxes, heights and counts above wait for refit_touched().
+void SnapIndex::remove_leaf(uint32_t leaf) {
+  if (leaf == root_) {
+    root_ = kNone;
+    return;
+  }
+  const uint32_t p = parent_of(leaf), gp = parent_[p];
+  const int s = nodes_[p].child[0] == leaf ? 1 : 0;
+  const uint32_t sibling = nodes_[p].child[s];
+  const Box sb = nodes_[p].box[s];
+  parent_of(sibling) = gp;
+  replace_child(gp, p, sibling, sb);
+  free_nodes_.push_back(p);
+  parent_[p] = kFreed;
+  if (gp != kNone) touched_.push_back(gp);
+}
+
+// Boxes, heights and leaf counts from node i to the root.
+void SnapIndex::refit_up(uint32_t i) {
+  for (; i != kNone; i = parent_[i]) {
+    const Node& n = nodes_[i];
+    height_[i] = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
+    leaves_under_[i] = leaves_of(n.child[0]) + leaves_of(n.child[1]);
+    const uint32_t p = parent_[i];
+    if (p != kNone) nodes_[p].box[nodes_[p].child[0] == i ? 0 : 1] = box_of(i);
+  }
+}
+
+// One pass over the union of the paths from the touched nodes to the root, children before parents, so a
+// curve's leaves, which share most of their paths, refit each shared node once. Then the highest subtrees
+// grown too deep for their leaves are rebuilt.
+void SnapIndex::refit_touched() {
+  if (touched_.empty()) return;
+  marked_list_.clear();
+  for (uint32_t t : touched_) {
+    if (parent_[t] == kFreed) continue;
+    for (; t != kNone && !marked_[t]; t = parent_[t]) {
+      marked_[t] = 1;
+      marked_list_.push_back(t);
+    }
+  }
+  touched_.clear();
+  unbalanced_.clear();
+  if (root_ != kNone && !(root_ & kLeafRef) && marked_[root_]) refit_marked(root_, unbalanced_);
+  for (uint32_t m : marked_list_) marked_[m] = 0;
+  for (uint32_t n : unbalanced_) rebuild_subtree(n);
+}
+
+void SnapIndex::refit_marked(uint32_t i, std::vector<uint32_t>& unbalanced) {
+  const size_t below = unbalanced.size();
+  Node& n = nodes_[i];
+  for (int s = 0; s < 2; ++s) {
+    const uint32_t c = n.child[s];
+    if (c & kLeafRef || !marked_[c]) continue;
+    refit_marked(c, unbalanced);
+    n.box[s] = box_of(c);
+  }
+  height_[i] = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
+  leaves_under_[i] = leaves_of(n.child[0]) + leaves_of(n.child[1]);
+  if (height_[i] > depth_limit(leaves_under_[i])) {
+    unbalanced.resize(below);  // rebuilding this subtree rebuilds those inside it
+    unbalanced.push_back(i);
+  }
+}
+
+void SnapIndex::rebuild() {
+  nodes_.clear();
+  parent_.clear();
+  height_.clear();
+  leaves_under_.clear();
+  marked_.clear();
+  free_nodes_.clear();
+  touched_.clear();
+  std::vector<Item> items;
+  for (uint32_t r = 0; r < leaves_.size(); ++r)
+    if (leaves_[r].edge != kNone) items.push_back({r | kLeafRef, leaves_[r].box});
+  root_ = kNone;
+  if (items.size() == 1) {
+    root_ = items[0].ref;
+    parent_of(root_) = kNone;
+  } else if (items.size() > 1) {
+    root_ = new_node();
+    build(items, root_, kNone);
+  }
+}
+
+// Rebuilds the subtree in place: `top` keeps its slot and its box, since it holds the same leaves.
+void SnapIndex::rebuild_subtree(uint32_t top) {
+  std::vector<Item> items;
+  std::vector<uint32_t> stack = {top};
+  while (!stack.empty()) {
+    const uint32_t i = stack.back();
+    stack.pop_back();
+    for (int s = 0; s < 2; ++s) {
+      const uint32_t c = nodes_[i].child[s];
+      if (c & kLeafRef) items.push_back({c, nodes_[i].box[s]});
+      else stack.push_back(c);
+    }
+    if (i != top) free_nodes_.push_back(i);
+  }
+  build(items, top, parent_[top]);
+  refit_up(parent_[top]);
+}
+
+// Top-down into inner node `node` (at least two items): split at the median of the box centres along the
+// axis where they spread most.
+void SnapIndex::build(std::span<Item> items, uint32_t node, uint32_t parent) {
+  parent_[node] = parent;
+  double lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = std::numeric_limits<double>::infinity();
+    hi[a] = -lo[a];
+  }
+  auto centre = [](const Item& it, int a) { return double(it.box.lo[a]) + double(it.box.hi[a]); };
+  for (const Item& it : items)
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], centre(it, a));
+      hi[a] = std::max(hi[a], centre(it, a));
+    }
+  int axis = 0;
+  for (int a = 1; a < 3; ++a)
+    if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
+  const size_t mid = items.size() / 2;
+  std::nth_element(items.begin(), items.begin() + static_cast<std::ptrdiff_t>(mid), items.end(),
+                   [&](const Item& x, const Item& y) { return centre(x, axis) < centre(y, axis); });
+  const std::span<Item> half[2] = {items.first(mid), items.subspan(mid)};
+  for (int s = 0; s < 2; ++s) {
+    uint32_t ref;
+    Box box;
+    if (half[s].size() == 1) {
+      ref = half[s][0].ref;
+      box = half[s][0].box;
+      parent_of(ref) = node;
+    } else {
+      ref = new_node();
+      build(half[s], ref, node);
+      box = box_of(ref);
+    }
+    nodes_[node].child[s] = ref;
+    nodes_[node].box[s] = box;
+  }
+  const Node& n = nodes_[node];
+  height_[node] = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
+  leaves_under_[node] = leaves_of(n.child[0]) + leaves_of(n.child[1]);
+}
+
+// ---- queries
+
+// Starts loading what a child reference points at while the current node is still being worked on.
+void SnapIndex::prefetch(uint32_t ref) const {
+  if (ref & kLeafRef) {
+    const char* l = reinterpret_cast<const char*>(&leaves_[ref & ~kLeafRef]);
+    for (size_t b = 0; b < sizeof(Leaf); b += 64) __builtin_prefetch(l + b);
+  } else {
+    __builtin_prefetch(&nodes_[ref]);
+  }
+}
+
+SnapHit SnapIndex::nearest(const Vec3& p, double radius) const {
+  SnapHit best;
+  if (root_ == kNone) return best;
+  double bound = bound_of(radius);
+  struct Pending {
+    uint32_t ref;
+    double gap;
+  };
+  Pending stack[kStack];  // left uninitialised: a query must not pay for clearing it
+  size_t top = 0;
+  stack[top++] = {root_, squared_gap(box_of(root_), p)};
+  while (top > 0) {
+    const auto [ref, gap] = stack[--top];
+    if (gap > bound) continue;
+    if (ref & kLeafRef) {
+      const Leaf& l = leaves_[ref & ~kLeafRef];
+      for (uint32_t k = 0; k < l.count; ++k) {
+        const double dx = l.x[k] - p.x(), dy = l.y[k] - p.y(), dz = l.z[k] - p.z();
+        if (dx * dx + dy * dy + dz * dz > bound) continue;
+        const Vec3 q(l.x[k], l.y[k], l.z[k]);
+        const double d = (q - p).norm();
+        if (d <= radius && before(d, l.edge, l.first + k, best)) {
+          best = {l.edge, l.first + k, d};
+          bound = bound_of(d);
+        }
+      }
+      continue;
+    }
+    const Node& n = nodes_[ref];
+    const double g0 = squared_gap(n.box[0], p), g1 = squared_gap(n.box[1], p);
+    // The nearer child goes on top, so it is searched first and tightens the bound for the other.
+    const int nearer = g1 < g0 ? 1 : 0;
+    const double gn = nearer ? g1 : g0, gf = nearer ? g0 : g1;
+    if (gf <= bound) stack[top++] = {n.child[1 - nearer], gf};
+    if (gn <= bound) {
+      stack[top++] = {n.child[nearer], gn};
+      prefetch(n.child[nearer]);
+    }
+  }
+  return best;
+}
+
+SnapHit SnapIndex::nearest_on_face(const Mesh& mesh, uint32_t f, const Vec3& p, double radius) const {
+  SnapHit best;
+  double bound = bound_of(radius);
+  // The exhaustive search's own order (loop order, then point order) with a strict comparison, so the
+  // first of equally near points wins as there; boxes only skip runs that cannot reach the best so far.
+  for (uint32_t oe : mesh.face_loop(f)) {
+    const uint32_t e = edge_of(oe);
+    if (e >= edge_leaves_.size()) continue;
+    for (uint32_t r : edge_leaves_[e]) {
+      const Leaf& l = leaves_[r];
+      if (squared_gap(l.box, p) > bound) continue;
+      for (uint32_t k = 0; k < l.count; ++k) {
+        const Vec3 q(l.x[k], l.y[k], l.z[k]);
+        const double d = (q - p).norm();
+        if (d <= radius && d < best.distance) {
+          best = {e, l.first + k, d};
+          bound = bound_of(d);
+        }
+      }
+    }
+  }
+  return best;
+}
+
+void SnapIndex::nearest_per_edge(const Vec3& p, double radius, std::vector<SnapHit>& out) const {
+  out.clear();
+  if (root_ == kNone) return;
+  const double bound = bound_of(radius);
+  uint32_t stack[kStack];
+  size_t top = 0;
+  if (squared_gap(box_of(root_), p) <= bound) stack[top++] = root_;
+  while (top > 0) {
+    const uint32_t ref = stack[--top];
+    if (!(ref & kLeafRef)) {
+      const Node& n = nodes_[ref];
+      for (int s = 0; s < 2; ++s)
+        if (squared_gap(n.box[s], p) <= bound) stack[top++] = n.child[s];
+      continue;
+    }
+    const Leaf& l = leaves_[ref & ~kLeafRef];
+    for (uint32_t k = 0; k < l.count; ++k) {
+      const Vec3 q(l.x[k], l.y[k], l.z[k]);
+      const double d = (q - p).norm();
+      if (d <= radius) out.push_back({l.edge, l.first + k, d});
+    }
+  }
+  std::sort(out.begin(), out.end(), [](const SnapHit& a, const SnapHit& b) {
+    if (a.edge != b.edge) return a.edge < b.edge;
+    return a.distance != b.distance ? a.distance < b.distance : a.point < b.point;
+  });
+  out.erase(std::unique(out.begin(), out.end(), [](const SnapHit& a, const SnapHit& b) { return a.edge == b.edge; }),
+            out.end());
+}
+
+// ---- checks
+
+namespace {
+bool same_box(const float (&alo)[3], const float (&ahi)[3], const float (&blo)[3], const float (&bhi)[3]) {
+  return std::equal(alo, alo + 3, blo) && std::equal(ahi, ahi + 3, bhi);
+}
+}  // namespace
+
+std::string SnapIndex::validate_ref(uint32_t ref, uint32_t parent, const Box& box, size_t& leaves) const {
+  const Box own = box_of(ref);
+  if (!same_box(own.lo, own.hi, box.lo, box.hi)) return "a box held by a parent is not its child's";
+  if (ref & kLeafRef) {
+    const Leaf& l = leaves_[ref & ~kLeafRef];
+    if (l.parent != parent || l.edge == kNone) return "a leaf record has a wrong parent or is free";
+    for (uint32_t k = 0; k < l.count; ++k) {
+      const double q[3] = {l.x[k], l.y[k], l.z[k]};
+      for (int a = 0; a < 3; ++a)
+        if (q[a] < l.box.lo[a] || q[a] > l.box.hi[a]) return "a point lies outside its leaf's box";
+    }
+    ++leaves;
+    return "";
+  }
+  if (parent_[ref] != parent) return "node " + std::to_string(ref) + " has a wrong parent";
+  const Node& n = nodes_[ref];
+  for (int s = 0; s < 2; ++s)
+    if (auto why = validate_ref(n.child[s], ref, n.box[s], leaves); !why.empty()) return why;
+  if (height_[ref] != 1 + std::max(height_of(n.child[0]), height_of(n.child[1])))
+    return "node " + std::to_string(ref) + " has a wrong height";
+  if (leaves_under_[ref] != leaves_of(n.child[0]) + leaves_of(n.child[1]))
+    return "node " + std::to_string(ref) + " has a wrong count";
+  if (height_[ref] > depth_limit(leaves_under_[ref])) return "node " + std::to_string(ref) + " is too deep for its leaves";
+  return "";
+}
+
+std::string SnapIndex::validate(const Mesh& mesh) const {
+  size_t points = 0, edges = 0;
+  for (uint32_t e = 0; e < std::max<size_t>(mesh.edge_slots(), edge_leaves_.size()); ++e) {
+    const bool held = e < edge_leaves_.size() && !edge_leaves_[e].empty();
+    if (held != mesh.edge_alive(e)) return "edge " + std::to_string(e) + (held ? " is held but dead" : " is live but missing");
+    if (!held) continue;
+    if (!same_polyline(e, mesh.polyline(e))) return "edge " + std::to_string(e) + " holds another polyline";
+    for (uint32_t r : edge_leaves_[e])
+      if (leaves_[r].edge != e) return "a leaf of edge " + std::to_string(e) + " names another edge";
+    points += mesh.edges.point_count[e];
+    ++edges;
+  }
+  if (points != points_ || edges != edges_) return "the point or edge count is off";
+  size_t leaves = 0;
+  if (root_ != kNone)
+    if (auto why = validate_ref(root_, kNone, box_of(root_), leaves); !why.empty()) return why;
+  if (leaves != leaves_.size() - free_leaves_.size()) return "the tree does not hold every leaf record";
+  return "";
+}
+
+}  // namespace fire

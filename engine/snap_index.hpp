@@ -1,0 +1,135 @@
+#pragma once
+// The snapping index (thesis 5.5): a bounding-volume hierarchy over the polyline points of the mesh's live
+// edges, kept in step with the mesh by incremental updates instead of rebuilds.
+//
+// Leaves are runs of up to kLeafPoints consecutive points of one polyline (a curve is spatially coherent
+// along its length, so a run's box is thin); inner nodes form a dynamic AABB tree: a new leaf goes next to
+// the sibling that adds the least box area, and a subtree that grows too deep for its size is rebuilt
+// top-down (as a scapegoat tree does), which keeps the depth logarithmic without rotations that would
+// pair far-apart subtrees. The index holds its own copy of the points, so it answers
+// between syncs without reading the mesh, and compaction only relabels edges.
+//
+// Answers and tie-breaks equal the exhaustive searches of the sketch system: distances are computed with
+// the same expression, `(q - p).norm()`, and pruning is conservative, so a tie is never cut off.
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "engine/change.hpp"
+#include "engine/mesh.hpp"
+
+namespace fire {
+
+// A polyline point: edge slot, index in the edge's polyline, distance to the query.
+struct SnapHit {
+  uint32_t edge = kNone;
+  uint32_t point = kNone;
+  double distance = std::numeric_limits<double>::infinity();
+  bool found() const { return edge != kNone; }
+  friend bool operator==(const SnapHit&, const SnapHit&) = default;
+};
+
+// The edge slots to hand to SnapIndex::update: those whose stamp (ChangeStamps::stamp) is later than `seen`.
+std::vector<uint32_t> changed_slots(std::span<const Frame> stamps, Frame seen);
+
+class SnapIndex {
+ public:
+  static constexpr uint32_t kLeafPoints = 8;
+  static constexpr double kUnbounded = std::numeric_limits<double>::infinity();
+
+  // Brings the index in step with `mesh` for these edge slots, each of which may now be dead, alive with a
+  // new polyline, or new; slots the mesh no longer has (truncated by undo) are dropped as well. A slot
+  // whose polyline is unchanged costs a comparison.
+  void update(const Mesh& mesh, std::span<const uint32_t> changed_edge_slots);
+  // Relabels the edges after Mesh::compact (no geometry is touched), so update() must have seen the frame
+  // before compaction.
+  void remap(const CompactionMap& map);
+  void clear();
+  // The end-of-frame sync: brings the index in step with every edge `mesh` stamped after the frame of the
+  // last sync, relabelling first when the mesh was compacted once since then; the first time, or after
+  // more than one compaction, it indexes every live edge afresh. Call it after the frame's last write.
+  void sync(const Mesh& mesh);
+
+  // Nearest polyline point within `radius` (distance <= radius); ties go to the lowest edge slot, then the
+  // lowest point index. Vertices are the ends of their edges' polylines.
+  SnapHit nearest(const Vec3& p, double radius = kUnbounded) const;
+  // Nearest point of face f's boundary within `radius`; ties go to the edge first in f's loop, then the
+  // lowest point index (the order sketch's exhaustive search walks the boundary in).
+  SnapHit nearest_on_face(const Mesh& mesh, uint32_t f, const Vec3& p, double radius = kUnbounded) const;
+  // For every edge with a point within `radius`: its nearest point (lowest index on ties), by edge slot.
+  void nearest_per_edge(const Vec3& p, double radius, std::vector<SnapHit>& out) const;
+
+  size_t point_count() const { return points_; }
+  size_t edge_count() const { return edges_; }
+  // Nodes on the longest path from the root to a leaf record, counting both (0 when empty).
+  uint32_t height() const;
+  // Empty when the index holds exactly the live edges of `mesh` with their polylines and the tree is sound.
+  std::string validate(const Mesh& mesh) const;
+
+ private:
+  // Single precision rounded outwards: fewer bytes per node, and a box still holds its points.
+  struct Box {
+    float lo[3], hi[3];
+  };
+  // An inner node holds its children's boxes, so a query decides on both children from the one node it
+  // has loaded, as a k-d tree decides from its split plane. A child is an inner node or a leaf record
+  // (kLeafRef set).
+  struct alignas(64) Node {  // one cache line
+    Box box[2];
+    uint32_t child[2];
+  };
+  static constexpr uint32_t kLeafRef = 0x80000000u;
+  static constexpr uint32_t kFreed = kNone - 1;  // parent_ of a node on the free list
+  struct Leaf {
+    Box box;
+    uint32_t edge, first, count, parent;  // parent: inner node, or kNone at the root
+    double x[kLeafPoints], y[kLeafPoints], z[kLeafPoints];
+  };
+  struct Item {  // a child reference with its box, while building
+    uint32_t ref;
+    Box box;
+  };
+
+  bool same_polyline(uint32_t e, std::span<const Vec3> line) const;
+  void remove_edge(uint32_t e);
+  void add_leaves(uint32_t e, std::span<const Vec3> line, std::vector<uint32_t>& fresh);
+  uint32_t new_node();
+  uint32_t& parent_of(uint32_t ref) { return ref & kLeafRef ? leaves_[ref & ~kLeafRef].parent : parent_[ref]; }
+  int32_t height_of(uint32_t ref) const { return ref & kLeafRef ? 0 : height_[ref]; }
+  uint32_t leaves_of(uint32_t ref) const { return ref & kLeafRef ? 1 : leaves_under_[ref]; }
+  Box box_of(uint32_t ref) const;
+  void replace_child(uint32_t parent, uint32_t old_ref, uint32_t new_ref, const Box& box);
+  void insert_leaf(uint32_t ref);
+  void remove_leaf(uint32_t ref);
+  void refit_up(uint32_t node);
+  void refit_touched();
+  void refit_marked(uint32_t node, std::vector<uint32_t>& unbalanced);
+  void rebuild();
+  void rebuild_subtree(uint32_t node);
+  void build(std::span<Item> items, uint32_t node, uint32_t parent);
+  void prefetch(uint32_t ref) const;
+  std::string validate_ref(uint32_t ref, uint32_t parent, const Box& box, size_t& leaves) const;
+
+  std::vector<Node> nodes_;
+  std::vector<uint32_t> parent_;
+  std::vector<int32_t> height_;  // edges to the deepest leaf record below
+  std::vector<uint32_t> leaves_under_;
+  std::vector<uint32_t> touched_;  // nodes whose subtree changed since the last refit
+  // Scratch of refit_touched(), kept to spare allocations; marked_ is all clear between calls.
+  std::vector<uint8_t> marked_;
+  std::vector<uint32_t> marked_list_, unbalanced_;
+  std::vector<uint32_t> free_nodes_;
+  std::vector<Leaf> leaves_;
+  std::vector<uint32_t> free_leaves_;
+  std::vector<std::vector<uint32_t>> edge_leaves_;  // per edge slot: its leaf records in point order
+  uint32_t root_ = kNone;                           // a child reference
+  size_t points_ = 0, edges_ = 0;
+  // What sync() has seen of the mesh.
+  bool synced_ = false;
+  Frame synced_frame_ = 0;
+  uint64_t synced_compactions_ = 0;
+};
+
+}  // namespace fire
