@@ -408,6 +408,8 @@ TEST_CASE("a live session on reader threads, with late and reordered arrivals, l
     REQUIRE(frames[c].size() == streamed);
     for (size_t k = 0; k < frames[c].size(); ++k) CHECK(frames[c][k] == k);
   }
+  CHECK_FALSE(any_rumble(s.cam0->writes()));
+  CHECK_FALSE(any_rumble(s.cam1->writes()));
   const tracking::DeviceStreams streams = tracking::decode_device_streams(log.events);
   CHECK(streams.counts.ir_reports == frames[0].size() + frames[1].size());
   CHECK(streams.counts.bad_length == 4);
