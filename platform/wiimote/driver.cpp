@@ -46,6 +46,7 @@ Driver::Driver(Backend& backend, LogWriter& log, std::vector<RemoteAssignment> a
 Driver::~Driver() { stop(); }
 
 Result<Scan> Driver::open_all() {
+  if (!links_.empty() || !threads_.empty()) return Result<Scan>::failure("the remotes are already open");
   Result<std::vector<DeviceInfo>> found = [&] {
     std::lock_guard lock(backend_mutex_);
     return backend_.enumerate();

@@ -63,7 +63,7 @@ class Driver {
   Driver& operator=(const Driver&) = delete;
 
   // Enumerates, opens every remote that has a role and begins its start-up. An assigned role
-  // whose remote is not there is looked for again while the driver runs.
+  // whose remote is not there is looked for again while the driver runs. Once, before start().
   Result<Scan> open_all();
   // One step of every remote on the calling thread, for tests (never while threads run).
   void poll(int read_timeout_ms = 0);
