@@ -417,3 +417,20 @@ TEST_CASE("a live session on reader threads, with late and reordered arrivals, l
   for (size_t k = 0; k < streams.cameras[0].size(); ++k) with_blobs += streams.cameras[0].blob_count[k] > 0;
   CHECK(with_blobs > 50);
 }
+
+TEST_CASE("a device that is not a Wii Remote is never opened, even at an assigned address") {
+  Session s(false);
+  s.cam0->unplug();
+  // Same vendor, same address as camera 0, another product (a GameCube adapter, say).
+  s.bus.add_other_device({.vendor = kNintendoVendor, .product = 0x0337, .serial = kCam0, .path = "fake:other"});
+  s.bus.add_other_device({.vendor = 0x054C, .product = kProductRemote, .serial = kPad, .path = "fake:sony"});
+  const Scan scan = s.open();
+  CHECK(scan.not_remotes.size() == 2);
+  CHECK(scan.open_errors.empty());
+  s.run_ms(1200);
+  CHECK(s.view(Role::Camera0).state == LinkState::Missing);
+  CHECK(s.view(Role::Camera0).error == "not found");
+  CHECK(s.view(Role::Camera1).state == LinkState::Running);
+  const InputLog log = s.parsed();
+  for (const InputEvent* e : metas(log, "device")) CHECK(e->text.rfind("1 ", 0) == 0);
+}
