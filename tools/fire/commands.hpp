@@ -22,4 +22,7 @@ void add_eval_commands(CLI::App& app, Registry& registry);
 // reconstruct (curve network to smooth surface, systems/reconstruct)
 void add_reconstruct_commands(CLI::App& app, Registry& registry);
 
+// devices (the Wii Remotes this machine sees, platform/wiimote)
+void add_devices_commands(CLI::App& app, Registry& registry);
+
 }  // namespace fire::cli

@@ -1,0 +1,346 @@
+#include "platform/wiimote/fake_remote.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace fire::wiimote {
+namespace {
+
+// How long a read waits in real time for a queued answer. The stream itself runs on the fake's
+// clock, so waiting longer would only slow tests down.
+constexpr int kMaxRealWaitMs = 2;
+
+// A backlog larger than this is dropped, as a remote's small buffer would.
+constexpr int kMaxBacklogReports = 32;
+
+class FakeHandle : public Device {
+ public:
+  FakeHandle(std::shared_ptr<FakeRemote> remote, uint64_t generation)
+      : remote_(std::move(remote)), generation_(generation) {}
+  Status write(std::span<const uint8_t> report) override { return remote_->host_write(generation_, report); }
+  ReadResult read(int timeout_ms) override { return remote_->host_read(generation_, timeout_ms); }
+
+ private:
+  std::shared_ptr<FakeRemote> remote_;
+  uint64_t generation_;
+};
+
+}  // namespace
+
+FakeRemote::FakeRemote(FakeRemoteOptions options, Clock clock) : options_(std::move(options)), clock_(std::move(clock)) {
+  power_on_locked();
+}
+
+void FakeRemote::power_on_locked() {
+  leds_ = 0;
+  rumble_ = false;
+  mode_ = kInButtons;
+  continuous_ = false;
+  pixel_clock_ = logic_ = false;
+  block1_ = block2_ = false;
+  registers_.clear();
+  configured_ = false;
+  bad_active_ = BadState::None;
+  fresh_ = true;
+  queue_.clear();
+  held_.clear();
+}
+
+void FakeRemote::set_blob_source(BlobSource source) {
+  std::lock_guard lock(mutex_);
+  blobs_ = std::move(source);
+}
+
+void FakeRemote::drop_acks(uint8_t id, int count) {
+  std::lock_guard lock(mutex_);
+  drop_acks_[id] += count;
+}
+
+void FakeRemote::set_never_ack(bool never) {
+  std::lock_guard lock(mutex_);
+  never_ack_ = never;
+}
+
+void FakeRemote::start_in_bad_state(BadState state, uint64_t seed) {
+  std::lock_guard lock(mutex_);
+  if (state == BadState::Random) {
+    rng_.seed(seed);
+    state = (rng_() & 1) ? BadState::NoIr : BadState::WrongMode;
+  }
+  bad_ = state;
+}
+
+void FakeRemote::send_status() {
+  std::lock_guard lock(mutex_);
+  if (plugged_) status_locked();
+}
+
+void FakeRemote::inject(Bytes report) {
+  std::lock_guard lock(mutex_);
+  if (plugged_) queue_locked(std::move(report));
+}
+
+void FakeRemote::hold_reports(bool hold) {
+  std::lock_guard lock(mutex_);
+  hold_ = hold;
+  if (!hold) {
+    for (Bytes& r : held_) queue_.push_back(std::move(r));
+    held_.clear();
+    arrived_.notify_all();
+  }
+}
+
+void FakeRemote::unplug() {
+  std::lock_guard lock(mutex_);
+  plugged_ = false;
+  ++generation_;
+  queue_.clear();
+  held_.clear();
+  arrived_.notify_all();
+}
+
+void FakeRemote::plug_in() {
+  std::lock_guard lock(mutex_);
+  if (plugged_) return;
+  plugged_ = true;
+  ++generation_;
+  power_on_locked();
+}
+
+bool FakeRemote::plugged() const {
+  std::lock_guard lock(mutex_);
+  return plugged_;
+}
+std::vector<Bytes> FakeRemote::writes() const {
+  std::lock_guard lock(mutex_);
+  return writes_;
+}
+uint8_t FakeRemote::leds() const {
+  std::lock_guard lock(mutex_);
+  return leds_;
+}
+bool FakeRemote::rumbling() const {
+  std::lock_guard lock(mutex_);
+  return rumble_;
+}
+uint8_t FakeRemote::reporting_mode() const {
+  std::lock_guard lock(mutex_);
+  return mode_;
+}
+bool FakeRemote::continuous() const {
+  std::lock_guard lock(mutex_);
+  return continuous_;
+}
+bool FakeRemote::camera_working() const {
+  std::lock_guard lock(mutex_);
+  return camera_working_locked();
+}
+int FakeRemote::initialisations() const {
+  std::lock_guard lock(mutex_);
+  return initialisations_;
+}
+size_t FakeRemote::reports_streamed() const {
+  std::lock_guard lock(mutex_);
+  return streamed_;
+}
+uint8_t FakeRemote::register_at(uint32_t address) const {
+  std::lock_guard lock(mutex_);
+  const auto it = registers_.find(address);
+  return it == registers_.end() ? 0 : it->second;
+}
+uint64_t FakeRemote::generation() const {
+  std::lock_guard lock(mutex_);
+  return generation_;
+}
+
+bool FakeRemote::camera_working_locked() const {
+  const auto reg = [&](uint32_t a) {
+    const auto it = registers_.find(a);
+    return it == registers_.end() ? -1 : int{it->second};
+  };
+  return configured_ && bad_active_ == BadState::None && pixel_clock_ && logic_ && block1_ && block2_ &&
+         reg(kRegIrControl) == kIrControlEnable && reg(kRegIrMode) == kIrModeExtended;
+}
+
+void FakeRemote::queue_locked(Bytes report) {
+  queue_.push_back(std::move(report));
+  arrived_.notify_all();
+}
+
+void FakeRemote::ack_locked(uint8_t id, uint8_t error) {
+  if (never_ack_) return;
+  auto it = drop_acks_.find(id);
+  if (it != drop_acks_.end() && it->second > 0) {
+    --it->second;
+    return;
+  }
+  queue_locked({kInAck, 0x00, 0x00, id, error});
+}
+
+void FakeRemote::status_locked() {
+  const uint8_t flags = static_cast<uint8_t>(leds_ | (pixel_clock_ ? 0x08 : 0) | (options_.battery < 0x20 ? 0x01 : 0));
+  queue_locked({kInStatus, 0x00, 0x00, flags, 0x00, 0x00, options_.battery});
+  continuous_ = false;  // the trap the notes describe: reporting stops until 0x12 is sent again
+}
+
+Status FakeRemote::host_write(uint64_t generation, std::span<const uint8_t> r) {
+  std::lock_guard lock(mutex_);
+  if (!plugged_ || generation != generation_) return Status::failure("the remote is gone (switched off or out of range)");
+  writes_.emplace_back(r.begin(), r.end());
+  if (r.size() < 2) return Status::success();  // nothing a remote can act on
+  const uint8_t id = r[0], flags = r[1];
+  const bool wants_ack = flags & kAckRequestBit;
+  rumble_ = flags & kRumbleBit;
+  switch (id) {
+    case kOutLeds:
+      leds_ = flags & kLedBits;
+      break;
+    case kOutReportingMode:
+      if (r.size() < 3) break;
+      continuous_ = flags & kEnableBit;
+      mode_ = r[2];
+      next_report_ns_ = clock_() + options_.phase_ns;
+      if (configured_ || (pixel_clock_ && logic_ && block1_ && block2_)) {
+        if (!configured_) ++initialisations_;
+        configured_ = true;
+      }
+      break;
+    case kOutIrPixelClock:
+      pixel_clock_ = flags & kEnableBit;
+      // A new set-up starts here: a camera that came up wrong works after being set up again.
+      if (configured_) bad_active_ = BadState::None;
+      configured_ = false;
+      if (bad_ != BadState::None) {
+        bad_active_ = bad_;
+        bad_ = BadState::None;
+      }
+      break;
+    case kOutIrLogic:
+      logic_ = flags & kEnableBit;
+      break;
+    case kOutStatusRequest:
+      status_locked();
+      return Status::success();
+    case kOutWriteMemory:
+      if (r.size() < 6) return Status::success();
+      if (flags & kEnableBit) {
+        const uint32_t address = uint32_t{r[2]} << 16 | uint32_t{r[3]} << 8 | r[4];
+        const size_t n = std::min<size_t>(r[5], r.size() - 6);
+        for (size_t k = 0; k < n; ++k) registers_[address + static_cast<uint32_t>(k)] = r[6 + k];
+        if (address == kRegIrBlock1 && n == 9) block1_ = true;
+        if (address == kRegIrBlock2 && n == 2) block2_ = true;
+      }
+      ack_locked(id, 0);  // a memory write is always answered
+      return Status::success();
+    case 0x14: case 0x19:
+      break;
+    default:
+      return Status::success();  // not acknowledged by any reading of the notes
+  }
+  if (wants_ack) ack_locked(id, 0);
+  return Status::success();
+}
+
+Bytes FakeRemote::data_report_locked(int64_t t_ns) {
+  const uint8_t mode = bad_active_ == BadState::WrongMode && configured_ ? uint8_t{0x31} : mode_;
+  if (mode != kInIrExtended) {
+    const size_t size = input_report_size(mode);
+    Bytes out(size ? size : 3, 0);
+    out[0] = size ? mode : kInButtons;
+    return out;
+  }
+  IrObjects objects{};
+  if (camera_working_locked() && blobs_) objects = blobs_(t_ns);
+  const bool any = std::any_of(objects.begin(), objects.end(), [](const IrObject& o) { return o.seen; });
+  Bytes out = ir_extended_report(objects, fresh_ && !any);
+  if (any) fresh_ = false;
+  out[3] = static_cast<uint8_t>(streamed_ >> 16);
+  out[4] = static_cast<uint8_t>(streamed_ >> 8);
+  out[5] = static_cast<uint8_t>(streamed_);
+  return out;
+}
+
+ReadResult FakeRemote::host_read(uint64_t generation, int timeout_ms) {
+  std::unique_lock lock(mutex_);
+  const auto gone = [&] {
+    return ReadResult{.status = ReadStatus::Gone, .report = {}, .error = "the remote is gone (switched off or out of range)"};
+  };
+  for (int pass = 0; pass < 2; ++pass) {
+    if (!plugged_ || generation != generation_) return gone();
+    if (continuous_ && options_.rate_hz > 0) {
+      const int64_t period = static_cast<int64_t>(std::llround(1e9 / options_.rate_hz));
+      const int64_t now = clock_();
+      if (now - next_report_ns_ > kMaxBacklogReports * period) next_report_ns_ = now - kMaxBacklogReports * period;
+      while (next_report_ns_ <= now) {
+        Bytes r = data_report_locked(next_report_ns_);
+        ++streamed_;
+        next_report_ns_ += period;
+        (hold_ ? held_ : queue_).push_back(std::move(r));
+      }
+    }
+    if (!queue_.empty()) {
+      ReadResult out{.status = ReadStatus::Report, .report = std::move(queue_.front()), .error = {}};
+      queue_.pop_front();
+      return out;
+    }
+    if (pass == 1 || timeout_ms <= 0) break;
+    arrived_.wait_for(lock, std::chrono::milliseconds(std::min(timeout_ms, kMaxRealWaitMs)));
+  }
+  return ReadResult{};
+}
+
+std::shared_ptr<FakeRemote> FakeBus::add_remote(FakeRemoteOptions options) {
+  auto remote = std::make_shared<FakeRemote>(std::move(options), clock_);
+  std::lock_guard lock(mutex_);
+  remotes_.push_back(remote);
+  return remote;
+}
+
+void FakeBus::add_other_device(DeviceInfo info) {
+  std::lock_guard lock(mutex_);
+  others_.push_back(std::move(info));
+}
+
+void FakeBus::deny_open(const std::string& address, std::string why) {
+  std::lock_guard lock(mutex_);
+  if (why.empty())
+    denied_.erase(address);
+  else
+    denied_[address] = std::move(why);
+}
+
+int FakeBus::opens(const std::string& address) const {
+  std::lock_guard lock(mutex_);
+  const auto it = opens_.find(address);
+  return it == opens_.end() ? 0 : it->second;
+}
+
+Result<std::vector<DeviceInfo>> FakeBus::enumerate() {
+  std::lock_guard lock(mutex_);
+  std::vector<DeviceInfo> out;
+  for (const auto& r : remotes_)
+    if (r->plugged())
+      out.push_back({.vendor = kNintendoVendor, .product = r->options().product, .serial = r->options().address,
+                     .path = "fake:" + r->options().address});
+  out.insert(out.end(), others_.begin(), others_.end());
+  // Real enumeration order changes from one call to the next; so does this one's.
+  if (!out.empty()) std::rotate(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(rotation_++ % out.size()), out.end());
+  return out;
+}
+
+Result<std::unique_ptr<Device>> FakeBus::open(const DeviceInfo& info) {
+  using R = Result<std::unique_ptr<Device>>;
+  std::lock_guard lock(mutex_);
+  for (const auto& r : remotes_) {
+    if ("fake:" + r->options().address != info.path) continue;
+    if (!r->plugged()) return R::failure(info.path + ": no such device (switched off?)");
+    const auto denied = denied_.find(r->options().address);
+    if (denied != denied_.end()) return R::failure(info.path + ": " + denied->second);
+    ++opens_[r->options().address];
+    return R(std::make_unique<FakeHandle>(r, r->generation()));
+  }
+  return R::failure(info.path + ": not a device on this bus");
+}
+
+}  // namespace fire::wiimote

@@ -1,0 +1,107 @@
+#include "platform/wiimote/protocol.hpp"
+
+#include <algorithm>
+
+namespace fire::wiimote {
+
+bool is_wii_remote(uint16_t vendor, uint16_t product) {
+  return vendor == kNintendoVendor && (product == kProductRemote || product == kProductRemotePlus);
+}
+
+SensitivityBlocks sensitivity_blocks(int level) {
+  switch (level) {
+    case 1: return {{0x02, 0x00, 0x00, 0x71, 0x01, 0x00, 0x64, 0x00, 0xFE}, {0xFD, 0x05}};
+    case 2: return {{0x02, 0x00, 0x00, 0x71, 0x01, 0x00, 0x96, 0x00, 0xB4}, {0xB3, 0x04}};
+    case 4: return {{0x02, 0x00, 0x00, 0x71, 0x01, 0x00, 0xC8, 0x00, 0x36}, {0x35, 0x03}};
+    case 5: return {{0x07, 0x00, 0x00, 0x71, 0x01, 0x00, 0x72, 0x00, 0x20}, {0x1F, 0x03}};
+    case kHighSensitivity: return {{0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x90, 0x00, 0x41}, {0x40, 0x00}};
+    default: return {{0x02, 0x00, 0x00, 0x71, 0x01, 0x00, 0xAA, 0x00, 0x64}, {0x63, 0x03}};
+  }
+}
+
+Bytes leds_report(uint8_t leds, bool ack) {
+  return {kOutLeds, static_cast<uint8_t>((leds & kLedBits) | (ack ? kAckRequestBit : 0))};
+}
+
+Bytes reporting_mode_report(uint8_t mode, bool continuous, bool ack) {
+  return {kOutReportingMode, static_cast<uint8_t>((continuous ? kEnableBit : 0) | (ack ? kAckRequestBit : 0)), mode};
+}
+
+Bytes ir_pixel_clock_report(bool ack) {
+  return {kOutIrPixelClock, static_cast<uint8_t>(kEnableBit | (ack ? kAckRequestBit : 0))};
+}
+
+Bytes ir_logic_report(bool ack) { return {kOutIrLogic, static_cast<uint8_t>(kEnableBit | (ack ? kAckRequestBit : 0))}; }
+
+Bytes status_request_report() { return {kOutStatusRequest, 0x00}; }
+
+Bytes write_register_report(uint32_t address, std::span<const uint8_t> data) {
+  const size_t n = std::min<size_t>(data.size(), 16);
+  Bytes out(22, 0);
+  out[0] = kOutWriteMemory;
+  out[1] = kEnableBit;
+  out[2] = static_cast<uint8_t>(address >> 16);
+  out[3] = static_cast<uint8_t>(address >> 8);
+  out[4] = static_cast<uint8_t>(address);
+  out[5] = static_cast<uint8_t>(n);
+  std::copy_n(data.begin(), n, out.begin() + 6);
+  return out;
+}
+
+size_t input_report_size(uint8_t id) {
+  switch (id) {
+    case 0x20: return 7;
+    case 0x21: return 22;
+    case 0x22: return 5;
+    case 0x30: return 3;
+    case 0x31: return 6;
+    case 0x32: return 11;
+    case 0x33: return 18;
+    case 0x34: case 0x35: case 0x36: case 0x37: case 0x3D: case 0x3E: case 0x3F: return 22;
+    default: return 0;
+  }
+}
+
+std::optional<Ack> parse_ack(std::span<const uint8_t> report) {
+  if (report.size() != input_report_size(kInAck) || report[0] != kInAck) return std::nullopt;
+  return Ack{.report_id = report[3], .error = report[4]};
+}
+
+std::optional<StatusReport> parse_status(std::span<const uint8_t> report) {
+  if (report.size() != input_report_size(kInStatus) || report[0] != kInStatus) return std::nullopt;
+  return StatusReport{.flags = report[3], .battery = report[6]};
+}
+
+std::optional<int> ir_object_count(std::span<const uint8_t> report) {
+  if (report.size() != input_report_size(kInIrExtended) || report[0] != kInIrExtended) return std::nullopt;
+  int n = 0;
+  for (size_t k = 0; k < 4; ++k) {
+    const uint8_t b0 = report[6 + 3 * k], b1 = report[7 + 3 * k], b2 = report[8 + 3 * k];
+    const int x = b0 | ((b2 & 0x30) << 4);
+    const int y = b1 | ((b2 & 0xC0) << 2);
+    const bool fresh_zero = x == 0 && y == 0 && (b2 & 0x0F) == 0;
+    n += y < 768 && !fresh_zero;
+  }
+  return n;
+}
+
+Bytes ir_extended_report(const IrObjects& objects, bool fresh) {
+  Bytes out(input_report_size(kInIrExtended), 0);
+  out[0] = kInIrExtended;
+  for (size_t k = 0; k < 4; ++k) {
+    const IrObject& o = objects[k];
+    uint8_t* b = out.data() + 6 + 3 * k;
+    if (!o.seen) {
+      const uint8_t empty = fresh ? 0x00 : 0xFF;
+      b[0] = b[1] = b[2] = empty;
+      continue;
+    }
+    const int x = std::min<int>(o.x, 1023), y = std::min<int>(o.y, 767);
+    b[0] = static_cast<uint8_t>(x & 0xFF);
+    b[1] = static_cast<uint8_t>(y & 0xFF);
+    b[2] = static_cast<uint8_t>(((y >> 8) & 0x03) << 6 | ((x >> 8) & 0x03) << 4 | (o.size & 0x0F));
+  }
+  return out;
+}
+
+}  // namespace fire::wiimote

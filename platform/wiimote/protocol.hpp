@@ -1,0 +1,104 @@
+#pragma once
+// The few Wii Remote reports the driver writes and reads (shared/wiimote-protocol.md). Kept here,
+// not taken from systems/tracking/hid.hpp, because platform/ never includes systems/: the driver
+// only needs to build output reports, read acknowledgements and status reports, and see whether
+// an IR report holds any object. Every parser accepts any byte sequence.
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+namespace fire::wiimote {
+
+using Bytes = std::vector<uint8_t>;
+
+inline constexpr uint16_t kNintendoVendor = 0x057E;
+inline constexpr uint16_t kProductRemote = 0x0306;      // the original Wii Remote
+inline constexpr uint16_t kProductRemotePlus = 0x0330;  // Wii Remote Plus (-TR)
+bool is_wii_remote(uint16_t vendor, uint16_t product);
+
+// Output report ids.
+inline constexpr uint8_t kOutLeds = 0x11;
+inline constexpr uint8_t kOutReportingMode = 0x12;
+inline constexpr uint8_t kOutIrPixelClock = 0x13;
+inline constexpr uint8_t kOutStatusRequest = 0x15;
+inline constexpr uint8_t kOutWriteMemory = 0x16;
+inline constexpr uint8_t kOutIrLogic = 0x1A;
+// Input report ids.
+inline constexpr uint8_t kInStatus = 0x20;
+inline constexpr uint8_t kInAck = 0x22;
+inline constexpr uint8_t kInButtons = 0x30;
+inline constexpr uint8_t kInIrExtended = 0x33;
+
+// Bits of the first payload byte of an output report.
+inline constexpr uint8_t kRumbleBit = 0x01;
+inline constexpr uint8_t kAckRequestBit = 0x02;  // 0x11-0x14, 0x19, 0x1A: acknowledge this report
+inline constexpr uint8_t kEnableBit = 0x04;      // 0x13/0x1A: on; 0x12: continuous; 0x16: registers
+inline constexpr uint8_t kLedBits = 0xF0;
+// The LED bit of player n (1..4).
+constexpr uint8_t player_led(int n) { return static_cast<uint8_t>(0x10 << (n - 1)); }
+
+// IR camera registers.
+inline constexpr uint32_t kRegIrControl = 0xB00030;
+inline constexpr uint32_t kRegIrBlock1 = 0xB00000;
+inline constexpr uint32_t kRegIrBlock2 = 0xB0001A;
+inline constexpr uint32_t kRegIrMode = 0xB00033;
+inline constexpr uint8_t kIrControlEnable = 0x08;
+inline constexpr uint8_t kIrModeExtended = 3;  // 3 bytes per object, read by report 0x33
+
+// Sensitivity 1..5 are the Wii's levels; kHighSensitivity is the community's high setting.
+inline constexpr int kHighSensitivity = 6;
+struct SensitivityBlocks {
+  std::array<uint8_t, 9> block1;
+  std::array<uint8_t, 2> block2;
+};
+// Levels outside 1..kHighSensitivity give level 3, the kernel's default.
+SensitivityBlocks sensitivity_blocks(int level);
+
+// Output reports; the rumble bit is left clear (the driver sets it per remote when it writes).
+Bytes leds_report(uint8_t leds, bool ack);
+Bytes reporting_mode_report(uint8_t mode, bool continuous, bool ack);
+Bytes ir_pixel_clock_report(bool ack);
+Bytes ir_logic_report(bool ack);
+Bytes status_request_report();
+// Writes 1..16 bytes to a register address; a memory write is always acknowledged.
+Bytes write_register_report(uint32_t address, std::span<const uint8_t> data);
+
+// Input report length including the id, or 0 for an id no Wii Remote sends.
+size_t input_report_size(uint8_t id);
+// A data report (0x30-0x3F): what the reporting mode streams.
+inline bool is_data_report(uint8_t id) { return id >= 0x30 && id <= 0x3F; }
+
+struct Ack {
+  uint8_t report_id = 0;
+  uint8_t error = 0;
+};
+std::optional<Ack> parse_ack(std::span<const uint8_t> report);
+
+struct StatusReport {
+  uint8_t flags = 0;    // 0x01 battery low, 0x02 extension, 0x04 speaker, 0x08 IR camera on, LEDs in 0xF0
+  uint8_t battery = 0;  // the raw level; kBatteryFull is a fresh pair of cells
+  bool battery_low() const { return flags & 0x01; }
+};
+inline constexpr uint8_t kBatteryFull = 0xC8;
+std::optional<StatusReport> parse_status(std::span<const uint8_t> report);
+
+// Objects in a well-formed 0x33 report: a slot counts unless it is the all-ones empty marker, a
+// y beyond the sensor, or a fresh remote's zero slot (x = y = 0, size 0). nullopt when the report
+// is not a complete 0x33.
+std::optional<int> ir_object_count(std::span<const uint8_t> report);
+
+// One IR object as a 0x33 report carries it.
+struct IrObject {
+  bool seen = false;
+  uint16_t x = 0;    // 0..1023
+  uint16_t y = 0;    // 0..767
+  uint8_t size = 0;  // 0..15
+};
+using IrObjects = std::array<IrObject, 4>;
+// The 18 bytes of a 0x33 report; unseen slots are FF FF FF, or zeros when `fresh` (a remote that
+// has not yet seen light).
+Bytes ir_extended_report(const IrObjects& objects, bool fresh);
+
+}  // namespace fire::wiimote

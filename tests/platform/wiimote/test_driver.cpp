@@ -1,0 +1,436 @@
+// The driver against fake remotes: roles by address, the input log, feedback, faults, and a live
+// session on reader threads whose log parses and keeps every report in order.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <map>
+#include <sstream>
+#include <thread>
+
+#include "engine/input_log.hpp"
+#include "platform/obj.hpp"
+#include "platform/wiimote/driver.hpp"
+#include "platform/wiimote/fake_remote.hpp"
+#include "systems/tracking/simulate.hpp"
+#include "systems/tracking/track.hpp"
+#include "tests/platform/wiimote/helpers.hpp"
+
+using namespace fire;
+using namespace fire::wiimote;
+using namespace fire::wiimote::test;
+
+namespace {
+
+const std::string kCam0 = "00:1F:32:00:00:0A";
+const std::string kCam1 = "00:1F:32:00:00:0B";
+const std::string kPad = "00:1F:32:00:00:0C";
+const std::string kStranger = "00:1F:32:00:00:0D";
+
+std::vector<RemoteAssignment> rig_roles() {
+  return {{kCam0, Role::Camera0}, {kCam1, Role::Camera1}, {kPad, Role::CommandPad}};
+}
+
+struct Session {
+  explicit Session(bool with_pad = true, std::vector<RemoteAssignment> roles = rig_roles(), DriverOptions options = {})
+      : bus(clock.clock()), log(text, clock.clock()) {
+    cam0 = bus.add_remote({.address = kCam0, .product = kProductRemote, .phase_ns = 3 * kMs});
+    cam1 = bus.add_remote({.address = "00:1f:32:00:00:0b", .product = kProductRemotePlus, .phase_ns = 7 * kMs});
+    if (with_pad) pad = bus.add_remote({.address = kPad});
+    for (int c = 0; c < 2; ++c) {
+      (c ? cam1 : cam0)->set_blob_source([this, c](int64_t) {
+        IrObjects o{};
+        if (visible[c]) o[0] = {.seen = true, .x = static_cast<uint16_t>(300 + 100 * c), .y = 200, .size = 2};
+        return o;
+      });
+    }
+    driver = std::make_unique<Driver>(bus, log, std::move(roles), options, clock.clock());
+  }
+  Scan open() {
+    Result<Scan> scan = driver->open_all();
+    REQUIRE(scan.ok());
+    return *scan;
+  }
+  void run_ms(int ms) {
+    for (int i = 0; i < ms; ++i) {
+      clock.advance(kMs);
+      driver->poll(0);
+    }
+  }
+  RemoteView view(Role role) const {
+    for (const RemoteView& v : driver->remotes())
+      if (v.role == role) return v;
+    FAIL("no remote with that role");
+    return {};
+  }
+  bool all_running() const {
+    for (const RemoteView& v : driver->remotes())
+      if (v.state != LinkState::Running) return false;
+    return true;
+  }
+  InputLog parsed() const {
+    Result<InputLog> l = parse_input_log(text.str(), "live");
+    INFO(l.error());
+    REQUIRE(l.ok());
+    return *l;
+  }
+  std::vector<std::string> notices() {
+    std::vector<std::string> out;
+    for (Notice& n : driver->take_notices()) out.push_back(std::to_string(n.device) + " " + n.text);
+    return out;
+  }
+
+  ManualClock clock{5'000'000'000};
+  FakeBus bus;
+  std::ostringstream text;
+  LogWriter log;
+  std::shared_ptr<FakeRemote> cam0, cam1, pad;
+  std::array<bool, 2> visible{};
+  std::unique_ptr<Driver> driver;
+};
+
+std::vector<const InputEvent*> metas(const InputLog& log, const std::string& key) {
+  std::vector<const InputEvent*> out;
+  for (const InputEvent& e : log.events)
+    if (e.kind == EventKind::Meta && e.name == key) out.push_back(&e);
+  return out;
+}
+
+bool contains(const std::vector<std::string>& lines, const std::string& part) {
+  return std::any_of(lines.begin(), lines.end(), [&](const std::string& l) { return l.find(part) != std::string::npos; });
+}
+
+}  // namespace
+
+TEST_CASE("driver opens the remotes with a role by address, leaves the rest alone and logs who is who") {
+  Session s;
+  auto stranger = s.bus.add_remote({.address = kStranger});
+  s.bus.add_other_device({.vendor = kNintendoVendor, .product = 0x0337, .serial = "", .path = "fake:gc-adapter"});
+  s.bus.add_other_device({.vendor = 0x046D, .product = 0xC52B, .serial = "", .path = "fake:receiver"});
+  const Scan scan = s.open();
+  CHECK(scan.not_remotes.size() == 2);
+  REQUIRE(scan.unassigned.size() == 1);
+  CHECK(scan.unassigned[0].serial == kStranger);
+  CHECK(scan.open_errors.empty());
+  s.visible = {true, true};
+  s.run_ms(300);
+  CHECK(s.all_running());
+  CHECK(s.bus.opens(kStranger) == 0);
+  CHECK(stranger->writes().empty());
+
+  const InputLog log = s.parsed();
+  const auto devices = metas(log, "device");
+  REQUIRE(devices.size() == 3);
+  std::vector<std::string> texts;
+  for (const InputEvent* e : devices) texts.push_back(e->text);
+  std::sort(texts.begin(), texts.end());
+  CHECK(texts[0] == "0 " + kCam0 + " camera0 0306");
+  CHECK(texts[1] == "1 " + kCam1 + " camera1 0330");
+  CHECK(texts[2] == "2 " + kPad + " pad 0306");
+  // Every report as it arrived: acknowledgements and status reports too.
+  std::map<int, std::map<uint8_t, int>> ids;
+  for (const InputEvent& e : log.events)
+    if (e.kind == EventKind::Hid) ++ids[e.device][e.bytes.at(0)];
+  CHECK(ids[0][0x33] > 20);
+  CHECK(ids[1][0x33] > 20);
+  CHECK(ids[0][0x22] == 9);
+  CHECK(ids[2][0x20] == 1);
+  CHECK(ids[2][0x22] == 2);
+  CHECK(ids.size() == 3);
+  // LEDs number the remotes by role.
+  CHECK(s.cam0->leds() == player_led(1));
+  CHECK(s.cam1->leds() == player_led(2));
+  CHECK(s.pad->leds() == player_led(3));
+  REQUIRE(s.view(Role::Camera1).status);
+  CHECK(s.view(Role::Camera1).status->battery == 0xA0);
+}
+
+TEST_CASE("without role assignments the remotes take roles by address order") {
+  Session s(false, {});
+  s.open();
+  s.run_ms(50);
+  CHECK(s.view(Role::Camera0).address == kCam0);
+  CHECK(s.view(Role::Camera1).address == kCam1);
+  CHECK(s.driver->remotes().size() == 2);
+}
+
+TEST_CASE("a third remote becomes the command pad only when the rig says so") {
+  SECTION("assigned: opened, started without the camera") {
+    Session s;
+    s.open();
+    s.run_ms(100);
+    CHECK(s.view(Role::CommandPad).state == LinkState::Running);
+    CHECK(writes_of(s.pad->writes(), kOutIrPixelClock).empty());
+  }
+  SECTION("not in the rig: left alone") {
+    Session s(true, {{kCam0, Role::Camera0}, {kCam1, Role::Camera1}});
+    const Scan scan = s.open();
+    CHECK(scan.unassigned.size() == 1);
+    s.run_ms(100);
+    CHECK(s.pad->writes().empty());
+    CHECK(s.driver->remotes().size() == 2);
+  }
+}
+
+TEST_CASE("feedback: LEDs say which camera lost the pen, only the pad rumbles") {
+  Session s;
+  s.open();
+  s.run_ms(200);
+  REQUIRE(s.all_running());
+  s.visible = {true, true};
+  s.run_ms(100);
+  CHECK(s.driver->pen_down());
+  CHECK(s.cam0->leds() == player_led(1));
+  s.notices();
+
+  // The pen leaves camera 1's view.
+  s.visible = {true, false};
+  s.run_ms(80);
+  CHECK_FALSE(s.driver->pen_down());
+  CHECK(s.cam1->leds() == (player_led(2) | kLostLed));
+  CHECK(s.cam0->leds() == player_led(1));
+  CHECK(s.pad->rumbling());
+  CHECK(contains(s.notices(), "left camera 1's view"));
+  s.run_ms(200);
+  CHECK_FALSE(s.pad->rumbling());
+
+  // Back in view, then both lose it at once while it is down.
+  s.visible = {true, true};
+  s.run_ms(50);
+  CHECK(s.cam1->leds() == player_led(2));
+  CHECK(s.driver->pen_down());
+  s.visible = {false, false};
+  s.run_ms(80);
+  CHECK(s.pad->rumbling());
+  CHECK(s.cam0->leds() == (player_led(1) | kLostLed));
+  CHECK(s.cam1->leds() == (player_led(2) | kLostLed));
+  CHECK(contains(s.notices(), "both cameras lost the pen"));
+  s.run_ms(200);
+  CHECK_FALSE(s.pad->rumbling());
+  // The pen seen again clears the warning LEDs.
+  s.visible = {true, false};
+  s.run_ms(30);
+  CHECK(s.cam0->leds() == player_led(1));
+
+  CHECK(any_rumble(s.pad->writes()));
+  CHECK_FALSE(any_rumble(s.cam0->writes()));
+  CHECK_FALSE(any_rumble(s.cam1->writes()));
+  CHECK(s.parsed().events.size() > 0);
+}
+
+TEST_CASE("a camera switched off mid-stroke ends the stroke, is reported and reopened when it returns") {
+  Session s;
+  s.open();
+  s.visible = {true, true};
+  s.run_ms(300);
+  REQUIRE(s.all_running());
+  REQUIRE(s.driver->pen_down());
+  s.notices();
+  const std::string before = s.text.str();
+
+  s.cam1->unplug();
+  s.run_ms(20);
+  CHECK_FALSE(s.driver->pen_down());
+  CHECK(s.view(Role::Camera1).state == LinkState::Missing);
+  const auto lost = s.notices();
+  CHECK(contains(lost, "1 lost"));
+  CHECK(contains(lost, "1 the stroke ended: camera 1 is gone"));
+  CHECK(s.pad->rumbling());
+  s.run_ms(2000);  // looked for, not there
+  CHECK(s.view(Role::Camera1).state == LinkState::Missing);
+  CHECK(s.view(Role::Camera0).state == LinkState::Running);
+
+  s.cam1->plug_in();
+  s.run_ms(1000);
+  CHECK(s.view(Role::Camera1).state == LinkState::Running);
+  CHECK(s.bus.opens("00:1f:32:00:00:0b") == 2);  // as the bus spells it
+  CHECK(s.cam1->camera_working());
+  CHECK(s.cam1->leds() == player_led(2));
+  CHECK(s.driver->pen_down());
+
+  // Nothing logged before the loss is gone; the log tells the story in order.
+  const std::string after = s.text.str();
+  CHECK(after.compare(0, before.size(), before) == 0);
+  const InputLog log = s.parsed();
+  const auto gone = metas(log, "device_lost");
+  REQUIRE(gone.size() == 1);
+  CHECK(gone[0]->text.rfind("1 " + kCam1 + " ", 0) == 0);
+  const auto opened = metas(log, "device");
+  REQUIRE(opened.size() == 4);
+  CHECK(opened[3]->text == "1 " + kCam1 + " camera1 0330");
+  CHECK(opened[3]->t_us > gone[0]->t_us);
+  size_t cam1_after = 0;
+  for (const InputEvent& e : log.events)
+    cam1_after += e.kind == EventKind::Hid && e.device == 1 && e.t_us > opened[3]->t_us && e.bytes[0] == 0x33;
+  CHECK(cam1_after > 30);
+}
+
+TEST_CASE("a camera missing at start is picked up when it is switched on") {
+  Session s;
+  s.cam1->unplug();
+  const Scan scan = s.open();
+  CHECK(scan.open_errors.empty());
+  CHECK(s.view(Role::Camera1).state == LinkState::Missing);
+  CHECK(contains(s.notices(), "1 not found"));
+  s.run_ms(100);
+  s.cam1->plug_in();
+  s.run_ms(600);
+  CHECK(s.all_running());
+}
+
+TEST_CASE("a remote that cannot be opened says why") {
+  Session s;
+  s.bus.deny_open(kCam0, "permission denied");
+  const Scan scan = s.open();
+  REQUIRE(scan.open_errors.size() == 1);
+  CHECK_THAT(scan.open_errors[0], Catch::Contains("permission denied"));
+  CHECK(s.view(Role::Camera0).state == LinkState::Missing);
+  CHECK_THAT(s.view(Role::Camera0).error, Catch::Contains("permission denied"));
+}
+
+TEST_CASE("a remote that never acknowledges fails in bounded time; the others run") {
+  Session s;
+  s.cam0->set_never_ack(true);
+  s.open();
+  const StartupOptions o;
+  s.run_ms(static_cast<int>(o.max_sequences * o.max_tries * o.ack_timeout_ns / kMs + 50));
+  const RemoteView v = s.view(Role::Camera0);
+  CHECK(v.state == LinkState::Failed);
+  CHECK_THAT(v.error, Catch::Contains("hid-wiimote"));
+  CHECK(s.view(Role::Camera1).state == LinkState::Running);
+  CHECK(contains(s.notices(), "0 failed: no acknowledgement"));
+}
+
+TEST_CASE("status reports mid-drawing and garbage from a remote lose no drawing") {
+  Session s;
+  s.open();
+  s.visible = {true, true};
+  s.run_ms(200);
+  REQUIRE(s.all_running());
+  s.cam0->send_status();
+  s.cam1->inject({0x33, 0x00, 0x01});
+  s.cam1->inject({0x7F, 0x01});
+  s.run_ms(100);
+  CHECK(s.cam0->continuous());
+  CHECK(s.driver->pen_down());
+  const InputLog log = s.parsed();
+  const tracking::DeviceStreams streams = tracking::decode_device_streams(log.events);
+  CHECK(streams.counts.bad_length == 1);
+  CHECK(streams.counts.unknown_id == 1);
+  CHECK(streams.counts.ir_reports > 50);
+}
+
+namespace {
+
+// The blobs each camera of the simulated rig saw, in time order, for a fake remote to replay.
+struct SimulatedBlobs {
+  std::array<std::vector<std::pair<int64_t, IrObjects>>, 2> frames;
+  IrObjects at(int camera, int64_t t_ns) const {
+    const auto& f = frames[camera];
+    auto it = std::upper_bound(f.begin(), f.end(), t_ns,
+                               [](int64_t t, const std::pair<int64_t, IrObjects>& p) { return t < p.first; });
+    return it == f.begin() ? IrObjects{} : std::prev(it)->second;
+  }
+};
+
+SimulatedBlobs simulated_blobs() {
+  Result<PolygonMesh> mesh = read_obj(std::string(FIRE_SHARED_DIR) + "/data/meshes/pawn.obj");
+  REQUIRE(mesh.ok());
+  tracking::SketchOptions sketch;
+  sketch.strokes = 2;
+  sketch.hold_s = 0.2;
+  sketch.duration_s = 3;
+  Result<tracking::SimulatedSession> sim = tracking::simulate_sketch(
+      tracking::RigOptions{}, sketch, tracking::MeshView{mesh->positions, mesh->face_offsets, mesh->face_vertices});
+  REQUIRE(sim.ok());
+  SimulatedBlobs out;
+  for (const InputEvent& e : sim->events) {
+    if (e.kind != EventKind::Hid || e.device > 1) continue;
+    const tracking::DecodedReport d = tracking::decode_ir_report(e.bytes);
+    if (d.status != tracking::ReportStatus::Ok) continue;
+    IrObjects o{};
+    for (int k = 0; k < 4; ++k) {
+      const tracking::IrSlot& s = d.report.slots[k];
+      o[k] = {.seen = s.seen, .x = s.x, .y = s.y, .size = s.size};
+    }
+    out.frames[e.device].push_back({e.t_us * 1000, o});
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("a live session on reader threads, with late and reordered arrivals, logs every report in order") {
+  const SimulatedBlobs sim = simulated_blobs();
+  REQUIRE(sim.frames[0].size() > 100);
+  Session s;
+  const int64_t origin = s.clock.now();
+  for (int c = 0; c < 2; ++c)
+    (c ? s.cam1 : s.cam0)->set_blob_source([&sim, c, origin](int64_t t) { return sim.at(c, t - origin); });
+  s.open();
+  s.driver->start();
+  // The clock moves only when this thread moves it; the readers keep up between steps.
+  auto advance = [&](int ms) {
+    for (int i = 0; i < ms; ++i) {
+      s.clock.advance(kMs);
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+  };
+  for (int i = 0; i < 50 && !s.all_running(); ++i) advance(20);
+  REQUIRE(s.all_running());
+  for (int k = 0; k < 4; ++k) {
+    advance(150);
+    // Camera 1's reports stall on the radio and arrive together, behind camera 0's later ones.
+    s.cam1->hold_reports(true);
+    advance(40);
+    s.cam1->hold_reports(false);
+    s.cam0->inject({0x33, 0x01});
+  }
+  advance(200);
+  s.driver->stop();
+  s.driver->poll(0);  // what was still queued
+  for (int i = 0; i < 20; ++i) s.driver->poll(0);
+
+  const InputLog log = s.parsed();
+  std::array<std::vector<uint32_t>, 2> frames;
+  size_t truncated = 0;
+  for (const InputEvent& e : log.events) {
+    if (e.kind != EventKind::Hid || e.device > 1 || e.bytes[0] != 0x33) continue;
+    if (e.bytes.size() != 18) {
+      ++truncated;
+      continue;
+    }
+    frames[e.device].push_back(uint32_t{e.bytes[3]} << 16 | uint32_t{e.bytes[4]} << 8 | e.bytes[5]);
+  }
+  CHECK(truncated == 4);
+  for (int c = 0; c < 2; ++c) {
+    const size_t streamed = (c ? s.cam1 : s.cam0)->reports_streamed();
+    INFO("camera " << c);
+    REQUIRE(frames[c].size() == streamed);
+    for (size_t k = 0; k < frames[c].size(); ++k) CHECK(frames[c][k] == k);
+  }
+  CHECK_FALSE(any_rumble(s.cam0->writes()));
+  CHECK_FALSE(any_rumble(s.cam1->writes()));
+  const tracking::DeviceStreams streams = tracking::decode_device_streams(log.events);
+  CHECK(streams.counts.ir_reports == frames[0].size() + frames[1].size());
+  CHECK(streams.counts.bad_length == 4);
+  size_t with_blobs = 0;
+  for (size_t k = 0; k < streams.cameras[0].size(); ++k) with_blobs += streams.cameras[0].blob_count[k] > 0;
+  CHECK(with_blobs > 50);
+}
+
+TEST_CASE("a device that is not a Wii Remote is never opened, even at an assigned address") {
+  Session s(false);
+  s.cam0->unplug();
+  // Same vendor, same address as camera 0, another product (a GameCube adapter, say).
+  s.bus.add_other_device({.vendor = kNintendoVendor, .product = 0x0337, .serial = kCam0, .path = "fake:other"});
+  s.bus.add_other_device({.vendor = 0x054C, .product = kProductRemote, .serial = kPad, .path = "fake:sony"});
+  const Scan scan = s.open();
+  CHECK(scan.not_remotes.size() == 2);
+  CHECK(scan.open_errors.empty());
+  s.run_ms(1200);
+  CHECK(s.view(Role::Camera0).state == LinkState::Missing);
+  CHECK(s.view(Role::Camera0).error == "not found");
+  CHECK(s.view(Role::Camera1).state == LinkState::Running);
+  const InputLog log = s.parsed();
+  for (const InputEvent* e : metas(log, "device")) CHECK(e->text.rfind("1 ", 0) == 0);
+}

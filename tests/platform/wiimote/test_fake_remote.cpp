@@ -1,0 +1,214 @@
+// The fake remote behaves as the strict reading of shared/wiimote-protocol.md says a remote does;
+// the driver's tests are only as good as this.
+#include <catch2/catch.hpp>
+
+#include "platform/wiimote/fake_remote.hpp"
+#include "systems/tracking/hid.hpp"
+#include "tests/platform/wiimote/helpers.hpp"
+
+using namespace fire;
+using namespace fire::wiimote;
+using fire::wiimote::test::kMs;
+
+namespace {
+
+// Everything the remote has queued for the host right now.
+std::vector<Bytes> drain(Device& d) {
+  std::vector<Bytes> out;
+  for (;;) {
+    ReadResult r = d.read(0);
+    if (r.status != ReadStatus::Report) return out;
+    out.push_back(std::move(r.report));
+  }
+}
+
+std::unique_ptr<Device> open_only(FakeBus& bus) {
+  auto found = bus.enumerate();
+  REQUIRE(found.ok());
+  REQUIRE(found->size() == 1);
+  auto d = bus.open(found->front());
+  REQUIRE(d.ok());
+  return std::move(*d);
+}
+
+void write(Device& d, Bytes r) { REQUIRE(d.write(r).ok()); }
+
+// The notes' initialisation, every report asking for its acknowledgement.
+void initialise(Device& d) {
+  const uint8_t enable[] = {kIrControlEnable};
+  const uint8_t mode[] = {kIrModeExtended};
+  const SensitivityBlocks s = sensitivity_blocks(3);
+  write(d, ir_pixel_clock_report(true));
+  write(d, ir_logic_report(true));
+  write(d, write_register_report(kRegIrControl, enable));
+  write(d, write_register_report(kRegIrBlock1, s.block1));
+  write(d, write_register_report(kRegIrBlock2, s.block2));
+  write(d, write_register_report(kRegIrMode, mode));
+  write(d, write_register_report(kRegIrControl, enable));
+  write(d, reporting_mode_report(kInIrExtended, true, true));
+}
+
+IrObjects one_blob(uint16_t x, uint16_t y) {
+  IrObjects o{};
+  o[0] = {.seen = true, .x = x, .y = y, .size = 3};
+  return o;
+}
+
+}  // namespace
+
+TEST_CASE("fake remote acknowledges only what asks for it, and every memory write") {
+  ManualClock clock;
+  FakeBus bus(clock.clock());
+  bus.add_remote({});
+  auto d = open_only(bus);
+  for (uint8_t id : {kOutLeds, kOutReportingMode, kOutIrPixelClock, uint8_t{0x14}, uint8_t{0x19}, kOutIrLogic}) {
+    write(*d, Bytes{id, 0x00, 0x30});
+    CHECK(drain(*d).empty());
+    write(*d, Bytes{id, kAckRequestBit, 0x30});
+    const auto acks = drain(*d);
+    REQUIRE(acks.size() == 1);
+    const auto ack = parse_ack(acks[0]);
+    REQUIRE(ack);
+    CHECK(ack->report_id == id);
+    CHECK(ack->error == 0);
+  }
+  const uint8_t one[] = {0x08};
+  write(*d, write_register_report(kRegIrControl, one));
+  CHECK(drain(*d).size() == 1);
+  // Rumble-only and status requests are never acknowledged; the status request is answered.
+  write(*d, Bytes{0x10, 0x02});
+  CHECK(drain(*d).empty());
+  write(*d, status_request_report());
+  const auto status = drain(*d);
+  REQUIRE(status.size() == 1);
+  CHECK(parse_status(status[0]));
+}
+
+TEST_CASE("fake remote drops chosen acknowledgements, or all of them") {
+  ManualClock clock;
+  FakeBus bus(clock.clock());
+  auto remote = bus.add_remote({});
+  auto d = open_only(bus);
+  remote->drop_acks(kOutIrLogic, 1);
+  write(*d, ir_logic_report(true));
+  CHECK(drain(*d).empty());
+  write(*d, ir_logic_report(true));
+  CHECK(drain(*d).size() == 1);
+  remote->set_never_ack(true);
+  const uint8_t one[] = {0x08};
+  write(*d, write_register_report(kRegIrControl, one));
+  write(*d, leds_report(0x10, true));
+  CHECK(drain(*d).empty());
+}
+
+TEST_CASE("fake remote streams on its own clock, stops after a status report, and needs the full set-up for IR") {
+  ManualClock clock;
+  FakeBus bus(clock.clock());
+  auto remote = bus.add_remote({});
+  remote->set_blob_source([](int64_t) { return one_blob(512, 300); });
+  auto d = open_only(bus);
+
+  // Asked for mode 0x33 without the camera set up: reports come, with no object, and fresh zero slots.
+  write(*d, reporting_mode_report(kInIrExtended, true, false));
+  clock.advance(100 * kMs);
+  auto reports = drain(*d);
+  CHECK(reports.size() == 11);  // at 0, 10, ..., 100 ms
+  REQUIRE(!reports.empty());
+  CHECK(reports.back().size() == 18);
+  CHECK(reports.back()[6] == 0x00);  // a fresh remote's empty slot reads 0,0,0 ...
+  CHECK(ir_object_count(reports.back()) == 0);  // ... which is not an object
+  CHECK(!remote->camera_working());
+
+  initialise(*d);
+  drain(*d);
+  CHECK(remote->camera_working());
+  CHECK(remote->register_at(kRegIrMode) == kIrModeExtended);
+  clock.advance(50 * kMs);
+  reports = drain(*d);
+  REQUIRE(reports.size() == 5);
+  CHECK(ir_object_count(reports[0]) == 1);
+  // The codec the tracker uses reads the same blob back.
+  const auto decoded = tracking::decode_ir_report(reports[0]);
+  REQUIRE(decoded.status == tracking::ReportStatus::Ok);
+  CHECK(decoded.report.slots[0].seen);
+  CHECK(decoded.report.slots[0].x == 512);
+  CHECK(decoded.report.slots[0].y == 300);
+  CHECK_FALSE(decoded.report.slots[1].seen);
+
+  // After a status report nothing comes until the mode is sent again.
+  remote->send_status();
+  clock.advance(50 * kMs);
+  reports = drain(*d);
+  REQUIRE(reports.size() == 1);
+  CHECK(reports[0][0] == kInStatus);
+  write(*d, reporting_mode_report(kInIrExtended, true, false));
+  clock.advance(30 * kMs);
+  CHECK(drain(*d).size() == 4);  // the first one at once
+}
+
+TEST_CASE("fake remote in a bad state works after a second set-up") {
+  ManualClock clock;
+  FakeBus bus(clock.clock());
+  auto remote = bus.add_remote({});
+  remote->set_blob_source([](int64_t) { return one_blob(100, 100); });
+  auto d = open_only(bus);
+  remote->start_in_bad_state(BadState::WrongMode);
+  initialise(*d);
+  drain(*d);
+  clock.advance(20 * kMs);
+  auto reports = drain(*d);
+  REQUIRE(!reports.empty());
+  CHECK(reports[0][0] == 0x31);
+  initialise(*d);
+  drain(*d);
+  clock.advance(20 * kMs);
+  reports = drain(*d);
+  REQUIRE(!reports.empty());
+  CHECK(reports[0][0] == kInIrExtended);
+  CHECK(ir_object_count(reports[0]) == 1);
+
+  remote->start_in_bad_state(BadState::NoIr);
+  initialise(*d);
+  drain(*d);
+  clock.advance(20 * kMs);
+  reports = drain(*d);
+  REQUIRE(!reports.empty());
+  CHECK(ir_object_count(reports.back()) == 0);
+  CHECK(remote->initialisations() == 3);
+}
+
+TEST_CASE("fake remote disappears and comes back as after a power-on") {
+  ManualClock clock;
+  FakeBus bus(clock.clock());
+  auto remote = bus.add_remote({.address = "00:1F:32:00:00:07"});
+  auto d = open_only(bus);
+  bus.add_other_device({.vendor = 0x046D, .product = 0xC52B, .serial = "", .path = "fake:mouse"});
+  write(*d, leds_report(0x30, false));
+  remote->unplug();
+  CHECK(d->read(0).status == ReadStatus::Gone);
+  CHECK_FALSE(d->write(leds_report(0x10, false)).ok());
+  auto found = bus.enumerate();
+  REQUIRE(found.ok());
+  CHECK(found->size() == 1);  // the mouse
+  remote->plug_in();
+  CHECK(d->read(0).status == ReadStatus::Gone);  // an old handle stays dead
+  CHECK(remote->leds() == 0);
+  found = bus.enumerate();
+  REQUIRE(found->size() == 2);
+  for (const DeviceInfo& info : *found)
+    if (is_wii_remote(info.vendor, info.product)) CHECK(bus.open(info).ok());
+  CHECK(bus.opens("00:1F:32:00:00:07") == 2);
+}
+
+TEST_CASE("fake remote holds reports back and releases them late") {
+  ManualClock clock;
+  FakeBus bus(clock.clock());
+  auto remote = bus.add_remote({});
+  auto d = open_only(bus);
+  write(*d, reporting_mode_report(kInIrExtended, true, false));
+  remote->hold_reports(true);
+  clock.advance(40 * kMs);
+  CHECK(drain(*d).empty());
+  remote->hold_reports(false);
+  CHECK(drain(*d).size() == 5);  // at 0, 10, ..., 40 ms
+}
