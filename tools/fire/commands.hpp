@@ -22,4 +22,7 @@ void add_eval_commands(CLI::App& app, Registry& registry);
 // reconstruct (curve network to smooth surface, systems/reconstruct)
 void add_reconstruct_commands(CLI::App& app, Registry& registry);
 
+// render (headless Vulkan rendering to PNG, platform/render)
+void add_render_commands(CLI::App& app, Registry& registry);
+
 }  // namespace fire::cli
