@@ -41,6 +41,7 @@ Result<Mesh> load_input(const std::string& path) {
   world->log = std::move(*log);
   Scheduler scheduler = make_scheduler(*world, monotonic_ns);
   replay_headless(*world, scheduler);
+  for (const Rejection& r : world->rejections) std::cerr << path << ":" << r.line << ": rejected: " << r.reason << "\n";
   if (std::string problem = world->mesh.validate(); !problem.empty())
     return Result<Mesh>::failure(path + ": the replayed network is invalid: " + problem);
   return std::move(world->mesh);
