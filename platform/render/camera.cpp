@@ -52,6 +52,23 @@ Camera frame_box(const Box& box, View view, uint32_t width, uint32_t height) {
   const float slope = far_plane * near_plane / ((far_plane - near_plane) * distance * distance);
   camera.line_depth_pull = slope * 0.01f * radius;
   camera.projection[1][1] *= -1.0f;  // Vulkan's clip space has y pointing down
+  // Perspective makes the box's near side look larger, so its image is off centre: shift and zoom the image
+  // plane (a lens shift, the view direction stays) so the projected corners are centred and fill `margin`.
+  glm::vec2 ndc_lo(1e30f), ndc_hi(-1e30f);
+  for (int c = 0; c < 8; ++c) {
+    glm::vec4 q = camera.projection * camera.view *
+                  glm::vec4((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z, 1.0f);
+    glm::vec2 n = glm::vec2(q) / q.w;
+    ndc_lo = glm::min(ndc_lo, n);
+    ndc_hi = glm::max(ndc_hi, n);
+  }
+  const glm::vec2 mid = (ndc_lo + ndc_hi) * 0.5f, half = glm::max((ndc_hi - ndc_lo) * 0.5f, glm::vec2(1e-6f));
+  const float zoom = margin / std::max(half.x, half.y);
+  glm::mat4 shift(1.0f);
+  shift[0][0] = shift[1][1] = zoom;
+  shift[3][0] = -zoom * mid.x;
+  shift[3][1] = -zoom * mid.y;
+  camera.projection = shift * camera.projection;
   camera.key_light = glm::normalize(0.6f * back + 0.9f * true_up - 0.6f * right);
   return camera;
 }
