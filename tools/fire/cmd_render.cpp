@@ -1,6 +1,8 @@
 // fire render: a curve network (or the network an input log draws) and its reconstructed surface,
 // rendered headless with Vulkan (lavapipe without a GPU) into a PNG.
+#include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -19,8 +21,8 @@ namespace fire::cli {
 namespace {
 
 struct RenderArgs {
-  std::string input_path, out_path, size = "1280x720", view = "iso", reference_path;
-  uint32_t levels = 3;
+  std::string input_path, out_path, size = "1280x720", view = "iso", reference_path, png_dir;
+  uint32_t levels = 3, every = 0;
 };
 
 int fail(const std::string& message) {
@@ -47,6 +49,72 @@ Result<Mesh> load_input(const std::string& path) {
   return std::move(world->mesh);
 }
 
+bool any_dirty(const Mesh& m) {
+  auto set = [](const std::vector<uint8_t>& tags) { return std::any_of(tags.begin(), tags.end(), [](uint8_t t) { return t; }); };
+  return set(m.vertices.dirty) || set(m.edges.dirty) || set(m.faces.dirty);
+}
+
+// --every N: the input log replayed with the renderer as the frame's last system. Every frame at least N
+// frames after the previous picture whose network changed is reconstructed incrementally, uploaded by
+// changed range and written to DIR/frame_NNNNNN.png; one JSON line per picture says what was uploaded.
+// The camera frames the final network, so the pictures line up.
+int render_sequence(const RenderArgs& a, const Mesh& final_network, render::Renderer& renderer, const render::Camera& camera) {
+  std::error_code error;
+  std::filesystem::create_directories(a.png_dir, error);
+  if (error) return fail(a.png_dir + ": cannot create the directory (" + error.message() + ")");
+  auto log = read_input_log(a.input_path);
+  if (!log) return fail(log.error());
+  auto world = std::make_unique<World>();
+  world->log = std::move(*log);
+  Scheduler scheduler = make_scheduler(*world, monotonic_ns);
+
+  reconstruct::Options options;
+  options.levels = a.levels;
+  reconstruct::ReconstructionState state;
+  SurfaceMesh built;
+  SurfaceLevels surface;
+  Status status;
+  uint64_t last_picture = 0;
+  bool pictured = false;
+  auto picture = [&](bool last) {
+    World& w = *world;
+    if (!status || !any_dirty(w.mesh) || (pictured && w.frame.index < last_picture + a.every && !last)) return;
+    if (reconstruct::reconstruct_update(w.mesh, options, state, built)) {
+      if (!assign_quads(built, w.frame.index, surface)) status = Status::failure("internal error: the surface is not all quads");
+    } else {
+      surface = SurfaceLevels{};  // no faces yet: the curves alone
+    }
+    if (status) status = renderer.upload(w.mesh, surface);
+    if (status) status = renderer.draw(camera);
+    if (!status) return;
+    w.mesh.clear_dirty();  // the renderer is the frame's last reader of the tags
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%06llu.png", static_cast<unsigned long long>(w.frame.index));
+    const std::string path = (std::filesystem::path(a.png_dir) / name).string();
+    status = render::write_png(renderer.image(), path);
+    if (!status) return;
+    const render::UploadStats& u = renderer.last_upload();
+    nlohmann::ordered_json out;
+    out["frame"] = w.frame.index;
+    out["png"] = path;
+    out["edges"] = w.mesh.edge_count();
+    out["surface_quads"] = surface.quad_count();
+    out["bytes_uploaded"] = u.bytes;
+    out["edges_uploaded"] = u.edges;
+    out["surface_vertices_uploaded"] = u.surface_vertices;
+    std::cout << out.dump() << "\n";
+    last_picture = w.frame.index;
+    pictured = true;
+  };
+  scheduler.add("render", [&] { picture(false); });
+  replay_headless(*world, scheduler);
+  picture(true);
+  if (!status) return fail(status.error);
+  if (!pictured) return fail(a.input_path + ": the replay drew nothing");
+  if (final_network.hash() != world->mesh.hash()) return fail("internal error: the replay with pictures differs from the replay without");
+  return 0;
+}
+
 int run_render(const RenderArgs& a) {
   uint32_t width = 0, height = 0;
   char tail = 0;
@@ -55,7 +123,10 @@ int run_render(const RenderArgs& a) {
     return fail("--size must be WIDTHxHEIGHT, 1 to 8192 pixels a side, not '" + a.size + "'");
   auto view = render::parse_view(a.view);
   if (!view) return fail(view.error());
-  if (!ends_with(a.out_path, ".png")) return fail(a.out_path + ": the output must be a .png file");
+  if (a.out_path.empty() == (a.every == 0)) return fail("give either -o OUT.png or --every N with --png-dir DIR");
+  if (a.every && (a.png_dir.empty() || ends_with(a.input_path, ".fnet")))
+    return fail("--every needs an input log and --png-dir DIR");
+  if (!a.every && !ends_with(a.out_path, ".png")) return fail(a.out_path + ": the output must be a .png file");
   if (a.levels < 1 || a.levels > reconstruct::kMaxLevels)
     return fail("--levels must be 1 to " + std::to_string(reconstruct::kMaxLevels));
 
@@ -96,6 +167,14 @@ int run_render(const RenderArgs& a) {
   auto renderer = render::Renderer::create(**context, {width, height});
   if (!renderer) return fail(renderer.error());
   Status drawn = (*renderer)->set_reference(reference_positions, reference_triangles);
+  if (drawn && a.every) {
+    const int code = render_sequence(a, *network, **renderer, render::frame_box(box, *view, width, height));
+    const size_t messages = (*context)->validation_message_count();
+    renderer->reset();
+    context->reset();
+    if (code == 0 && messages) return fail(std::to_string(messages) + " Vulkan validation message(s), see above");
+    return code;
+  }
   if (drawn) drawn = (*renderer)->upload(*network, surface);
   if (drawn) drawn = (*renderer)->draw(render::frame_box(box, *view, width, height));
   if (!drawn) return fail("Vulkan: " + drawn.error);
@@ -134,9 +213,15 @@ void add_render_commands(CLI::App& app, Registry& registry) {
       "the lit surface, the curves over it, the vertices as markers, the reference mesh see-through. Without a "
       "GPU, Vulkan runs on lavapipe (Debian package mesa-vulkan-drivers). FIRE_VK_VALIDATION=1 turns the "
       "validation layer on; any message then fails the command. Prints one JSON line: output, width, height, "
-      "view, device, edges, surface_quads, bytes_uploaded, validation.");
+      "view, device, edges, surface_quads, bytes_uploaded, validation. With --every, a picture sequence of the "
+      "replay instead (see --every).");
   cmd->add_option("NET", a->input_path, "curve network (.fnet) or input log")->required();
-  cmd->add_option("-o,--output", a->out_path, "PNG file to write")->required();
+  cmd->add_option("-o,--output", a->out_path, "PNG file to write");
+  cmd->add_option("--every", a->every,
+                  "N: replay the input log with the renderer as the last system and write a picture to --png-dir "
+                  "whenever the network changed and N frames passed since the last; one JSON line per picture "
+                  "(frame, png, edges, surface_quads, bytes_uploaded, edges_uploaded, surface_vertices_uploaded)");
+  cmd->add_option("--png-dir", a->png_dir, "directory for --every's frame_NNNNNN.png pictures");
   cmd->add_option("--size", a->size, "WIDTHxHEIGHT in pixels")->capture_default_str();
   cmd->add_option("--view", a->view, "iso, front, top or side (Z up)")->capture_default_str();
   cmd->add_option("--reference", a->reference_path, "OBJ mesh drawn see-through over the scene");

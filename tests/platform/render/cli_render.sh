@@ -17,6 +17,10 @@ expect_error() {
 }
 # png_size FILE: "WIDTH HEIGHT" from the PNG's IHDR chunk
 png_size() { od -An -tu1 -j16 -N8 "$1" | awk '{print $1*16777216+$2*65536+$3*256+$4, $5*16777216+$6*65536+$7*256+$8}'; }
+# some_partial_upload FILE: a JSON line of --every whose edges_uploaded is below its edges
+some_partial_upload() {
+  sed -n 's/.*"edges":\([0-9]*\),.*"edges_uploaded":\([0-9]*\),.*/\1 \2/p' "$1" | awk '$2 < $1 {n++} END {exit !(n > 0)}'
+}
 is_png() { [ "$(od -An -c -j1 -N3 "$1" | tr -d ' ')" = "PNG" ]; }
 
 out=$("$fire" render "$here/data/sketch.fnet" -o "$tmp/net.png" --size 400x300 --view front 2>"$tmp/err"); rc=$?
@@ -28,6 +32,16 @@ check "writes a 400x300 PNG" "is_png '$tmp/net.png' && [ \"\$(png_size '$tmp/net
 "$fire" render "$log" -o "$tmp/log.png" --size 320x180 --view top >"$tmp/stdout" 2>"$tmp/err"; rc=$?
 check "an input log is replayed and rendered" "[ $rc -eq 0 ] && is_png '$tmp/log.png' && [ \"\$(png_size '$tmp/log.png')\" = '320 180' ]"
 check "the replay's rejected stroke is reported, not fatal" "grep -q 'rejected' '$tmp/err'"
+
+"$fire" render "$log" --every 40 --png-dir "$tmp/frames" --size 160x90 >"$tmp/seq" 2>"$tmp/err"; rc=$?
+pictures=$(ls "$tmp/frames" 2>/dev/null | grep -c '^frame_[0-9]*\.png$')
+check "--every: a picture per JSON line as the sketch grows (exit 0, at least 10)" \
+  "[ $rc -eq 0 ] && [ $pictures -ge 10 ] && [ \$(grep -c '^{\"frame\":' '$tmp/seq') -eq $pictures ]"
+check "--every: the last picture has the final network and surface" "tail -1 '$tmp/seq' | grep -q '\"edges\":32,\"surface_quads\":3264,'"
+check "--every: some picture re-sends fewer edges than the network has" "some_partial_upload '$tmp/seq'"
+expect_error "--every with a network file" "--every needs an input log" "$tmp/frames2" \
+  "$fire" render "$here/data/sketch.fnet" --every 5 --png-dir "$tmp/frames2"
+expect_error "neither -o nor --every" "give either -o OUT.png or --every N" "$tmp/none" "$fire" render "$log"
 
 printf 'v 0 0 0\nv 0.2 0 0\nv 0.2 0.2 0\nv 0 0.2 0\nf 1 2 3 4\n' >"$tmp/plane.obj"
 "$fire" render "$here/data/sketch.fnet" -o "$tmp/ref.png" --size 320x180 --reference "$tmp/plane.obj" >/dev/null 2>"$tmp/err"; rc=$?
