@@ -102,7 +102,7 @@ Status Context::init(const ContextOptions& options) {
                            "." + std::to_string(VK_API_VERSION_MINOR(loader_version)) + "; 1.3 is required");
   if (options.validation && !has_layer(kValidationLayer))
     return Status::failure(std::string("validation was asked for but the layer ") + kValidationLayer +
-                           " is missing (Debian package vulkan-validationlayers)");
+                           " is missing (Debian package vulkan-validationlayers; FIRE_VK_VALIDATION=0 turns validation off)");
 
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = "fire";
