@@ -18,6 +18,11 @@
 using namespace fire;
 using namespace fire::render;
 
+#if defined(__SANITIZE_ADDRESS__)
+// LeakSanitizer reads its options from here too: the suppressions for Mesa, LLVM and the Vulkan loader.
+extern "C" const char* __lsan_default_options() { return "suppressions=" FIRE_LSAN_SUPPRESSIONS; }
+#endif
+
 namespace {
 
 const std::string kDir = FIRE_RENDER_TEST_DIR;
