@@ -24,5 +24,7 @@ void add_reconstruct_commands(CLI::App& app, Registry& registry);
 
 // devices (the Wii Remotes this machine sees, platform/wiimote)
 void add_devices_commands(CLI::App& app, Registry& registry);
+// render (headless Vulkan rendering to PNG, platform/render)
+void add_render_commands(CLI::App& app, Registry& registry);
 
 }  // namespace fire::cli

@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   fire::cli::add_eval_commands(app, registry);
   fire::cli::add_reconstruct_commands(app, registry);
   fire::cli::add_devices_commands(app, registry);
+  fire::cli::add_render_commands(app, registry);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,615 @@
+#include "platform/render/renderer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+// SPIR-V compiled from shaders/ at build time (platform/render/CMakeLists.txt).
+#include "shaders/background_frag.h"
+#include "shaders/background_vert.h"
+#include "shaders/curve_vert.h"
+#include "shaders/flat_frag.h"
+#include "shaders/marker_frag.h"
+#include "shaders/marker_vert.h"
+#include "shaders/surface_frag.h"
+#include "shaders/surface_vert.h"
+
+namespace fire::render {
+
+namespace {
+
+// The push constants of shaders/common.glsl.
+struct PushConstants {
+  glm::mat4 view_proj;
+  glm::vec4 eye;
+  glm::vec4 color;
+  glm::vec4 params;
+  glm::vec4 light;
+};
+static_assert(sizeof(PushConstants) == 128, "the minimum maxPushConstantsSize");
+
+constexpr uint64_t kFenceTimeoutNs = 60'000'000'000ull;  // a frame on lavapipe takes well under a second
+
+float srgb_to_linear(uint8_t c) {
+  float v = float(c) / 255.0f;
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+glm::vec4 linear(const uint8_t (&c)[3], float alpha = 1.0f) {
+  return {srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), alpha};
+}
+glm::vec3 to_float(const Vec3& p) { return {float(p.x()), float(p.y()), float(p.z())}; }
+
+constexpr VkBufferUsageFlags kVertex = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT;
+constexpr VkBufferUsageFlags kIndex = VK_BUFFER_USAGE_INDEX_BUFFER_BIT;
+
+struct PipelineDesc {
+  std::span<const uint32_t> vert, frag;
+  std::vector<VkVertexInputBindingDescription> bindings;
+  std::vector<VkVertexInputAttributeDescription> attributes;
+  bool depth_test = true, depth_write = true, blend = false;
+};
+
+}  // namespace
+
+Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const RenderSettings& settings) {
+  if (settings.width == 0 || settings.height == 0 || settings.width > 8192 || settings.height > 8192)
+    return Result<std::unique_ptr<Renderer>>::failure("image size must be 1 to 8192 pixels a side");
+  std::unique_ptr<Renderer> r(new Renderer(context, settings));
+  if (Status s = r->init(); !s) return Result<std::unique_ptr<Renderer>>::failure("Vulkan: " + s.error);
+  return r;
+}
+
+Status Renderer::init() {
+  VkDevice device = context_.device();
+  const VkPhysicalDeviceLimits& limits = context_.properties().limits;
+  if (limits.framebufferColorSampleCounts & limits.framebufferDepthSampleCounts & VK_SAMPLE_COUNT_4_BIT)
+    samples_ = VK_SAMPLE_COUNT_4_BIT;
+  VkFormatProperties depth_props;
+  vkGetPhysicalDeviceFormatProperties(context_.physical_device(), depth_format_, &depth_props);
+  if (!(depth_props.optimalTilingFeatures & VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT))
+    depth_format_ = VK_FORMAT_X8_D24_UNORM_PACK32;  // one of the two is always supported
+
+  if (samples_ != VK_SAMPLE_COUNT_1_BIT)
+    FIRE_TRY(create_target(color_, color_format_, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSIENT_ATTACHMENT_BIT,
+                           samples_, VK_IMAGE_ASPECT_COLOR_BIT));
+  FIRE_TRY(create_target(resolve_, color_format_, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                         VK_SAMPLE_COUNT_1_BIT, VK_IMAGE_ASPECT_COLOR_BIT));
+  FIRE_TRY(create_target(depth_, depth_format_, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, samples_,
+                         VK_IMAGE_ASPECT_DEPTH_BIT));
+  bool grown = false;
+  FIRE_TRY(reserve(readback_, VkDeviceSize(settings_.width) * settings_.height * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, grown));
+
+  VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pool.queueFamilyIndex = context_.queue_family();
+  FIRE_VK_TRY(vkCreateCommandPool(device, &pool, nullptr, &pool_));
+  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  alloc.commandPool = pool_;
+  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  alloc.commandBufferCount = 1;
+  FIRE_VK_TRY(vkAllocateCommandBuffers(device, &alloc, &commands_));
+  VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  FIRE_VK_TRY(vkCreateFence(device, &fence, nullptr, &fence_));
+  return create_pipelines();
+}
+
+Status Renderer::create_target(Target& target, VkFormat format, VkImageUsageFlags usage, VkSampleCountFlagBits samples,
+                               VkImageAspectFlags aspect) {
+  VkDevice device = context_.device();
+  VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+  info.imageType = VK_IMAGE_TYPE_2D;
+  info.format = format;
+  info.extent = {settings_.width, settings_.height, 1};
+  info.mipLevels = 1;
+  info.arrayLayers = 1;
+  info.samples = samples;
+  info.tiling = VK_IMAGE_TILING_OPTIMAL;
+  info.usage = usage;
+  info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  FIRE_VK_TRY(vkCreateImage(device, &info, nullptr, &target.image));
+  VkMemoryRequirements req;
+  vkGetImageMemoryRequirements(device, target.image, &req);
+  auto type = context_.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  if (!type) type = context_.memory_type(req.memoryTypeBits, 0);
+  if (!type) return Status::failure(type.error());
+  VkMemoryAllocateInfo mem{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  mem.allocationSize = req.size;
+  mem.memoryTypeIndex = *type;
+  FIRE_VK_TRY(vkAllocateMemory(device, &mem, nullptr, &target.memory));
+  FIRE_VK_TRY(vkBindImageMemory(device, target.image, target.memory, 0));
+  VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+  view.image = target.image;
+  view.viewType = VK_IMAGE_VIEW_TYPE_2D;
+  view.format = format;
+  view.subresourceRange = {aspect, 0, 1, 0, 1};
+  FIRE_VK_TRY(vkCreateImageView(device, &view, nullptr, &target.view));
+  return Status::success();
+}
+
+Status Renderer::reserve(Buffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage, bool& grown) {
+  grown = false;
+  bytes = std::max<VkDeviceSize>(bytes, 256);
+  if (buffer.capacity >= bytes) return Status::success();
+  grown = true;
+  const VkDeviceSize capacity = std::max(bytes, buffer.capacity * 2);
+  // The GPU reads buffers only inside draw(), which waits for its frame to finish.
+  destroy(buffer);
+  VkDevice device = context_.device();
+  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.size = capacity;
+  info.usage = usage;
+  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  FIRE_VK_TRY(vkCreateBuffer(device, &info, nullptr, &buffer.buffer));
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(device, buffer.buffer, &req);
+  constexpr VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  // Readback is read by the CPU: cached memory where there is such.
+  auto type = context_.memory_type(req.memoryTypeBits, usage == VK_BUFFER_USAGE_TRANSFER_DST_BIT
+                                                           ? host | VK_MEMORY_PROPERTY_HOST_CACHED_BIT
+                                                           : host | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  if (!type) type = context_.memory_type(req.memoryTypeBits, host);
+  if (!type) return Status::failure(type.error());
+  VkMemoryAllocateInfo mem{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  mem.allocationSize = req.size;
+  mem.memoryTypeIndex = *type;
+  FIRE_VK_TRY(vkAllocateMemory(device, &mem, nullptr, &buffer.memory));
+  FIRE_VK_TRY(vkBindBufferMemory(device, buffer.buffer, buffer.memory, 0));
+  FIRE_VK_TRY(vkMapMemory(device, buffer.memory, 0, VK_WHOLE_SIZE, 0, &buffer.mapped));
+  buffer.capacity = capacity;
+  return Status::success();
+}
+
+void Renderer::destroy(Buffer& buffer) {
+  VkDevice device = context_.device();
+  if (buffer.buffer) vkDestroyBuffer(device, buffer.buffer, nullptr);
+  if (buffer.memory) vkFreeMemory(device, buffer.memory, nullptr);  // unmaps implicitly
+  buffer = Buffer{};
+}
+
+void Renderer::destroy(Target& target) {
+  VkDevice device = context_.device();
+  if (target.view) vkDestroyImageView(device, target.view, nullptr);
+  if (target.image) vkDestroyImage(device, target.image, nullptr);
+  if (target.memory) vkFreeMemory(device, target.memory, nullptr);
+  target = Target{};
+}
+
+Renderer::~Renderer() {
+  VkDevice device = context_.device();
+  vkDeviceWaitIdle(device);  // nothing else to do on failure: everything is destroyed either way
+  for (Buffer* b : {&readback_, &points_, &vertices_, &surface_vertices_, &surface_indices_, &reference_vertices_,
+                    &reference_indices_})
+    destroy(*b);
+  for (Target* t : {&color_, &resolve_, &depth_}) destroy(*t);
+  for (VkPipeline p : {background_, surface_, reference_pipeline_, curves_, markers_})
+    if (p) vkDestroyPipeline(device, p, nullptr);
+  if (layout_) vkDestroyPipelineLayout(device, layout_, nullptr);
+  if (fence_) vkDestroyFence(device, fence_, nullptr);
+  if (pool_) vkDestroyCommandPool(device, pool_, nullptr);
+}
+
+Status Renderer::create_pipelines() {
+  VkDevice device = context_.device();
+  VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(PushConstants)};
+  VkPipelineLayoutCreateInfo layout{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  layout.pushConstantRangeCount = 1;
+  layout.pPushConstantRanges = &range;
+  FIRE_VK_TRY(vkCreatePipelineLayout(device, &layout, nullptr, &layout_));
+
+  auto build = [&](const PipelineDesc& d, VkPipeline& out) -> Status {
+    VkShaderModule modules[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
+    std::span<const uint32_t> code[2] = {d.vert, d.frag};
+    Status status;
+    for (int i = 0; i < 2 && status; ++i) {
+      VkShaderModuleCreateInfo info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+      info.codeSize = code[i].size_bytes();
+      info.pCode = code[i].data();
+      const VkResult r = vkCreateShaderModule(device, &info, nullptr, &modules[i]);
+      if (r != VK_SUCCESS) status = Status::failure(vk_failure("vkCreateShaderModule", r));
+    }
+    if (status) {
+      VkPipelineShaderStageCreateInfo stages[2]{};
+      for (int i = 0; i < 2; ++i) {
+        stages[i].sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+        stages[i].stage = i == 0 ? VK_SHADER_STAGE_VERTEX_BIT : VK_SHADER_STAGE_FRAGMENT_BIT;
+        stages[i].module = modules[i];
+        stages[i].pName = "main";
+      }
+      VkPipelineVertexInputStateCreateInfo input{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+      input.vertexBindingDescriptionCount = uint32_t(d.bindings.size());
+      input.pVertexBindingDescriptions = d.bindings.data();
+      input.vertexAttributeDescriptionCount = uint32_t(d.attributes.size());
+      input.pVertexAttributeDescriptions = d.attributes.data();
+      VkPipelineInputAssemblyStateCreateInfo assembly{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+      assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+      VkPipelineViewportStateCreateInfo viewport{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+      viewport.viewportCount = 1;
+      viewport.scissorCount = 1;
+      VkPipelineRasterizationStateCreateInfo raster{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+      raster.polygonMode = VK_POLYGON_MODE_FILL;
+      raster.cullMode = VK_CULL_MODE_NONE;  // open surfaces are seen from both sides
+      raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+      raster.lineWidth = 1.0f;
+      VkPipelineMultisampleStateCreateInfo multisample{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+      multisample.rasterizationSamples = samples_;
+      VkPipelineDepthStencilStateCreateInfo depth{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+      depth.depthTestEnable = d.depth_test;
+      depth.depthWriteEnable = d.depth_write;
+      depth.depthCompareOp = VK_COMPARE_OP_LESS_OR_EQUAL;
+      VkPipelineColorBlendAttachmentState blend{};
+      blend.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
+                             VK_COLOR_COMPONENT_A_BIT;
+      if (d.blend) {
+        blend.blendEnable = VK_TRUE;
+        blend.srcColorBlendFactor = VK_BLEND_FACTOR_SRC_ALPHA;
+        blend.dstColorBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+        blend.colorBlendOp = VK_BLEND_OP_ADD;
+        blend.srcAlphaBlendFactor = VK_BLEND_FACTOR_ZERO;
+        blend.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+        blend.alphaBlendOp = VK_BLEND_OP_ADD;
+      }
+      VkPipelineColorBlendStateCreateInfo blending{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+      blending.attachmentCount = 1;
+      blending.pAttachments = &blend;
+      VkDynamicState dynamic_states[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+      VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+      dynamic.dynamicStateCount = 2;
+      dynamic.pDynamicStates = dynamic_states;
+      VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
+      rendering.colorAttachmentCount = 1;
+      rendering.pColorAttachmentFormats = &color_format_;
+      rendering.depthAttachmentFormat = depth_format_;
+      VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+      info.pNext = &rendering;
+      info.stageCount = 2;
+      info.pStages = stages;
+      info.pVertexInputState = &input;
+      info.pInputAssemblyState = &assembly;
+      info.pViewportState = &viewport;
+      info.pRasterizationState = &raster;
+      info.pMultisampleState = &multisample;
+      info.pDepthStencilState = &depth;
+      info.pColorBlendState = &blending;
+      info.pDynamicState = &dynamic;
+      info.layout = layout_;
+      const VkResult r = vkCreateGraphicsPipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &out);
+      if (r != VK_SUCCESS) status = Status::failure(vk_failure("vkCreateGraphicsPipelines", r));
+    }
+    for (VkShaderModule m : modules)
+      if (m) vkDestroyShaderModule(device, m, nullptr);
+    return status;
+  };
+
+  const auto instance = VK_VERTEX_INPUT_RATE_INSTANCE;
+  PipelineDesc background{background_vert, background_frag, {}, {}, false, false, false};
+  PipelineDesc surface{surface_vert, surface_frag, {{0, 24, VK_VERTEX_INPUT_RATE_VERTEX}},
+                       {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}, {1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12}}};
+  PipelineDesc reference = surface;
+  reference.depth_write = false;
+  reference.blend = true;
+  // A segment is two consecutive points: one binding read per instance at offsets 0 and 12.
+  PipelineDesc curves{curve_vert, flat_frag, {{0, 12, instance}},
+                      {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}, {1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12}}};
+  PipelineDesc markers{marker_vert, marker_frag, {{0, 12, instance}}, {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}}};
+  FIRE_TRY(build(background, background_));
+  FIRE_TRY(build(surface, surface_));
+  FIRE_TRY(build(reference, reference_pipeline_));
+  FIRE_TRY(build(curves, curves_));
+  return build(markers, markers_);
+}
+
+void Renderer::copy_into(Buffer& buffer, VkDeviceSize offset, const void* data, VkDeviceSize bytes) {
+  std::memcpy(static_cast<char*>(buffer.mapped) + offset, data, bytes);
+  stats_.bytes += bytes;
+}
+
+Status Renderer::upload(const Mesh& network, const SurfaceLevels& surface) {
+  stats_ = {};
+  FIRE_TRY(upload_points(network));
+  FIRE_TRY(upload_vertices(network));
+  network_frame_ = network.frame();
+  return upload_surface(surface);
+}
+
+Status Renderer::upload_points(const Mesh& network) {
+  bool grown = false;
+  FIRE_TRY(reserve(points_, VkDeviceSize(network.points.size()) * sizeof(glm::vec3), kVertex, grown));
+  if (grown) edge_records_.clear();
+  edge_records_.resize(network.edge_slots());
+  curve_draws_.clear();
+  std::vector<glm::vec3> floats;
+  for (uint32_t e = 0; e < network.edge_slots(); ++e) {
+    EdgeRecord& record = edge_records_[e];
+    if (!network.edge_alive(e)) {
+      record = {};
+      continue;
+    }
+    const EdgeRecord now{network.edges.generation[e], network.edges.point_offset[e], network.edges.point_count[e]};
+    const bool stamped = network.edges.changes.changed_since(e, network_frame_);
+    if (stamped || now.generation != record.generation || now.offset != record.offset || now.count != record.count) {
+      floats.clear();
+      for (const Vec3& p : network.polyline(e)) floats.push_back(to_float(p));
+      copy_into(points_, VkDeviceSize(now.offset) * sizeof(glm::vec3), floats.data(), floats.size() * sizeof(glm::vec3));
+      ++stats_.edges;
+      record = now;
+    }
+    if (now.count >= 2) curve_draws_.emplace_back(now.offset, now.count);
+  }
+  return Status::success();
+}
+
+Status Renderer::upload_vertices(const Mesh& network) {
+  const uint32_t slots = uint32_t(network.vertex_slots());
+  bool grown = false;
+  FIRE_TRY(reserve(vertices_, VkDeviceSize(slots) * sizeof(glm::vec3), kVertex, grown));
+  if (grown) vertex_live_.clear();
+  vertex_copy_.resize(slots);
+  vertex_live_.resize(slots, 0);
+  marker_draws_.clear();
+  for (uint32_t v = 0; v < slots; ++v) {
+    if (!network.vertex_alive(v)) {
+      vertex_live_[v] = 0;
+      continue;
+    }
+    const glm::vec3 p = to_float(network.vertices.position[v]);
+    if (!vertex_live_[v] || vertex_copy_[v] != p) {
+      vertex_copy_[v] = p;
+      vertex_live_[v] = 1;
+      copy_into(vertices_, VkDeviceSize(v) * sizeof(glm::vec3), &p, sizeof p);
+      ++stats_.vertices;
+    }
+    if (!marker_draws_.empty() && marker_draws_.back().first + marker_draws_.back().second == v)
+      ++marker_draws_.back().second;
+    else
+      marker_draws_.emplace_back(v, 1);
+  }
+  return Status::success();
+}
+
+Status Renderer::upload_surface(const SurfaceLevels& s) {
+  surface_settled_ = s.settled;
+  if (s.empty()) {
+    surface_index_count_ = 0;
+    surface_seen_ = false;  // whatever comes next is uploaded whole
+    return Status::success();
+  }
+  bool full = !surface_seen_ || s.topology_version != surface_topology_;
+  bool grown = false;
+  FIRE_TRY(reserve(surface_vertices_, VkDeviceSize(s.vertex_count()) * 24, kVertex, grown));
+  full = full || grown;
+  FIRE_TRY(reserve(surface_indices_, VkDeviceSize(s.quad_count()) * 24, kIndex, grown));
+  full = full || grown;
+  auto write_vertices = [&](uint32_t begin, uint32_t end) {
+    std::vector<glm::vec3> interleaved;
+    interleaved.reserve(size_t(end - begin) * 2);
+    for (uint32_t v = begin; v < end; ++v) {
+      interleaved.push_back(to_float(s.positions[v]));
+      interleaved.push_back(to_float(s.normals[v]));
+    }
+    copy_into(surface_vertices_, VkDeviceSize(begin) * 24, interleaved.data(), interleaved.size() * sizeof(glm::vec3));
+    stats_.surface_vertices += end - begin;
+  };
+  if (full) {
+    write_vertices(0, s.vertex_count());
+    std::vector<uint32_t> triangles;
+    triangles.reserve(size_t(s.quad_count()) * 6);
+    for (uint32_t q = 0; q < s.quad_count(); ++q) {
+      const uint32_t* c = &s.quads[size_t(q) * 4];
+      triangles.insert(triangles.end(), {c[0], c[1], c[2], c[0], c[2], c[3]});
+    }
+    copy_into(surface_indices_, 0, triangles.data(), triangles.size() * sizeof(uint32_t));
+    surface_index_count_ = uint32_t(triangles.size());
+    stats_.surface_topology = true;
+  } else if (s.frame != surface_frame_) {
+    const uint32_t end = std::min(s.changed.end, s.vertex_count());
+    if (s.changed.begin < end) write_vertices(s.changed.begin, end);
+  }
+  surface_seen_ = true;
+  surface_topology_ = s.topology_version;
+  surface_frame_ = s.frame;
+  return Status::success();
+}
+
+Status Renderer::set_reference(std::span<const Vec3> positions, std::span<const uint32_t> triangles) {
+  reference_index_count_ = 0;
+  if (triangles.empty()) return Status::success();
+  // Area-weighted vertex normals; the shader lights both sides, so orientation does not matter.
+  std::vector<glm::vec3> normals(positions.size(), glm::vec3(0.0f));
+  for (size_t t = 0; t + 2 < triangles.size(); t += 3) {
+    const uint32_t a = triangles[t], b = triangles[t + 1], c = triangles[t + 2];
+    if (a >= positions.size() || b >= positions.size() || c >= positions.size())
+      return Status::failure("reference mesh: triangle index out of range");
+    const glm::vec3 n = glm::cross(to_float(positions[b]) - to_float(positions[a]), to_float(positions[c]) - to_float(positions[a]));
+    for (uint32_t v : {a, b, c}) normals[v] += n;
+  }
+  std::vector<glm::vec3> interleaved;
+  for (size_t v = 0; v < positions.size(); ++v) {
+    interleaved.push_back(to_float(positions[v]));
+    const float length = glm::length(normals[v]);
+    interleaved.push_back(length > 0.0f ? normals[v] / length : glm::vec3(0.0f, 0.0f, 1.0f));
+  }
+  bool grown = false;
+  FIRE_TRY(reserve(reference_vertices_, interleaved.size() * sizeof(glm::vec3), kVertex, grown));
+  FIRE_TRY(reserve(reference_indices_, triangles.size_bytes(), kIndex, grown));
+  std::memcpy(reference_vertices_.mapped, interleaved.data(), interleaved.size() * sizeof(glm::vec3));
+  std::memcpy(reference_indices_.mapped, triangles.data(), triangles.size_bytes());
+  reference_index_count_ = uint32_t(triangles.size() / 3 * 3);
+  return Status::success();
+}
+
+Status Renderer::draw(const Camera& camera) {
+  VkDevice device = context_.device();
+  VkCommandBuffer cmd = commands_;
+  FIRE_VK_TRY(vkResetFences(device, 1, &fence_));
+  FIRE_VK_TRY(vkResetCommandBuffer(cmd, 0));
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  FIRE_VK_TRY(vkBeginCommandBuffer(cmd, &begin));
+
+  // Every target starts undefined: the frame clears or overwrites all of it.
+  auto to_attachment = [](VkImage image, VkImageLayout layout, VkImageAspectFlags aspect, VkPipelineStageFlags2 stage,
+                          VkAccessFlags2 access) {
+    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    b.srcStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;  // the previous frame's copy or depth use
+    b.srcAccessMask = 0;
+    b.dstStageMask = stage;
+    b.dstAccessMask = access;
+    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    b.newLayout = layout;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image;
+    b.subresourceRange = {aspect, 0, 1, 0, 1};
+    return b;
+  };
+  std::vector<VkImageMemoryBarrier2> barriers;
+  const VkPipelineStageFlags2 color_stage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+  const VkAccessFlags2 color_access = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT;
+  barriers.push_back(to_attachment(resolve_.image, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_ASPECT_COLOR_BIT,
+                                   color_stage, color_access));
+  if (color_.image)
+    barriers.push_back(to_attachment(color_.image, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_ASPECT_COLOR_BIT,
+                                     color_stage, color_access));
+  barriers.push_back(to_attachment(depth_.image, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_ASPECT_DEPTH_BIT,
+                                   VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                                   VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT));
+  VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  dependency.imageMemoryBarrierCount = uint32_t(barriers.size());
+  dependency.pImageMemoryBarriers = barriers.data();
+  vkCmdPipelineBarrier2(cmd, &dependency);
+
+  VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+  color.imageView = color_.image ? color_.view : resolve_.view;
+  color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+  color.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+  color.storeOp = color_.image ? VK_ATTACHMENT_STORE_OP_DONT_CARE : VK_ATTACHMENT_STORE_OP_STORE;
+  if (color_.image) {
+    color.resolveMode = VK_RESOLVE_MODE_AVERAGE_BIT;
+    color.resolveImageView = resolve_.view;
+    color.resolveImageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+  }
+  VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+  depth.imageView = depth_.view;
+  depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+  depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+  depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+  depth.clearValue.depthStencil = {1.0f, 0};
+  VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
+  rendering.renderArea = {{0, 0}, {settings_.width, settings_.height}};
+  rendering.layerCount = 1;
+  rendering.colorAttachmentCount = 1;
+  rendering.pColorAttachments = &color;
+  rendering.pDepthAttachment = &depth;
+  vkCmdBeginRendering(cmd, &rendering);
+
+  VkViewport viewport{0.0f, 0.0f, float(settings_.width), float(settings_.height), 0.0f, 1.0f};
+  VkRect2D scissor{{0, 0}, {settings_.width, settings_.height}};
+  vkCmdSetViewport(cmd, 0, 1, &viewport);
+  vkCmdSetScissor(cmd, 0, 1, &scissor);
+
+  // Line and marker sizes follow the image height so a small test image looks like a large one scaled down.
+  const float scale = float(settings_.height) / 720.0f;
+  PushConstants pc{};
+  pc.view_proj = camera.view_projection();
+  pc.eye = glm::vec4(camera.eye, 1.0f);
+  pc.params = {0.0f, float(settings_.width), float(settings_.height), 0.0f};
+  pc.light = glm::vec4(camera.key_light, 0.0f);
+  auto push = [&] {
+    vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof pc, &pc);
+  };
+  const VkDeviceSize zero = 0;
+
+  {  // background: top colour in `color`, bottom colour in `light`
+    PushConstants bg = pc;
+    bg.color = linear(Palette::background_top);
+    bg.light = linear(Palette::background_bottom);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, background_);
+    vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof bg, &bg);
+    vkCmdDraw(cmd, 3, 1, 0, 0);
+  }
+  if (surface_index_count_) {
+    pc.color = linear(surface_settled_ ? Palette::surface : Palette::provisional_surface);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, surface_);
+    push();
+    vkCmdBindVertexBuffers(cmd, 0, 1, &surface_vertices_.buffer, &zero);
+    vkCmdBindIndexBuffer(cmd, surface_indices_.buffer, 0, VK_INDEX_TYPE_UINT32);
+    vkCmdDrawIndexed(cmd, surface_index_count_, 1, 0, 0, 0);
+  }
+  if (!curve_draws_.empty()) {
+    pc.color = linear(Palette::curve);
+    pc.params.x = std::max(1.0f, 1.6f * scale);
+    pc.params.w = camera.line_depth_pull;
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, curves_);
+    push();
+    vkCmdBindVertexBuffers(cmd, 0, 1, &points_.buffer, &zero);
+    for (const auto& [first, count] : curve_draws_) vkCmdDraw(cmd, 6, count - 1, 0, first);
+  }
+  if (!marker_draws_.empty()) {
+    pc.color = linear(Palette::marker);
+    pc.params.x = std::max(2.5f, 4.5f * scale);
+    pc.params.w = camera.line_depth_pull * 2.0f;
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, markers_);
+    push();
+    vkCmdBindVertexBuffers(cmd, 0, 1, &vertices_.buffer, &zero);
+    for (const auto& [first, count] : marker_draws_) vkCmdDraw(cmd, 6, count, 0, first);
+  }
+  if (reference_index_count_) {
+    pc.color = linear(Palette::reference, 0.35f);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, reference_pipeline_);
+    push();
+    vkCmdBindVertexBuffers(cmd, 0, 1, &reference_vertices_.buffer, &zero);
+    vkCmdBindIndexBuffer(cmd, reference_indices_.buffer, 0, VK_INDEX_TYPE_UINT32);
+    vkCmdDrawIndexed(cmd, reference_index_count_, 1, 0, 0, 0);
+  }
+  vkCmdEndRendering(cmd);
+
+  // The resolved image to the readback buffer, then visible to the host.
+  VkImageMemoryBarrier2 to_copy{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+  to_copy.srcStageMask = color_stage;
+  to_copy.srcAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
+  to_copy.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+  to_copy.dstAccessMask = VK_ACCESS_2_TRANSFER_READ_BIT;
+  to_copy.oldLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+  to_copy.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+  to_copy.srcQueueFamilyIndex = to_copy.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  to_copy.image = resolve_.image;
+  to_copy.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+  dependency = {VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  dependency.imageMemoryBarrierCount = 1;
+  dependency.pImageMemoryBarriers = &to_copy;
+  vkCmdPipelineBarrier2(cmd, &dependency);
+  VkBufferImageCopy region{};
+  region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  region.imageExtent = {settings_.width, settings_.height, 1};
+  vkCmdCopyImageToBuffer(cmd, resolve_.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_.buffer, 1, &region);
+  VkBufferMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
+  to_host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+  to_host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+  to_host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
+  to_host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
+  to_host.srcQueueFamilyIndex = to_host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  to_host.buffer = readback_.buffer;
+  to_host.size = VK_WHOLE_SIZE;
+  dependency = {VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  dependency.bufferMemoryBarrierCount = 1;
+  dependency.pBufferMemoryBarriers = &to_host;
+  vkCmdPipelineBarrier2(cmd, &dependency);
+  FIRE_VK_TRY(vkEndCommandBuffer(cmd));
+
+  VkCommandBufferSubmitInfo command{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+  command.commandBuffer = cmd;
+  VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+  submit.commandBufferInfoCount = 1;
+  submit.pCommandBufferInfos = &command;
+  FIRE_VK_TRY(vkQueueSubmit2(context_.queue(), 1, &submit, fence_));
+  FIRE_VK_TRY(vkWaitForFences(device, 1, &fence_, VK_TRUE, kFenceTimeoutNs));
+  return Status::success();
+}
+
+Image Renderer::image() const {
+  Image out{settings_.width, settings_.height, {}};
+  const auto* bytes = static_cast<const uint8_t*>(readback_.mapped);
+  out.rgba.assign(bytes, bytes + size_t(settings_.width) * settings_.height * 4);
+  return out;
+}
+
+}  // namespace fire::render

@@ -1,0 +1,143 @@
+#pragma once
+// The renderer: reads the curve network's pools and SurfaceLevels and draws them into an offscreen
+// target (4x multisampled colour and depth, resolved and read back to the CPU).
+//
+// What it draws, back to front: a neutral gradient background; the surface, lit (two-sided Blinn-Phong)
+// and tinted while it is provisional (SurfaceLevels::settled false); every live edge's polyline as a
+// screen-space line pulled slightly towards the camera so it shows on the surface it lies on; the
+// network's vertices as round markers; an optional see-through reference mesh.
+//
+// Uploads copy only what changed and count the bytes (UploadStats, per upload() call, i.e. per frame):
+// - points: the GPU keeps a float copy of the point pool at the pool's indices. An edge's points are
+//   copied when the edge is new to the renderer, its slot's generation, offset or count moved, or it is
+//   stamped (engine/change.hpp) after the network frame of the previous upload;
+// - network vertices: by slot, when new or their position changed;
+// - surface: all vertices and the triangle indices when topology_version moved (or on first sight),
+//   else only SurfaceLevels::changed when SurfaceLevels::frame is newer than the last frame uploaded.
+// Buffers are host-visible; growing one re-uploads its whole content (counted as well).
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "engine/mesh.hpp"
+#include "engine/surface.hpp"
+#include "platform/render/camera.hpp"
+#include "platform/render/context.hpp"
+#include "platform/render/image.hpp"
+
+namespace fire::render {
+
+struct RenderSettings {
+  uint32_t width = 1280, height = 720;
+};
+
+// Colours of the scene, sRGB 0..255: shared with the tests, which find the curves and the background by them.
+struct Palette {
+  static constexpr uint8_t background_top[3] = {72, 76, 82};
+  static constexpr uint8_t background_bottom[3] = {30, 32, 36};
+  static constexpr uint8_t curve[3] = {255, 140, 26};
+  static constexpr uint8_t surface[3] = {196, 200, 206};
+  static constexpr uint8_t provisional_surface[3] = {132, 196, 214};  // light teal: not settled yet
+  static constexpr uint8_t marker[3] = {250, 250, 250};
+  static constexpr uint8_t reference[3] = {120, 170, 255};
+};
+
+struct UploadStats {
+  uint64_t bytes = 0;              // copied into GPU buffers by the last upload()
+  uint32_t edges = 0;              // edges whose points were copied
+  uint32_t vertices = 0;           // network vertex markers copied
+  uint32_t surface_vertices = 0;   // surface vertices copied
+  bool surface_topology = false;   // triangle indices copied
+};
+
+class Renderer {
+ public:
+  static Result<std::unique_ptr<Renderer>> create(Context& context, const RenderSettings& settings = {});
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Brings the GPU copies of the network and the surface up to date (see the top of this file).
+  Status upload(const Mesh& network, const SurfaceLevels& surface);
+  const UploadStats& last_upload() const { return stats_; }
+  // A mesh drawn see-through over the scene (triangles: 3 indices each); empty triangles removes it.
+  Status set_reference(std::span<const Vec3> positions, std::span<const uint32_t> triangles);
+
+  // Draws one frame and waits for it; the result is then in image().
+  Status draw(const Camera& camera);
+  Image image() const;
+
+  uint32_t width() const { return settings_.width; }
+  uint32_t height() const { return settings_.height; }
+  VkSampleCountFlagBits samples() const { return samples_; }
+
+  struct Buffer {
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    void* mapped = nullptr;
+    VkDeviceSize capacity = 0;
+  };
+  struct Target {
+    VkImage image = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    VkImageView view = VK_NULL_HANDLE;
+  };
+
+ private:
+  explicit Renderer(Context& context, const RenderSettings& settings) : context_(context), settings_(settings) {}
+  Status init();
+  Status create_target(Target& target, VkFormat format, VkImageUsageFlags usage, VkSampleCountFlagBits samples,
+                       VkImageAspectFlags aspect);
+  // Makes `buffer` hold at least `bytes`; `grown` tells whether its old content was lost.
+  Status reserve(Buffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage, bool& grown);
+  void destroy(Buffer& buffer);
+  void destroy(Target& target);
+  Status create_pipelines();
+  void copy_into(Buffer& buffer, VkDeviceSize offset, const void* data, VkDeviceSize bytes);
+  Status upload_points(const Mesh& network);
+  Status upload_vertices(const Mesh& network);
+  Status upload_surface(const SurfaceLevels& surface);
+
+  Context& context_;
+  RenderSettings settings_;
+  VkSampleCountFlagBits samples_ = VK_SAMPLE_COUNT_1_BIT;
+  VkFormat color_format_ = VK_FORMAT_R8G8B8A8_SRGB;
+  VkFormat depth_format_ = VK_FORMAT_D32_SFLOAT;
+  Target color_, resolve_, depth_;
+  Buffer readback_;
+  VkCommandPool pool_ = VK_NULL_HANDLE;
+  VkCommandBuffer commands_ = VK_NULL_HANDLE;
+  VkFence fence_ = VK_NULL_HANDLE;
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkPipeline background_ = VK_NULL_HANDLE, surface_ = VK_NULL_HANDLE, reference_pipeline_ = VK_NULL_HANDLE,
+             curves_ = VK_NULL_HANDLE, markers_ = VK_NULL_HANDLE;
+
+  // Network: float points at pool indices, and what was uploaded per edge slot.
+  struct EdgeRecord {
+    uint32_t generation = kNone, offset = 0, count = 0;
+  };
+  Buffer points_;
+  std::vector<EdgeRecord> edge_records_;
+  Frame network_frame_ = 0;  // the network's frame at the last upload: later stamps are news
+  std::vector<std::pair<uint32_t, uint32_t>> curve_draws_;  // (first point, point count) per live edge
+  Buffer vertices_;
+  std::vector<glm::vec3> vertex_copy_;  // what the vertex buffer holds, per slot
+  std::vector<uint8_t> vertex_live_;
+  std::vector<std::pair<uint32_t, uint32_t>> marker_draws_;  // runs of live vertex slots (first, count)
+
+  // Surface: interleaved float position and normal per vertex, 6 indices per quad.
+  Buffer surface_vertices_, surface_indices_;
+  uint64_t surface_topology_ = 0;
+  Frame surface_frame_ = 0;
+  bool surface_seen_ = false;
+  uint32_t surface_index_count_ = 0;
+  bool surface_settled_ = true;
+
+  Buffer reference_vertices_, reference_indices_;
+  uint32_t reference_index_count_ = 0;
+
+  UploadStats stats_;
+};
+
+}  // namespace fire::render

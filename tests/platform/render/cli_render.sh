@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# `fire render` as a user runs it, on lavapipe or a GPU with the validation layer on (FIRE_VK_VALIDATION=1
+# from ctest): a network and an input log become PNGs of the asked size; bad input (no Vulkan device, a
+# reference mesh that does not load, a PNG that cannot be written, a bad view or size) exits 1 with a
+# message saying what is wrong, and writes nothing.
+set -u
+fire="$1" here="$2" log="$3"
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+fail=0
+check() { if eval "$2"; then echo "ok: $1"; else echo "FAILED: $1"; fail=1; fi; }
+# expect_error NAME PATTERN OUT CMD...: exit code 1 (not a crash), stderr matching PATTERN, no OUT
+expect_error() {
+  local name="$1" pattern="$2" out="$3"; shift 3
+  "$@" >"$tmp/stdout" 2>"$tmp/err"; local rc=$?
+  if [ $rc -eq 1 ] && grep -q -- "$pattern" "$tmp/err" && [ ! -e "$out" ] && [ ! -s "$tmp/stdout" ]; then
+    echo "ok: $name"; else echo "FAILED: $name (exit $rc)"; cat "$tmp/err"; fail=1; fi
+}
+# png_size FILE: "WIDTH HEIGHT" from the PNG's IHDR chunk
+png_size() { od -An -tu1 -j16 -N8 "$1" | awk '{print $1*16777216+$2*65536+$3*256+$4, $5*16777216+$6*65536+$7*256+$8}'; }
+# some_partial_upload FILE: a JSON line of --every whose edges_uploaded is below its edges
+some_partial_upload() {
+  sed -n 's/.*"edges":\([0-9]*\),.*"edges_uploaded":\([0-9]*\),.*/\1 \2/p' "$1" | awk '$2 < $1 {n++} END {exit !(n > 0)}'
+}
+is_png() { [ "$(od -An -c -j1 -N3 "$1" | tr -d ' ')" = "PNG" ]; }
+
+out=$("$fire" render "$here/data/sketch.fnet" -o "$tmp/net.png" --size 400x300 --view front 2>"$tmp/err"); rc=$?
+check "a network renders (exit 0, nothing on stderr)" "[ $rc -eq 0 ] && [ ! -s '$tmp/err' ]"
+check "prints one JSON line with the device and the counts" \
+  "echo '$out' | grep -q '^{\"output\":\"$tmp/net.png\",\"width\":400,\"height\":300,\"view\":\"front\",\"device\":\"[^\"]*\",\"edges\":32,\"surface_quads\":3264,\"bytes_uploaded\":[1-9][0-9]*,\"validation\":true}$'"
+check "writes a 400x300 PNG" "is_png '$tmp/net.png' && [ \"\$(png_size '$tmp/net.png')\" = '400 300' ]"
+
+"$fire" render "$log" -o "$tmp/log.png" --size 320x180 --view top >"$tmp/stdout" 2>"$tmp/err"; rc=$?
+check "an input log is replayed and rendered" "[ $rc -eq 0 ] && is_png '$tmp/log.png' && [ \"\$(png_size '$tmp/log.png')\" = '320 180' ]"
+check "the replay's rejected stroke is reported, not fatal" "grep -q 'rejected' '$tmp/err'"
+
+"$fire" render "$log" --every 40 --png-dir "$tmp/frames" --size 160x90 >"$tmp/seq" 2>"$tmp/err"; rc=$?
+pictures=$(ls "$tmp/frames" 2>/dev/null | grep -c '^frame_[0-9]*\.png$')
+check "--every: a picture per JSON line as the sketch grows (exit 0, at least 10)" \
+  "[ $rc -eq 0 ] && [ $pictures -ge 10 ] && [ \$(grep -c '^{\"frame\":' '$tmp/seq') -eq $pictures ]"
+check "--every: the last picture has the final network and surface" "tail -1 '$tmp/seq' | grep -q '\"edges\":32,\"surface_quads\":3264,'"
+check "--every: some picture re-sends fewer edges than the network has" "some_partial_upload '$tmp/seq'"
+expect_error "--every with a network file" "--every needs an input log" "$tmp/frames2" \
+  "$fire" render "$here/data/sketch.fnet" --every 5 --png-dir "$tmp/frames2"
+expect_error "neither -o nor --every" "give either -o OUT.png or --every N" "$tmp/none" "$fire" render "$log"
+
+printf 'v 0 0 0\nv 0.2 0 0\nv 0.2 0.2 0\nv 0 0.2 0\nf 1 2 3 4\n' >"$tmp/plane.obj"
+"$fire" render "$here/data/sketch.fnet" -o "$tmp/ref.png" --size 320x180 --reference "$tmp/plane.obj" >/dev/null 2>"$tmp/err"; rc=$?
+check "a reference mesh is drawn with the network" "[ $rc -eq 0 ] && is_png '$tmp/ref.png'"
+check "the reference changes the image" "! cmp -s '$tmp/ref.png' '$tmp/log.png'"
+
+expect_error "no Vulkan device: says where lavapipe comes from" "mesa-vulkan-drivers" "$tmp/none.png" \
+  env VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json "$fire" render "$here/data/sketch.fnet" -o "$tmp/none.png"
+printf 'v 0 0 0\nf 1 2 3\n' >"$tmp/broken.obj"
+expect_error "a reference mesh that does not load" "--reference: .*broken.obj" "$tmp/broken.png" \
+  "$fire" render "$here/data/sketch.fnet" -o "$tmp/broken.png" --reference "$tmp/broken.obj"
+expect_error "a missing reference mesh" "--reference: .*missing.obj" "$tmp/missing.png" \
+  "$fire" render "$here/data/sketch.fnet" -o "$tmp/missing.png" --reference "$tmp/missing.obj"
+expect_error "a PNG path that cannot be written" "$tmp/no/such/dir/x.png: cannot write" "$tmp/no/such/dir/x.png" \
+  "$fire" render "$here/data/sketch.fnet" -o "$tmp/no/such/dir/x.png" --size 64x64
+expect_error "an output that is not a PNG" "must be a .png" "$tmp/x.jpg" "$fire" render "$here/data/sketch.fnet" -o "$tmp/x.jpg"
+expect_error "an unknown view" "--view must be iso, front, top or side" "$tmp/v.png" \
+  "$fire" render "$here/data/sketch.fnet" -o "$tmp/v.png" --view diagonal
+expect_error "a bad size" "--size must be WIDTHxHEIGHT" "$tmp/s.png" "$fire" render "$here/data/sketch.fnet" -o "$tmp/s.png" --size 0x10
+expect_error "a network that does not load" "missing.fnet" "$tmp/n.png" "$fire" render "$tmp/missing.fnet" -o "$tmp/n.png"
+exit $fail

@@ -1,0 +1,326 @@
+// The renderer on whatever Vulkan device the machine has (lavapipe in CI), validation layer on: images of
+// the demo network checked against expected PNGs and by pixel statistics, uploads by changed range, the
+// provisional tint, error messages. Any validation message fails the test.
+//
+// FIRE_UPDATE_RENDER_EXPECTED=1 rewrites tests/platform/render/expected/ (look at the images before committing).
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdlib>
+
+// VkBufferCreateInfo below is zero-filled after sType on purpose, the Vulkan idiom.
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+
+#include "platform/network_file.hpp"
+#include "platform/render/renderer.hpp"
+#include "systems/reconstruct/reconstruct.hpp"
+
+using namespace fire;
+using namespace fire::render;
+
+#if defined(__SANITIZE_ADDRESS__)
+// LeakSanitizer reads its options from here too: the suppressions for Mesa, LLVM and the Vulkan loader.
+extern "C" const char* __lsan_default_options() { return "suppressions=" FIRE_LSAN_SUPPRESSIONS; }
+#endif
+
+namespace {
+
+const std::string kDir = FIRE_RENDER_TEST_DIR;
+constexpr uint32_t kWidth = 320, kHeight = 180;
+
+std::unique_ptr<Context> make_context() {
+  auto c = Context::create({.validation = true});
+  INFO(c.error());
+  REQUIRE(c);
+  return std::move(*c);
+}
+
+struct Scene {
+  Mesh network;
+  SurfaceLevels surface;
+};
+
+Scene demo_scene() {
+  auto net = load_network(kDir + "/data/sketch.fnet");
+  INFO(net.error());
+  REQUIRE(net);
+  Scene s{std::move(*net), {}};
+  auto built = reconstruct::reconstruct_surface(s.network, {});
+  INFO(built.error());
+  REQUIRE(built);
+  REQUIRE(assign_quads(*built, 1, s.surface));
+  return s;
+}
+
+Box box_of(const Scene& s) {
+  Box box;
+  for (const Vec3& p : s.network.points.values()) box.add(p);
+  for (const Vec3& p : s.surface.positions) box.add(p);
+  return box;
+}
+
+Image render_scene(Context& context, Renderer& renderer, const Scene& s, View view) {
+  REQUIRE(renderer.upload(s.network, s.surface));
+  Status drawn = renderer.draw(frame_box(box_of(s), view, renderer.width(), renderer.height()));
+  INFO(drawn.error);
+  REQUIRE(drawn);
+  CHECK(context.validation_message_count() == 0);
+  return renderer.image();
+}
+
+float srgb_to_linear(uint8_t c) {
+  float v = c / 255.0f;
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+float linear_to_srgb(float v) {
+  return 255.0f * (v <= 0.0031308f ? v * 12.92f : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f);
+}
+// The background gradient at row y, sRGB.
+std::array<float, 3> background(uint32_t y, uint32_t height) {
+  const float t = (y + 0.5f) / height;
+  std::array<float, 3> c;
+  for (int k = 0; k < 3; ++k)
+    c[k] = linear_to_srgb(srgb_to_linear(Palette::background_top[k]) * (1 - t) +
+                          srgb_to_linear(Palette::background_bottom[k]) * t);
+  return c;
+}
+bool is_background(const Image& im, uint32_t x, uint32_t y) {
+  auto bg = background(y, im.height);
+  for (int k = 0; k < 3; ++k)
+    if (std::abs(im.pixel(x, y)[k] - bg[k]) > 4) return false;
+  return true;
+}
+bool near(const uint8_t* p, const uint8_t (&c)[3], int tolerance) {
+  for (int k = 0; k < 3; ++k)
+    if (std::abs(int(p[k]) - int(c[k])) > tolerance) return false;
+  return true;
+}
+
+struct Rect {
+  float x0 = 1e9f, y0 = 1e9f, x1 = -1e9f, y1 = -1e9f;
+  void add(float x, float y) {
+    x0 = std::min(x0, x), y0 = std::min(y0, y), x1 = std::max(x1, x), y1 = std::max(y1, y);
+  }
+  bool contains(float x, float y, float inset) const { return x >= x0 + inset && x <= x1 - inset && y >= y0 + inset && y <= y1 - inset; }
+};
+
+// Compares with the committed image (or rewrites it on request): at most 1% of the pixels differ by more
+// than 48 in a channel (edges may move by a pixel between driver versions), and the mean difference is small.
+void check_expected(const Image& image, const std::string& name) {
+  const std::string path = kDir + "/expected/" + name;
+  if (const char* update = std::getenv("FIRE_UPDATE_RENDER_EXPECTED"); update && std::string(update) == "1") {
+    REQUIRE(write_png(image, path));
+    WARN("rewrote " << path);
+    return;
+  }
+  auto expected = read_png(path);
+  INFO(expected.error());
+  REQUIRE(expected);
+  REQUIRE(expected->width == image.width);
+  REQUIRE(expected->height == image.height);
+  size_t differing = 0;
+  double sum = 0;
+  for (size_t i = 0; i < image.rgba.size(); i += 4) {
+    int worst = 0;
+    for (int k = 0; k < 3; ++k) {
+      const int d = std::abs(int(image.rgba[i + k]) - int(expected->rgba[i + k]));
+      worst = std::max(worst, d);
+      sum += d;
+    }
+    if (worst > 48) ++differing;
+  }
+  const size_t pixels = image.rgba.size() / 4;
+  INFO(name << ": " << differing << " of " << pixels << " pixels differ, mean channel difference "
+            << sum / (3.0 * pixels));
+  CHECK(differing <= pixels / 100);
+  CHECK(sum / (3.0 * pixels) < 2.0);
+}
+
+}  // namespace
+
+TEST_CASE("the demo network renders as expected from two views, with the surface, curves and markers where they belong") {
+  auto context = make_context();
+  auto renderer = Renderer::create(*context, {kWidth, kHeight});
+  INFO(renderer.error());
+  REQUIRE(renderer);
+  const Scene scene = demo_scene();
+  for (View view : {View::iso, View::top}) {
+    const std::string name = view == View::iso ? "sketch_iso.png" : "sketch_top.png";
+    SECTION(name) {
+      const Image image = render_scene(*context, **renderer, scene, view);
+      check_expected(image, name);
+
+      // The background at the four corners.
+      for (uint32_t x : {0u, kWidth - 1})
+        for (uint32_t y : {0u, kHeight - 1}) CHECK(is_background(image, x, y));
+
+      // Where the surface should land: its vertices projected with the same camera.
+      const Camera camera = frame_box(box_of(scene), view, kWidth, kHeight);
+      Rect projected;
+      for (const Vec3& p : scene.surface.positions) {
+        glm::vec2 q = project_to_pixels(camera, p, kWidth, kHeight);
+        projected.add(q.x, q.y);
+      }
+      Rect drawn;
+      size_t inside = 0, covered = 0, curve = 0, curve_inside = 0, marker = 0;
+      for (uint32_t y = 0; y < kHeight; ++y)
+        for (uint32_t x = 0; x < kWidth; ++x) {
+          const bool bg = is_background(image, x, y);
+          const float cx = x + 0.5f, cy = y + 0.5f;
+          if (!bg) drawn.add(cx, cy);
+          if (projected.contains(cx, cy, 0)) {
+            ++inside;
+            covered += !bg;
+          }
+          if (near(image.pixel(x, y), Palette::curve, 40)) {
+            ++curve;
+            curve_inside += projected.contains(cx, cy, 6);
+          }
+          marker += near(image.pixel(x, y), Palette::marker, 12);
+        }
+      INFO("projected surface box " << projected.x0 << "," << projected.y0 << " .. " << projected.x1 << ","
+                                    << projected.y1 << "; drawn box " << drawn.x0 << "," << drawn.y0 << " .. "
+                                    << drawn.x1 << "," << drawn.y1);
+      // What is drawn spans the surface's projection, up to a marker's radius (2.5 px here) and a pixel.
+      constexpr float kSlack = 4.5f;
+      CHECK(std::abs(drawn.x0 - projected.x0) <= kSlack);
+      CHECK(std::abs(drawn.x1 - projected.x1) <= kSlack);
+      CHECK(std::abs(drawn.y0 - projected.y0) <= kSlack);
+      CHECK(std::abs(drawn.y1 - projected.y1) <= kSlack);
+      // The surface fills its box: a square seen from above, a diamond seen from the side.
+      const double coverage = double(covered) / double(inside);
+      INFO("coverage " << coverage << ", curve pixels " << curve << " (" << curve_inside << " inside), marker pixels "
+                       << marker);
+      CHECK(coverage > (view == View::top ? 0.9 : 0.45));
+      CHECK(coverage <= 1.0);
+      // Curves are visible over the surface, not only along its border.
+      CHECK(curve > kWidth * kHeight / 100);
+      CHECK(curve_inside > 150);
+      CHECK(marker >= 10);
+    }
+  }
+}
+
+TEST_CASE("uploads copy only what changed and the image equals a fresh upload's") {
+  auto context = make_context();
+  auto incremental = Renderer::create(*context, {kWidth, kHeight});
+  REQUIRE(incremental);
+  Renderer& r = **incremental;
+  Scene scene = demo_scene();
+  Mesh& net = scene.network;
+
+  uint64_t points = 0, vertices = 0;
+  for (uint32_t e = 0; e < net.edge_slots(); ++e)
+    if (net.edge_alive(e)) points += net.edges.point_count[e];
+  for (uint32_t v = 0; v < net.vertex_slots(); ++v) vertices += net.vertex_alive(v);
+  REQUIRE(r.upload(net, scene.surface));
+  CHECK(r.last_upload().bytes ==
+        12 * (points + vertices) + 24ull * scene.surface.vertex_count() + 24ull * scene.surface.quad_count());
+  CHECK(r.last_upload().edges == net.edge_count());
+  CHECK(r.last_upload().surface_topology);
+
+  net.begin_frame(net.frame() + 1);
+  REQUIRE(r.upload(net, scene.surface));
+  CHECK(r.last_upload().bytes == 0);
+
+  // Moving one vertex re-sends the points of its edges and its marker, nothing else.
+  uint32_t moved = 0;
+  while (!net.vertex_alive(moved) || net.valence(moved) < 3) ++moved;
+  uint64_t edge_points = 0;
+  for (uint32_t e : net.vertex_edges(moved)) edge_points += net.edges.point_count[e];
+  net.move_vertex(moved, net.vertices.position[moved] + Vec3(0, 0, 0.01));
+  REQUIRE(r.upload(net, scene.surface));
+  CHECK(r.last_upload().edges == net.valence(moved));
+  CHECK(r.last_upload().vertices == 1);
+  CHECK(r.last_upload().bytes == 12 * (edge_points + 1));
+  net.begin_frame(net.frame() + 1);
+
+  // A surface write of a vertex range re-sends that range only.
+  for (uint32_t v = 100; v < 140; ++v) scene.surface.positions[v].z() += 0.002;
+  scene.surface.frame = 2;
+  scene.surface.changed = {100, 140};
+  REQUIRE(r.upload(net, scene.surface));
+  CHECK(r.last_upload().bytes == 40 * 24);
+  CHECK_FALSE(r.last_upload().surface_topology);
+  // The same frame again: nothing new.
+  REQUIRE(r.upload(net, scene.surface));
+  CHECK(r.last_upload().bytes == 0);
+
+  const Camera camera = frame_box(box_of(scene), View::iso, kWidth, kHeight);
+  REQUIRE(r.draw(camera));
+  const Image after_edits = r.image();
+  auto fresh = Renderer::create(*context, {kWidth, kHeight});
+  REQUIRE(fresh);
+  REQUIRE((*fresh)->upload(net, scene.surface));
+  REQUIRE((*fresh)->draw(camera));
+  CHECK(after_edits.rgba == (*fresh)->image().rgba);
+
+  // A new topology (a version bump) sends everything of the surface again.
+  ++scene.surface.topology_version;
+  scene.surface.frame = 3;
+  REQUIRE(r.upload(net, scene.surface));
+  CHECK(r.last_upload().surface_topology);
+  CHECK(r.last_upload().surface_vertices == scene.surface.vertex_count());
+  CHECK(context->validation_message_count() == 0);
+}
+
+TEST_CASE("a provisional surface is tinted, a settled one is neutral grey") {
+  auto context = make_context();
+  auto renderer = Renderer::create(*context, {kWidth, kHeight});
+  REQUIRE(renderer);
+  Scene scene = demo_scene();
+  scene.network = Mesh{};  // the surface alone
+  auto mean_tint = [&](bool settled) {
+    scene.surface.settled = settled;
+    const Image image = render_scene(*context, **renderer, scene, View::top);
+    double blue_minus_red = 0;
+    size_t n = 0;
+    for (uint32_t y = 0; y < kHeight; ++y)
+      for (uint32_t x = 0; x < kWidth; ++x)
+        if (!is_background(image, x, y)) {
+          blue_minus_red += int(image.pixel(x, y)[2]) - int(image.pixel(x, y)[0]);
+          ++n;
+        }
+    REQUIRE(n > kWidth * kHeight / 4);
+    return blue_minus_red / double(n);
+  };
+  const double settled = mean_tint(true), provisional = mean_tint(false);
+  INFO("settled " << settled << ", provisional " << provisional);
+  CHECK(std::abs(settled) < 15);
+  CHECK(provisional > settled + 25);
+}
+
+TEST_CASE("Vulkan failures name the call") {
+  CHECK(vk_failure("vkCreateDevice(physical_, &device, nullptr, &device_)", VK_ERROR_DEVICE_LOST) ==
+        "vkCreateDevice failed: VK_ERROR_DEVICE_LOST (-4)");
+  CHECK_FALSE(parse_view("diagonal"));
+  CHECK(parse_view("side"));
+}
+
+TEST_CASE("framing keeps every corner of the box inside the image") {
+  Box box;
+  box.add(Vec3(-1, -2, 0));
+  box.add(Vec3(3, 1, 0.5));
+  for (View view : {View::iso, View::front, View::top, View::side}) {
+    const Camera camera = frame_box(box, view, 640, 360);
+    for (int c = 0; c < 8; ++c) {
+      const Vec3 p((c & 1) ? 3 : -1, (c & 2) ? 1 : -2, (c & 4) ? 0.5 : 0);
+      const glm::vec2 q = project_to_pixels(camera, p, 640, 360);
+      CHECK(q.x >= 0);
+      CHECK(q.x <= 640);
+      CHECK(q.y >= 0);
+      CHECK(q.y <= 360);
+    }
+  }
+}
+
+TEST_CASE("validation messages are counted, so the tests above would fail on one") {
+  auto context = make_context();
+  VkBufferCreateInfo invalid{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  invalid.size = 0;  // must be greater than 0: the layer reports it
+  invalid.usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT;
+  VkBuffer buffer = VK_NULL_HANDLE;
+  const VkResult result = vkCreateBuffer(context->device(), &invalid, nullptr, &buffer);
+  if (result == VK_SUCCESS) vkDestroyBuffer(context->device(), buffer, nullptr);
+  CHECK(context->validation_message_count() >= 1);
+}
