@@ -15,7 +15,8 @@ tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 # The first 30 strokes: everything up to the 30th pen-up.
 awk '/ up$/ { n++ } { print } n == 30 { exit }' "$tmp/grid.log" >"$tmp/grid30.log"
 
-systems=(input_system sketch_system split_system refine_system subdivide_system)
+# Each system's function as callgrind names it (the snap system is the index's sync).
+systems=(input_system sketch_system split_system refine_system subdivide_system SnapIndex::sync)
 echo
 echo "| drawing | system | instructions | D1 misses | LL misses | D1 misses per 1000 instructions |"
 echo "|---|---|---|---|---|---|"
@@ -34,9 +35,11 @@ for drawing in demo grid30; do
   # share in parentheses; a zero count is printed as ".".
   for s in "${systems[@]}"; do
     line=$(grep -E "fire::${s}\(" "$tmp/ann.$drawing" | head -1 || true)
-    [ -n "$line" ] || { echo "| $drawing | ${s%_system} | not run | | | |"; continue; }
+    name="${s%_system}"
+    [ "$s" = SnapIndex::sync ] && name=snap
+    [ -n "$line" ] || { echo "| $drawing | $name | not run | | | |"; continue; }
     read -r ir dr dw i1 d1r d1w il dlr dlw _ <<<"$(sed -E 's/\( *[0-9.]+%\)//g; s/,//g; s/ \. / 0 /g; s/ \. / 0 /g' <<<"$line")"
-    awk -v d="$drawing" -v s="${s%_system}" -v ir="$ir" -v d1="$((d1r + d1w))" -v ll="$((dlr + dlw))" \
-      'BEGIN { printf "| %s | %s | %d | %d | %d | %.2f |\n", d, s, ir, d1, ll, ir ? 1000 * d1 / ir : 0 }'
+    awk -v d="$drawing" -v s="$name" -v ir="$ir" -v d1r="$d1r" -v d1w="$d1w" -v dlr="$dlr" -v dlw="$dlw" \
+      'BEGIN { d1 = d1r + d1w; ll = dlr + dlw; printf "| %s | %s | %.0f | %.0f | %.0f | %.2f |\n", d, s, ir, d1, ll, ir ? 1000 * d1 / ir : 0 }'
   done
 done
