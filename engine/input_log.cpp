@@ -130,7 +130,9 @@ Result<InputLog> parse_input_log(std::string_view text, const std::string& sourc
       e.kind = EventKind::Meta;
       if (f.size() < 3) return fail(line_no, "meta needs a key");
       e.name = std::string(f[2]);
-      size_t at = line.find(f[2]) + f[2].size();
+      // The text starts after the key field itself; searching for the key's text could match it earlier
+      // in the line (in the timestamp or the word meta).
+      size_t at = static_cast<size_t>(f[2].data() - line.data()) + f[2].size();
       while (at < line.size() && line[at] == ' ') ++at;
       e.text = std::string(line.substr(at));
     } else {

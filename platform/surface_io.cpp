@@ -384,6 +384,10 @@ Result<SurfaceMesh> decode_ply(std::string_view bytes, const std::string& source
     if (!is_finite(s.positions[v]) || !is_finite(s.normals[v]))
       return fail("vertex " + std::to_string(v) + " has a non-finite value");
   }
+  // Each face takes at least its count byte and three indices: a larger count cannot be real, and
+  // reserving for it could exhaust memory.
+  if ((bytes.size() - at) / 13 < face_count)
+    return fail("truncated: " + std::to_string(face_count) + " faces need at least 13 bytes each after the vertices");
   s.face_offsets.reserve(face_count + 1);
   for (size_t f = 0; f < face_count; ++f) {
     if (at >= bytes.size()) return fail("truncated in face " + std::to_string(f) + " of " + std::to_string(face_count));
@@ -396,6 +400,9 @@ Result<SurfaceMesh> decode_ply(std::string_view bytes, const std::string& source
       if (index < 0 || static_cast<size_t>(index) >= vertex_count)
         return fail("face " + std::to_string(f) + " refers to vertex " + std::to_string(index) + " of " +
                     std::to_string(vertex_count));
+      // The writer refuses such a face, so the reader does too.
+      if (std::find(s.face_vertices.end() - k, s.face_vertices.end(), static_cast<uint32_t>(index)) != s.face_vertices.end())
+        return fail("face " + std::to_string(f) + " uses vertex " + std::to_string(index) + " twice");
       s.face_vertices.push_back(static_cast<uint32_t>(index));
     }
     s.face_offsets.push_back(static_cast<uint32_t>(s.face_vertices.size()));
@@ -430,6 +437,21 @@ Result<SurfaceMesh> decode_stl(std::string_view bytes, const std::string& source
     s.face_offsets.push_back(static_cast<uint32_t>(s.face_vertices.size()));
   }
   return s;
+}
+
+// A glTF count, offset or index must be a JSON integer from 0 up; nlohmann's get<uint64_t>() would wrap a
+// negative one and is undefined for a fraction beyond the range, so the type is checked first.
+struct GlbBad {
+  std::string why;
+};
+
+uint64_t whole_number(const nlohmann::json& j, const std::string& what) {
+  if (!j.is_number_unsigned()) throw GlbBad{what + " is not a whole number from 0 up"};
+  return j.get<uint64_t>();
+}
+
+uint64_t whole_member(const nlohmann::json& object, const char* key, uint64_t fallback, const std::string& what) {
+  return object.contains(key) ? whole_number(object.at(key), what + " " + key) : fallback;
 }
 
 struct GlbParts {
@@ -476,7 +498,7 @@ Result<GlbParts> parse_glb(std::string_view bytes, const std::string& source) {
     if (doc.at("asset").at("version") != "2.0") return fail("asset.version is not \"2.0\"");
     const json& buffers = doc.at("buffers");
     if (buffers.size() != 1) return fail("expected one buffer, found " + std::to_string(buffers.size()));
-    const uint64_t buffer_length = buffers[0].at("byteLength").get<uint64_t>();
+    const uint64_t buffer_length = whole_number(buffers[0].at("byteLength"), "buffer byteLength");
     if (buffers[0].contains("uri")) return fail("the buffer has a uri; a .glb buffer lives in the BIN chunk");
     // The BIN chunk may pad the buffer by up to 3 bytes.
     if (buffer_length > sum.bin_length || sum.bin_length - buffer_length > 3)
@@ -484,34 +506,40 @@ Result<GlbParts> parse_glb(std::string_view bytes, const std::string& source) {
                   std::to_string(sum.bin_length) + " bytes)");
     const json& views = doc.at("bufferViews");
     for (size_t i = 0; i < views.size(); ++i) {
-      const uint64_t offset = views[i].value("byteOffset", uint64_t{0}), length = views[i].at("byteLength").get<uint64_t>();
-      if (views[i].at("buffer") != 0 || offset + length > buffer_length)
+      const std::string view_name = "bufferView " + std::to_string(i);
+      const uint64_t offset = whole_member(views[i], "byteOffset", 0, view_name);
+      const uint64_t length = whole_number(views[i].at("byteLength"), view_name + " byteLength");
+      // Compared without adding, so that offsets near 2^64 cannot wrap around past the check.
+      if (views[i].at("buffer") != 0 || length > buffer_length || offset > buffer_length - length)
         return fail("bufferView " + std::to_string(i) + " (offset " + std::to_string(offset) + ", length " +
                     std::to_string(length) + ") does not fit the buffer of " + std::to_string(buffer_length) + " bytes");
     }
     const json& accessors = doc.at("accessors");
     const json& primitive = doc.at("meshes").at(0).at("primitives").at(0);
-    if (primitive.value("mode", 4) != 4) return fail("the primitive is not a triangle list");
+    if (primitive.contains("mode") && primitive.at("mode") != 4) return fail("the primitive is not a triangle list");
     // Checks accessor `index` has the expected type and fits its bufferView; returns its byte offset in bin.
     auto accessor = [&](const json& ref, const char* role, int component_type, const char* type, size_t components,
                         uint64_t& count, size_t& bin_offset) -> Status {
-      const size_t index = ref.get<size_t>();
+      const uint64_t index = whole_number(ref, std::string(role) + " accessor index");
       if (index >= accessors.size()) return Status::failure(std::string(role) + " accessor " + std::to_string(index) + " does not exist");
       const json& a = accessors[index];
       if (a.at("componentType") != component_type || a.at("type") != type)
         return Status::failure(std::string(role) + " accessor is not " + type + " of component type " + std::to_string(component_type));
-      const size_t view_index = a.at("bufferView").get<size_t>();
+      const uint64_t view_index = whole_number(a.at("bufferView"), std::string(role) + " accessor's bufferView");
       if (view_index >= views.size()) return Status::failure(std::string(role) + " accessor's bufferView does not exist");
       const json& view = views[view_index];
-      count = a.at("count").get<uint64_t>();
+      count = whole_number(a.at("count"), std::string(role) + " accessor's count");
       const uint64_t element = 4 * components;
-      const uint64_t stride = view.value("byteStride", element);
-      const uint64_t offset = a.value("byteOffset", uint64_t{0});
-      const uint64_t needed = count == 0 ? 0 : offset + stride * (count - 1) + element;
+      const uint64_t stride = whole_member(view, "byteStride", element, std::string(role) + " bufferView");
       if (stride != element) return Status::failure(std::string(role) + " data is interleaved (byteStride " + std::to_string(stride) + ")");
-      if (needed > view.at("byteLength").get<uint64_t>())
-        return Status::failure(std::string(role) + " accessor needs " + std::to_string(needed) + " bytes, its bufferView has " +
-                               view.at("byteLength").dump());
+      const uint64_t offset = whole_member(a, "byteOffset", 0, std::string(role) + " accessor");
+      // The bufferView lies inside the buffer (checked above), so its length and offset are below 2^32 and
+      // these comparisons, made without multiplying the count, cannot wrap around.
+      const uint64_t view_length = view.at("byteLength").get<uint64_t>();
+      if (offset > view_length || (view_length - offset) / element < count)
+        return Status::failure(std::string(role) + " accessor needs " + std::to_string(count) + " elements of " +
+                               std::to_string(element) + " bytes from byte " + std::to_string(offset) +
+                               ", its bufferView has " + std::to_string(view_length));
       bin_offset = view.value("byteOffset", uint64_t{0}) + offset;
       if (bin_offset % 4 != 0) return Status::failure(std::string(role) + " data is not 4-byte aligned");
       return Status::success();
@@ -535,7 +563,7 @@ Result<GlbParts> parse_glb(std::string_view bytes, const std::string& source) {
       return fail("counts exceed 32 bits");
     sum.vertex_count = static_cast<uint32_t>(vertex_count);
     sum.index_count = static_cast<uint32_t>(index_count);
-    const json& position = accessors[attributes.at("POSITION").get<size_t>()];
+    const json& position = accessors[attributes.at("POSITION").get<uint64_t>()];
     if (!position.contains("min") || !position.contains("max")) return fail("POSITION accessor lacks min/max (required)");
     Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::max()), hi = -lo;
     for (uint32_t v = 0; v < sum.vertex_count; ++v) {
@@ -553,6 +581,8 @@ Result<GlbParts> parse_glb(std::string_view bytes, const std::string& source) {
     for (uint32_t i = 0; i < sum.index_count; ++i)
       if (get<uint32_t>(parts.bin, parts.index_offset + 4 * size_t{i}) >= sum.vertex_count)
         return fail("index " + std::to_string(i) + " is not below the vertex count " + std::to_string(sum.vertex_count));
+  } catch (const GlbBad& bad) {
+    return fail(bad.why);
   } catch (const nlohmann::json::exception& e) {
     // A missing member or a wrong type anywhere in the JSON chunk (outside the frame loop: a file boundary).
     return fail(std::string("malformed glTF JSON: ") + e.what());
@@ -578,7 +608,15 @@ Result<SurfaceMesh> decode_glb(std::string_view bytes, const std::string& source
   s.face_vertices.resize(parts.summary.index_count);
   for (uint32_t i = 0; i < parts.summary.index_count; ++i)
     s.face_vertices[i] = get<uint32_t>(parts.bin, parts.index_offset + 4 * size_t{i});
-  for (uint32_t t = 1; t <= parts.summary.index_count / 3; ++t) s.face_offsets.push_back(3 * t);
+  for (uint32_t t = 0; t < parts.summary.index_count / 3; ++t) {
+    const uint32_t* tri = s.face_vertices.data() + 3 * size_t{t};
+    // A degenerate triangle is valid glTF, but not a surface the writer accepts or `fire eval` measures.
+    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
+      return Result<SurfaceMesh>::failure(source + ": triangle " + std::to_string(t) + " (indices " +
+                                          std::to_string(tri[0]) + ", " + std::to_string(tri[1]) + ", " +
+                                          std::to_string(tri[2]) + ") repeats a vertex");
+    s.face_offsets.push_back(3 * (t + 1));
+  }
   return s;
 }
 
