@@ -228,6 +228,7 @@ TEST_CASE("uploads copy only what changed and the image equals a fresh upload's"
   while (!net.vertex_alive(moved) || net.valence(moved) < 3) ++moved;
   uint64_t edge_points = 0;
   for (uint32_t e : net.vertex_edges(moved)) edge_points += net.edges.point_count[e];
+  net.begin_frame(net.frame() + 1);  // an edit belongs to a frame after the last upload's
   net.move_vertex(moved, net.vertices.position[moved] + Vec3(0, 0, 0.01));
   REQUIRE(r.upload(net, scene.surface));
   CHECK(r.last_upload().edges == net.valence(moved));
