@@ -66,4 +66,22 @@ uint32_t edge_between(const Mesh& m, uint32_t a, uint32_t b) {
   return kNone;
 }
 
+EditCommand random_split(const Mesh& m, std::mt19937_64& rng, int max_points) {
+  std::vector<uint32_t> live;
+  for (uint32_t f = 0; f < m.face_slots(); ++f)
+    if (m.face_alive(f)) live.push_back(f);
+  const uint32_t f = live[rng() % live.size()];
+  auto loop = m.face_loop(f);
+  auto pick = [&] {
+    uint32_t e = edge_of(loop[rng() % loop.size()]);
+    return CurveEnd{e, uint32_t(rng() % m.edges.point_count[e])};
+  };
+  CurveEnd a = pick(), b = pick();
+  Vec3 pa = m.polyline(a.edge)[a.point], pb = m.polyline(b.edge)[b.point];
+  std::uniform_real_distribution<double> lift(0.0, 0.1);
+  std::vector<Vec3> pts = line(pa, pb, 2 + int(rng() % uint64_t(max_points - 2)));
+  for (size_t k = 1; k + 1 < pts.size(); ++k) pts[k].z() += lift(rng);
+  return split(f, a, b, pts);
+}
+
 }  // namespace fire::test

@@ -1,5 +1,6 @@
 #pragma once
 // Tiny hand-made networks for the engine tests.
+#include <random>
 #include <vector>
 
 #include "engine/mesh.hpp"
@@ -24,5 +25,8 @@ Vec3 at(const Mesh& m, uint32_t e, uint32_t k);
 std::vector<uint32_t> face_sizes(const Mesh& m);
 // The live edge joining vertices a and b, or kNone.
 uint32_t edge_between(const Mesh& m, uint32_t a, uint32_t b);
+// A split of a random live face between two random points of its border (possibly the same edge or point,
+// so some are rejected), with 2 to max_points - 1 points lifted up to 0.1 out of the plane.
+EditCommand random_split(const Mesh& m, std::mt19937_64& rng, int max_points);
 
 }  // namespace fire::test

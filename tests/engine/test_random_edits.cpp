@@ -16,23 +16,6 @@ struct Stats {
   int splits = 0, deletes = 0, undos = 0, redos = 0, rejected = 0;
 };
 
-EditCommand random_split(const Mesh& m, std::mt19937_64& rng) {
-  std::vector<uint32_t> live;
-  for (uint32_t f = 0; f < m.face_slots(); ++f)
-    if (m.face_alive(f)) live.push_back(f);
-  uint32_t f = live[rng() % live.size()];
-  auto loop = m.face_loop(f);
-  auto pick = [&] {
-    uint32_t e = edge_of(loop[rng() % loop.size()]);
-    return CurveEnd{e, uint32_t(rng() % m.edges.point_count[e])};
-  };
-  CurveEnd a = pick(), b = pick();
-  Vec3 pa = m.polyline(a.edge)[a.point], pb = m.polyline(b.edge)[b.point];
-  std::uniform_real_distribution<double> lift(0.0, 0.1);
-  std::vector<Vec3> pts = line(pa, pb, 2 + int(rng() % 6));
-  for (size_t k = 1; k + 1 < pts.size(); ++k) pts[k].z() += lift(rng);
-  return split(f, a, b, pts);
-}
 
 }  // namespace
 
@@ -46,7 +29,7 @@ TEST_CASE("10,000 random edits keep every invariant", "[random]") {
     uint64_t before = m.hash();
     EditOutcome r;
     if (dice < 55) {
-      r = h.apply(m, random_split(m, rng));
+      r = h.apply(m, random_split(m, rng, 8));
       s.splits += r.ok;
     } else if (dice < 70) {
       std::vector<uint32_t> interior;

@@ -53,22 +53,6 @@ std::vector<uint32_t> live_faces(const Mesh& m) {
   return out;
 }
 
-EditCommand random_split(const Mesh& m, std::mt19937_64& rng) {
-  const std::vector<uint32_t> faces = live_faces(m);
-  const uint32_t f = faces[rng() % faces.size()];
-  auto loop = m.face_loop(f);
-  auto pick = [&] {
-    uint32_t e = edge_of(loop[rng() % loop.size()]);
-    return CurveEnd{e, uint32_t(rng() % m.edges.point_count[e])};
-  };
-  CurveEnd a = pick(), b = pick();
-  Vec3 pa = m.polyline(a.edge)[a.point], pb = m.polyline(b.edge)[b.point];
-  std::uniform_real_distribution<double> lift(0.0, 0.1);
-  // Up to three leaves' worth of points, so edges span several leaves.
-  std::vector<Vec3> pts = line(pa, pb, 2 + int(rng() % 22));
-  for (size_t k = 1; k + 1 < pts.size(); ++k) pts[k].z() += lift(rng);
-  return split(f, a, b, pts);
-}
 
 // A query point: on a polyline point (ties at vertices), halfway between two neighbours (ties between
 // points), near the network at several scales, or far from it.
@@ -222,7 +206,7 @@ TEST_CASE("the index equals the exhaustive search through random edits, undos an
       const Mesh before = m;
       const uint64_t dice = rng() % 100;
       if (dice < 55) {
-        h.apply(m, random_split(m, rng));
+        h.apply(m, random_split(m, rng, 24));  // up to three leaves' worth of points per curve
       } else if (dice < 68) {
         std::vector<uint32_t> interior;
         for (uint32_t e = 0; e < m.edge_slots(); ++e)

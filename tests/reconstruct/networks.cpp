@@ -149,4 +149,15 @@ EditCommand random_split(const Mesh& m, std::mt19937_64& rng) {
 }
 
 
+std::optional<EditCommand> random_delete(const Mesh& m, std::mt19937_64& rng) {
+  std::vector<uint32_t> interior;
+  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e) && !m.is_border_edge(e)) interior.push_back(e);
+  if (interior.empty()) return std::nullopt;
+  EditCommand del;
+  del.kind = EditKind::DeleteCurve;
+  del.edge = interior[rng() % interior.size()];
+  return del;
+}
+
 }  // namespace fire::test

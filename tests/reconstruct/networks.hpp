@@ -1,6 +1,7 @@
 #pragma once
 // Hand-made curve networks for the reconstruction tests.
 #include <functional>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -30,5 +31,7 @@ Mesh limit_grid_network(uint32_t m, uint32_t levels, const Height& height);
 // A curve across a random live face between two random points of its border, bowed up. Mostly between
 // points inside two different edges; one in sixteen may end anywhere, which can make 2-sided faces.
 EditCommand random_split(const Mesh& m, std::mt19937_64& rng);
+// Deleting a random interior curve, or nothing when every curve is on the border.
+std::optional<EditCommand> random_delete(const Mesh& m, std::mt19937_64& rng);
 
 }  // namespace fire::test

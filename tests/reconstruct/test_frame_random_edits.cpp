@@ -69,14 +69,9 @@ TEST_CASE("random edits through the frame: the settled surface equals a full reb
     if (grow) {
       r = history.apply(net, random_split(net, rng));
     } else if (dice < 75) {
-      std::vector<uint32_t> interior;
-      for (uint32_t e = 0; e < net.edge_slots(); ++e)
-        if (net.edge_alive(e) && !net.is_border_edge(e)) interior.push_back(e);
-      if (interior.empty()) continue;
-      EditCommand del;
-      del.kind = EditKind::DeleteCurve;
-      del.edge = interior[rng() % interior.size()];
-      r = history.apply(net, del);
+      const std::optional<EditCommand> del = random_delete(net, rng);
+      if (!del) continue;
+      r = history.apply(net, *del);
     } else if (dice < 90) {
       r = history.undo(net);
     } else {
