@@ -109,7 +109,7 @@ int run_replay(const ReplayOptions& o) {
 void add_network_commands(CLI::App& app, Registry& registry) {
   auto o = std::make_shared<ReplayOptions>();
   CLI::App* replay = app.add_subcommand(
-      "replay", "Replay an input log headless through the frame systems (input, sketch, split, refine, subdivide)");
+      "replay", "Replay an input log headless through the frame systems (input, sketch, split, refine, subdivide, snap)");
   replay->add_option("LOG", o->log_path, "input log (format: engine/INPUT_LOG.md)")->required();
   replay->add_option("-o,--output", o->out_path, "write the final curve network here (format: engine/NETWORK_FORMAT.md)");
   replay->add_option("--export-obj", o->obj_path, "also write the network's polylines as OBJ lines");
