@@ -295,6 +295,13 @@ void Mesh::rollback(const MeshMark& m) {
   });
 }
 
+bool Mesh::written_after(Frame f) const {
+  for (const ChangeStamps* c : {&vertices.changes, &edges.changes, &faces.changes})
+    for (Frame stamp : c->stamp)
+      if (stamp > f) return true;
+  return false;
+}
+
 void Mesh::begin_frame(Frame f) {
   FIRE_ASSERT(f >= frame_, "frames never go back: consumers would miss the writes in between");
   frame_ = f;

@@ -147,6 +147,8 @@ class Mesh {
   void begin_frame(Frame f);
   Frame frame() const { return frame_; }
   const CompactionRecord& last_compaction() const { return last_compaction_; }
+  // Whether any vertex, edge or face was written after frame `f`.
+  bool written_after(Frame f) const;
 
   // ---- primitive mutations (journaled inside a transaction, stamped always)
   uint32_t add_vertex(const Vec3& p, uint8_t extra_flags = 0);

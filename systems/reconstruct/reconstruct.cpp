@@ -45,13 +45,6 @@ const BaseMesh& ReconstructionState::base() const { return cache_->base; }
 
 namespace {
 
-bool changed_since(const Mesh& net, Frame seen) {
-  for (const ChangeStamps* c : {&net.vertices.changes, &net.edges.changes, &net.faces.changes})
-    for (Frame stamp : c->stamp)
-      if (stamp > seen) return true;
-  return false;
-}
-
 bool used_by_face(const Mesh& net, uint32_t e) {
   return net.edges.face[e][0] != kNone || net.edges.face[e][1] != kNone;
 }
@@ -257,7 +250,7 @@ Result<bool> run_refine(const Mesh& net, const Options& options, ReconstructionC
   // Cached results name slots; after a compaction they would name the wrong ones.
   const bool everything =
       !c.built || !(c.options == options) || net.last_compaction().count != c.compactions_seen;
-  if (!everything && !c.pending_subdivide && !changed_since(net, c.seen)) {
+  if (!everything && !c.pending_subdivide && !net.written_after(c.seen)) {
     c.stats = {};
     return false;
   }

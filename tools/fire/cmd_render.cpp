@@ -49,13 +49,6 @@ Result<Mesh> load_input(const std::string& path) {
   return std::move(world->mesh);
 }
 
-// Whether the network wrote anything after frame `f`.
-bool stamped_after(const Mesh& m, Frame f) {
-  for (const ChangeStamps* c : {&m.vertices.changes, &m.edges.changes, &m.faces.changes})
-    if (std::any_of(c->stamp.begin(), c->stamp.end(), [f](Frame s) { return s > f; })) return true;
-  return false;
-}
-
 // --every N: the input log replayed with the renderer as the frame's last system. Every frame at least N
 // frames after the previous picture whose network changed is reconstructed incrementally, uploaded by
 // changed range and written to DIR/frame_NNNNNN.png; one JSON line per picture says what was uploaded.
@@ -77,7 +70,7 @@ int render_sequence(const RenderArgs& a, const Mesh& final_network, render::Rend
   auto picture = [&](bool last) {
     World& w = *world;
     if (!status || w.mesh.edge_count() == 0) return;
-    const bool changed = !pictured || stamped_after(w.mesh, last_picture) || w.surface.frame > last_picture;
+    const bool changed = !pictured || w.mesh.written_after(last_picture) || w.surface.frame > last_picture;
     if (!changed || (pictured && w.frame.index < last_picture + a.every && !last)) return;
     status = renderer.upload(w.mesh, w.surface);
     if (status) status = renderer.draw(camera);
