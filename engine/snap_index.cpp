@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <utility>
 
 namespace fire {
@@ -66,6 +67,26 @@ double squared_gap(const B& b, const Vec3& p) {
   double s = 0;
   for (int a = 0; a < 3; ++a) {
     const double g = std::max(std::max(double(b.lo[a]) - p[a], p[a] - double(b.hi[a])), 0.0);
+    s += g * g;
+  }
+  return s;
+}
+
+using DoublePair = double __attribute__((vector_size(16)));
+using FloatPair = float __attribute__((vector_size(8)));
+
+// squared_gap() of both children's boxes at once, with the same arithmetic in the same order.
+template <class Node>
+DoublePair children_gaps(const Node& n, const Vec3& p) {
+  DoublePair s = {0, 0};
+  for (int a = 0; a < 3; ++a) {
+    FloatPair lo, hi;
+    std::memcpy(&lo, n.lo[a], sizeof lo);
+    std::memcpy(&hi, n.hi[a], sizeof hi);
+    const DoublePair below = __builtin_convertvector(lo, DoublePair) - p[a];
+    const DoublePair above = p[a] - __builtin_convertvector(hi, DoublePair);
+    DoublePair g = below < above ? above : below;
+    g = g < 0.0 ? 0.0 : g;
     s += g * g;
   }
   return s;
@@ -138,6 +159,8 @@ void SnapIndex::add_leaves(uint32_t e, std::span<const Vec3> line, std::vector<u
       l.box.lo[a] = round_down(lo[a]);
       l.box.hi[a] = round_up(hi[a]);
     }
+    // Unused places are infinitely far, so queries test points in pairs without a bounds check.
+    for (uint32_t i = l.count; i < kLeafPoints; ++i) l.x[i] = l.y[i] = l.z[i] = std::numeric_limits<double>::infinity();
     edge_leaves_[e].push_back(r);
     fresh.push_back(r);
     points_ += l.count;
@@ -236,8 +259,8 @@ uint32_t SnapIndex::new_node() {
 
 SnapIndex::Box SnapIndex::box_of(uint32_t ref) const {
   if (ref & kLeafRef) return leaves_[ref & ~kLeafRef].box;
-  Box b = nodes_[ref].box[0];
-  merge_into(b, nodes_[ref].box[1]);
+  Box b = nodes_[ref].box(0);
+  merge_into(b, nodes_[ref].box(1));
   return b;
 }
 
@@ -249,7 +272,7 @@ void SnapIndex::replace_child(uint32_t parent, uint32_t old_ref, uint32_t new_re
   Node& p = nodes_[parent];
   const int s = p.child[0] == old_ref ? 0 : 1;
   p.child[s] = new_ref;
-  p.box[s] = box;
+  p.set_box(s, box);
 }
 
 // Picks the sibling that adds the least box area over the path (the surface area heuristic, greedily
@@ -272,19 +295,24 @@ void SnapIndex::insert_leaf(uint32_t leaf) {
     const double here = 2 * combined, inherited = 2 * (combined - half_area(ib));
     double cost[2];
     for (int s = 0; s < 2; ++s) {
-      Box b = n.box[s];
+      Box b = n.box(s);
       merge_into(b, lb);
-      cost[s] = half_area(b) + inherited - (n.child[s] & kLeafRef ? 0.0 : half_area(n.box[s]));
+      cost[s] = half_area(b) + inherited - (n.child[s] & kLeafRef ? 0.0 : half_area(n.box(s)));
     }
     if (here < cost[0] && here < cost[1]) break;
     const int s = cost[0] <= cost[1] ? 0 : 1;
-    ib = n.box[s];
-    merge_into(n.box[s], lb);
+    ib = n.box(s);
+    Box grown = ib;
+    merge_into(grown, lb);
+    n.set_box(s, grown);
     i = n.child[s];
   }
   const uint32_t sibling = i, old_parent = parent_of(sibling);
   const uint32_t p = new_node();
-  nodes_[p] = {{ib, lb}, {sibling, leaf}};
+  nodes_[p].set_box(0, ib);
+  nodes_[p].set_box(1, lb);
+  nodes_[p].child[0] = sibling;
+  nodes_[p].child[1] = leaf;
   parent_[p] = old_parent;
   parent_of(sibling) = p;
   parent_of(leaf) = p;
@@ -303,7 +331,7 @@ void SnapIndex::remove_leaf(uint32_t leaf) {
   const uint32_t p = parent_of(leaf), gp = parent_[p];
   const int s = nodes_[p].child[0] == leaf ? 1 : 0;
   const uint32_t sibling = nodes_[p].child[s];
-  const Box sb = nodes_[p].box[s];
+  const Box sb = nodes_[p].box(s);
   parent_of(sibling) = gp;
   replace_child(gp, p, sibling, sb);
   free_nodes_.push_back(p);
@@ -318,7 +346,7 @@ void SnapIndex::refit_up(uint32_t i) {
     height_[i] = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
     leaves_under_[i] = leaves_of(n.child[0]) + leaves_of(n.child[1]);
     const uint32_t p = parent_[i];
-    if (p != kNone) nodes_[p].box[nodes_[p].child[0] == i ? 0 : 1] = box_of(i);
+    if (p != kNone) nodes_[p].set_box(nodes_[p].child[0] == i ? 0 : 1, box_of(i));
   }
 }
 
@@ -349,7 +377,7 @@ void SnapIndex::refit_marked(uint32_t i, std::vector<uint32_t>& unbalanced) {
     const uint32_t c = n.child[s];
     if (c & kLeafRef || !marked_[c]) continue;
     refit_marked(c, unbalanced);
-    n.box[s] = box_of(c);
+    n.set_box(s, box_of(c));
   }
   height_[i] = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
   leaves_under_[i] = leaves_of(n.child[0]) + leaves_of(n.child[1]);
@@ -389,7 +417,7 @@ void SnapIndex::rebuild_subtree(uint32_t top) {
     stack.pop_back();
     for (int s = 0; s < 2; ++s) {
       const uint32_t c = nodes_[i].child[s];
-      if (c & kLeafRef) items.push_back({c, nodes_[i].box[s]});
+      if (c & kLeafRef) items.push_back({c, nodes_[i].box(s)});
       else stack.push_back(c);
     }
     if (i != top) free_nodes_.push_back(i);
@@ -433,7 +461,7 @@ void SnapIndex::build(std::span<Item> items, uint32_t node, uint32_t parent) {
       box = box_of(ref);
     }
     nodes_[node].child[s] = ref;
-    nodes_[node].box[s] = box;
+    nodes_[node].set_box(s, box);
   }
   const Node& n = nodes_[node];
   height_[node] = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
@@ -468,28 +496,37 @@ SnapHit SnapIndex::nearest(const Vec3& p, double radius) const {
     if (gap > bound) continue;
     if (ref & kLeafRef) {
       const Leaf& l = leaves_[ref & ~kLeafRef];
-      for (uint32_t k = 0; k < l.count; ++k) {
-        const double dx = l.x[k] - p.x(), dy = l.y[k] - p.y(), dz = l.z[k] - p.z();
-        if (dx * dx + dy * dy + dz * dz > bound) continue;
-        const Vec3 q(l.x[k], l.y[k], l.z[k]);
-        const double d = (q - p).norm();
-        if (d <= radius && before(d, l.edge, l.first + k, best)) {
-          best = {l.edge, l.first + k, d};
-          bound = bound_of(d);
+      for (uint32_t k = 0; k < kLeafPoints; k += 2) {
+        DoublePair x, y, z;
+        std::memcpy(&x, l.x + k, sizeof x);
+        std::memcpy(&y, l.y + k, sizeof y);
+        std::memcpy(&z, l.z + k, sizeof z);
+        const DoublePair dx = x - p.x(), dy = y - p.y(), dz = z - p.z();
+        const auto near = dx * dx + dy * dy + dz * dz <= bound;
+        for (uint32_t j = 0; j < 2; ++j) {
+          if (!near[j]) continue;
+          const double d = (Vec3(l.x[k + j], l.y[k + j], l.z[k + j]) - p).norm();
+          if (d <= radius && before(d, l.edge, l.first + k + j, best)) {
+            best = {l.edge, l.first + k + j, d};
+            bound = bound_of(d);
+          }
         }
       }
       continue;
     }
     const Node& n = nodes_[ref];
-    const double g0 = squared_gap(n.box[0], p), g1 = squared_gap(n.box[1], p);
-    // The nearer child goes on top, so it is searched first and tightens the bound for the other.
-    const int nearer = g1 < g0 ? 1 : 0;
-    const double gn = nearer ? g1 : g0, gf = nearer ? g0 : g1;
-    if (gf <= bound) stack[top++] = {n.child[1 - nearer], gf};
-    if (gn <= bound) {
-      stack[top++] = {n.child[nearer], gn};
-      prefetch(n.child[nearer]);
-    }
+    const DoublePair g = children_gaps(n, p);
+    // The nearer child goes on top, so it is searched first and tightens the bound for the other. Pushes
+    // are unconditional writes with a conditional count: which child is nearer is a coin toss that a
+    // branch would mispredict.
+    const int nearer = g[1] < g[0] ? 1 : 0;
+    const double gn = g[nearer], gf = g[1 - nearer];
+    stack[top] = {n.child[1 - nearer], gf};
+    top += gf <= bound;
+    stack[top] = {n.child[nearer], gn};
+    top += gn <= bound;
+    prefetch(n.child[nearer]);
+    prefetch(n.child[1 - nearer]);
   }
   return best;
 }
@@ -530,7 +567,7 @@ void SnapIndex::nearest_per_edge(const Vec3& p, double radius, std::vector<SnapH
     if (!(ref & kLeafRef)) {
       const Node& n = nodes_[ref];
       for (int s = 0; s < 2; ++s)
-        if (squared_gap(n.box[s], p) <= bound) stack[top++] = n.child[s];
+        if (squared_gap(n.box(s), p) <= bound) stack[top++] = n.child[s];
       continue;
     }
     const Leaf& l = leaves_[ref & ~kLeafRef];
@@ -573,7 +610,7 @@ std::string SnapIndex::validate_ref(uint32_t ref, uint32_t parent, const Box& bo
   if (parent_[ref] != parent) return "node " + std::to_string(ref) + " has a wrong parent";
   const Node& n = nodes_[ref];
   for (int s = 0; s < 2; ++s)
-    if (auto why = validate_ref(n.child[s], ref, n.box[s], leaves); !why.empty()) return why;
+    if (auto why = validate_ref(n.child[s], ref, n.box(s), leaves); !why.empty()) return why;
   if (height_[ref] != 1 + std::max(height_of(n.child[0]), height_of(n.child[1])))
     return "node " + std::to_string(ref) + " has a wrong height";
   if (leaves_under_[ref] != leaves_of(n.child[0]) + leaves_of(n.child[1]))

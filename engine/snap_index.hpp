@@ -36,7 +36,7 @@ std::vector<uint32_t> changed_slots(std::span<const Frame> stamps, Frame seen);
 
 class SnapIndex {
  public:
-  static constexpr uint32_t kLeafPoints = 8;
+  static constexpr uint32_t kLeafPoints = 8;  // even: queries read points in pairs
   static constexpr double kUnbounded = std::numeric_limits<double>::infinity();
 
   // Brings the index in step with `mesh` for these edge slots, each of which may now be dead, alive with a
@@ -74,11 +74,18 @@ class SnapIndex {
     float lo[3], hi[3];
   };
   // An inner node holds its children's boxes, so a query decides on both children from the one node it
-  // has loaded, as a k-d tree decides from its split plane. A child is an inner node or a leaf record
-  // (kLeafRef set).
+  // has loaded, as a k-d tree decides from its split plane; axis by axis ([axis][child]), so it computes
+  // both children's distances at once. A child is an inner node or a leaf record (kLeafRef set).
   struct alignas(64) Node {  // one cache line
-    Box box[2];
+    float lo[3][2], hi[3][2];
     uint32_t child[2];
+    Box box(int s) const { return {{lo[0][s], lo[1][s], lo[2][s]}, {hi[0][s], hi[1][s], hi[2][s]}}; }
+    void set_box(int s, const Box& b) {
+      for (int a = 0; a < 3; ++a) {
+        lo[a][s] = b.lo[a];
+        hi[a][s] = b.hi[a];
+      }
+    }
   };
   static constexpr uint32_t kLeafRef = 0x80000000u;
   static constexpr uint32_t kFreed = kNone - 1;  // parent_ of a node on the free list
