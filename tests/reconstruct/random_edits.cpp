@@ -1,0 +1,46 @@
+// The random edits of networks.hpp, without Catch, so the soak in perf/soak/ builds them too.
+#include <cmath>
+
+#include "networks.hpp"
+
+namespace fire::test {
+
+EditCommand random_split(const Mesh& m, std::mt19937_64& rng) {
+  std::vector<uint32_t> live;
+  for (uint32_t f = 0; f < m.face_slots(); ++f)
+    if (m.face_alive(f)) live.push_back(f);
+  EditCommand c;
+  c.kind = EditKind::SplitFace;
+  c.face = live[rng() % live.size()];
+  const auto loop = m.face_loop(c.face);
+  const bool anywhere = rng() % 16 == 0;
+  auto pick = [&](uint32_t e) {
+    const uint32_t n = m.edges.point_count[e];
+    return CurveEnd{e, anywhere || n < 3 ? uint32_t(rng() % n) : 1 + uint32_t(rng() % (n - 2))};
+  };
+  const size_t first = rng() % loop.size();
+  const size_t second = anywhere || loop.size() < 2 ? rng() % loop.size() : (first + 1 + rng() % (loop.size() - 1)) % loop.size();
+  c.start = pick(loop[first] >> 1);
+  c.end = pick(loop[second] >> 1);
+  const Vec3 a = m.polyline(c.start.edge)[c.start.point], b = m.polyline(c.end.edge)[c.end.point];
+  const int n = 3 + int(rng() % 8);
+  for (int k = 0; k < n; ++k) {
+    const double s = double(k) / (n - 1);
+    c.points.push_back(a + (b - a) * s + Vec3(0, 0, 0.2 * std::sin(M_PI * s)));
+  }
+  return c;
+}
+
+
+std::optional<EditCommand> random_delete(const Mesh& m, std::mt19937_64& rng) {
+  std::vector<uint32_t> interior;
+  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e) && !m.is_border_edge(e)) interior.push_back(e);
+  if (interior.empty()) return std::nullopt;
+  EditCommand del;
+  del.kind = EditKind::DeleteCurve;
+  del.edge = interior[rng() % interior.size()];
+  return del;
+}
+
+}  // namespace fire::test
