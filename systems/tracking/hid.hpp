@@ -60,7 +60,10 @@ struct ReportCounts {
   size_t garbled = 0;             // hex that did not parse, or no bytes at all
   size_t bad_length = 0;          // truncated or padded IR reports
   size_t unknown_id = 0;          // report ids no Wii Remote sends
-  size_t unknown_device = 0;      // device numbers other than 0 and 1
+  size_t unknown_device = 0;      // devices that are no camera: not 0 or 1 in a log without device records,
+                                  // or with no camera role in the log's `meta device` records
+  size_t pad_reports = 0;         // reports of the command pad (role `pad` in `meta device`): no camera data
+  size_t bad_device_records = 0;  // `meta device` records that do not read as D ADDRESS ROLE PRODUCT
   size_t out_of_range_slots = 0;  // blobs with impossible coordinates, dropped from kept reports
   size_t rejected_reports() const { return garbled + bad_length + unknown_id + unknown_device; }
 };

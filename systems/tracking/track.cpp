@@ -2,6 +2,8 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <map>
+#include <sstream>
 #include <cmath>
 #include <limits>
 
@@ -124,16 +126,62 @@ double sampson(const Eigen::Matrix3d& E, const Vec2& n0, const Vec2& n1) {
 
 }  // namespace
 
+namespace {
+
+constexpr int kPad = -2, kNoRole = -1;
+
+// A `meta device` record's device number and role (camera index, kPad), or nothing when it does not read.
+std::optional<std::pair<int, int>> device_record(const std::string& text, std::string& address) {
+  std::istringstream in(text);
+  long device = -1;
+  std::string role, product;
+  if (!(in >> device >> address >> role >> product) || device < 0 || device > 1'000'000) return std::nullopt;
+  if (role == "camera0") return std::pair{int(device), 0};
+  if (role == "camera1") return std::pair{int(device), 1};
+  if (role == "pad") return std::pair{int(device), kPad};
+  return std::nullopt;
+}
+
+}  // namespace
+
 DeviceStreams decode_device_streams(std::span<const InputEvent> events) {
   DeviceStreams out;
   ReportCounts& c = out.counts;
+  std::map<int, int> role_of;  // device -> camera index or kPad, once the log has device records
+  bool has_records = false;
   for (const InputEvent& e : events) {
+    if (e.kind == EventKind::Meta && e.name == "device") {
+      std::string address;
+      const auto record = device_record(e.text, address);
+      if (!record) {
+        ++c.bad_device_records;
+        continue;
+      }
+      has_records = true;
+      const auto [device, role] = *record;
+      // A device number now taken by another role, or a role now held by another device, is given up.
+      for (auto& [d, r] : role_of)
+        if (d != device && r == role) r = kNoRole;
+      role_of[device] = role;
+      std::string& known = role >= 0 ? out.camera_address[size_t(role)] : out.pad_address;
+      if (known.empty()) known = address;
+      continue;
+    }
     if (e.kind != EventKind::Hid) continue;
     if (!e.hid_ok) {
       ++c.garbled;
       continue;
     }
-    if (e.device != 0 && e.device != 1) {
+    int camera = e.device == 0 || e.device == 1 ? e.device : kNoRole;
+    if (has_records) {
+      const auto it = role_of.find(e.device);
+      camera = it == role_of.end() ? kNoRole : it->second;
+    }
+    if (camera == kPad) {
+      ++c.pad_reports;
+      continue;
+    }
+    if (camera == kNoRole) {
       ++c.unknown_device;
       continue;
     }
@@ -147,7 +195,7 @@ DeviceStreams decode_device_streams(std::span<const InputEvent> events) {
     }
     ++c.ir_reports;
     c.out_of_range_slots += static_cast<size_t>(r.out_of_range_slots);
-    CameraFrames& f = out.cameras[e.device];
+    CameraFrames& f = out.cameras[size_t(camera)];
     std::array<Vec2, kIrSlots> blobs;
     blobs.fill(Vec2::Zero());
     uint8_t n = 0;

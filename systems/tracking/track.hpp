@@ -35,10 +35,16 @@ struct CameraFrames {
 
 struct DeviceStreams {
   std::array<CameraFrames, 2> cameras;
+  // The Bluetooth address of each camera's remote, from the log's `meta device` records; empty when
+  // the log does not say (simulated sessions). A camera whose remote changed mid-log keeps the first.
+  std::array<std::string, 2> camera_address;
+  std::string pad_address;
   ReportCounts counts;
 };
 
-// Decodes every `hid` event of devices 0 and 1; garbled, truncated, unknown and out-of-range
+// Decodes every camera's `hid` events. Which device is which camera comes from the log's `meta device`
+// records (D ADDRESS ROLE PRODUCT, roles camera0, camera1, pad), in log order; a log without them (the
+// simulator's) has cameras 0 and 1 as devices 0 and 1. Garbled, truncated, unknown and out-of-range
 // input is counted in `counts` and skipped, never fatal. t_frame_us starts as the arrival time.
 DeviceStreams decode_device_streams(std::span<const InputEvent> events);
 

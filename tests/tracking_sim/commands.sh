@@ -80,4 +80,25 @@ expect_failure "track with a broken rig" "$fire" track s.log --rig broken.json -
 expect_failure "track --truth on a log without truth" "$fire" track pen.log --rig rig.json -o x.log --truth
 expect_failure "simulate with a NaN option" "$fire" simulate wand --noise-px nan -o x.log
 expect_failure "track with a NaN filter option" "$fire" track s.log --rig rig.json -o x.log --beta nan
+
+# Remotes by their Bluetooth address: a wand log whose device records name the remotes gives a rig that
+# names them; a drawing by the same remotes tracks (the pad's reports counted apart, not rejected), one
+# by another camera is refused with both addresses.
+records() { # camera0 camera1
+  printf '0 meta device 0 %s camera0 0306\n0 meta device 1 %s camera1 0306\n0 meta device 2 00:1F:32:AA:BB:03 pad 0306\n' "$1" "$2"
+}
+named() { # log camera0 camera1 -> the log with device records after its header, and a pad report
+  { head -1 "$1"; records "$2" "$3"; tail -n +2 "$1"; echo "999999999 hid 2 3000"; }
+}
+named w.log 00:1F:32:AA:BB:01 00:1F:32:AA:BB:02 > w_named.log
+"$fire" calibrate w_named.log -o rig_named.json >/dev/null
+grep -qi '"address": "00:1f:32:aa:bb:01"' rig_named.json && grep -q '"role": "pad"' rig_named.json ||
+  fail "the rig does not name the calibrated remotes: $(cat rig_named.json)"
+named s.log 00:1f:32:aa:bb:01 00:1F:32:AA:BB:02 > s_named.log
+out=$("$fire" track s_named.log --rig rig_named.json -o x.log)
+grep -q '"pad":1,' <<<"$out" && grep -q '"unknown_device":0,' <<<"$out" || fail "the pad's report was not counted apart: $out"
+named s.log 00:1F:32:AA:BB:01 00:1F:32:AA:BB:09 > s_other.log
+expect_failure "track a drawing by other remotes than the rig's" "$fire" track s_other.log --rig rig_named.json -o x.log
+grep -qi "camera 1 is the remote 00:1f:32:aa:bb:09" err.txt && grep -qi "calibrated with 00:1f:32:aa:bb:02" err.txt ||
+  fail "the other remote is not named: $(cat err.txt)"
 echo "tracking commands: ok"

@@ -249,3 +249,53 @@ TEST_CASE("bad device reports are counted and skipped; the good ones are kept") 
   CHECK(s.cameras[1].blob_count[0] == 0);  // its only blob was out of range
   CHECK(s.cameras[1].blobs[1][0] == Vec2(100, 200));
 }
+
+TEST_CASE("cameras are the remotes the log's device records name; the command pad is no camera") {
+  auto hid = [](int device, uint16_t x) {
+    IrReport r;
+    r.slots[0] = IrSlot{true, x, 200, 3};
+    InputEvent e;
+    e.kind = EventKind::Hid;
+    e.device = device;
+    e.bytes = encode_ir_report(r);
+    return e;
+  };
+  auto device = [](const std::string& text) {
+    InputEvent e;
+    e.kind = EventKind::Meta;
+    e.name = "device";
+    e.text = text;
+    return e;
+  };
+  // Remotes whose device numbers do not follow their roles, a pad, a record that does not read, and a
+  // device no record names.
+  const std::vector<InputEvent> events{device("0 00:1F:32:AA:BB:02 camera1 0306"),
+                                       device("1 00:1f:32:aa:bb:01 camera0 0330"),
+                                       device("2 00:1F:32:AA:BB:03 pad 0306"),
+                                       device("3 00:1F:32:AA:BB:04 left 0306"),
+                                       hid(0, 10),
+                                       hid(1, 20),
+                                       hid(2, 30),
+                                       hid(3, 40),
+                                       hid(1, 21)};
+  const DeviceStreams s = decode_device_streams(events);
+  REQUIRE(s.cameras[0].size() == 2);
+  REQUIRE(s.cameras[1].size() == 1);
+  CHECK(s.cameras[0].blobs[0][0].x() == 20);
+  CHECK(s.cameras[0].blobs[1][0].x() == 21);
+  CHECK(s.cameras[1].blobs[0][0].x() == 10);
+  CHECK(s.camera_address[0] == "00:1f:32:aa:bb:01");
+  CHECK(s.camera_address[1] == "00:1F:32:AA:BB:02");
+  CHECK(s.pad_address == "00:1F:32:AA:BB:03");
+  CHECK(s.counts.pad_reports == 1);
+  CHECK(s.counts.bad_device_records == 1);
+  CHECK(s.counts.unknown_device == 1);
+  CHECK(s.counts.rejected_reports() == 1);
+
+  // A log without device records (the simulator's): devices 0 and 1 are cameras 0 and 1.
+  const DeviceStreams bare = decode_device_streams(std::vector<InputEvent>{hid(0, 10), hid(1, 20), hid(2, 30)});
+  REQUIRE(bare.cameras[0].size() == 1);
+  CHECK(bare.cameras[0].blobs[0][0].x() == 10);
+  CHECK(bare.counts.unknown_device == 1);
+  CHECK(bare.camera_address[0].empty());
+}

@@ -9,6 +9,8 @@
 #include "engine/input_log.hpp"
 #include "platform/files.hpp"
 #include "platform/obj.hpp"
+#include "platform/wiimote/device.hpp"
+#include "platform/wiimote/roles.hpp"
 #include "systems/tracking/calibration.hpp"
 #include "systems/tracking/rig_io.hpp"
 #include "systems/tracking/simulate.hpp"
@@ -40,6 +42,8 @@ ordered_json report_counts_json(const ReportCounts& c, size_t truth_lines_reject
           {"bad_length", c.bad_length},
           {"unknown_id", c.unknown_id},
           {"unknown_device", c.unknown_device},
+          {"pad", c.pad_reports},
+          {"bad_device_records", c.bad_device_records},
           {"out_of_range_blobs", c.out_of_range_slots},
           {"truth_lines_rejected", truth_lines_rejected}};
 }
@@ -123,6 +127,33 @@ int run_simulate_sketch(const SimulateArgs& a) {
 
 // --- calibrate ---
 
+// The rig file's "remotes" member (platform/wiimote/roles.hpp) from the log's device records.
+ordered_json logged_remotes(const DeviceStreams& streams) {
+  ordered_json out = ordered_json::array();
+  for (int c = 0; c < 2; ++c)
+    if (!streams.camera_address[c].empty())
+      out.push_back({{"address", wiimote::normalize_address(streams.camera_address[c])}, {"role", c == 0 ? "camera0" : "camera1"}});
+  if (!streams.pad_address.empty())
+    out.push_back({{"address", wiimote::normalize_address(streams.pad_address)}, {"role", "pad"}});
+  return out;
+}
+
+// An error when the log's cameras are other remotes than the ones the rig was calibrated with.
+std::string other_remotes(const DeviceStreams& streams, const std::vector<wiimote::RemoteAssignment>& rig_remotes,
+                          const std::string& log_path, const std::string& rig_path) {
+  for (int c = 0; c < 2; ++c) {
+    if (streams.camera_address[c].empty()) continue;
+    const wiimote::Role role = c == 0 ? wiimote::Role::Camera0 : wiimote::Role::Camera1;
+    const std::string seen = wiimote::normalize_address(streams.camera_address[c]);
+    for (const wiimote::RemoteAssignment& r : rig_remotes)
+      if (r.role == role && r.address != seen)
+        return log_path + ": camera " + std::to_string(c) + " is the remote " + seen + ", but " + rig_path +
+               " was calibrated with " + r.address + " as camera " + std::to_string(c) +
+               "; track with the rig of these remotes, or calibrate them (fire calibrate)";
+  }
+  return "";
+}
+
 struct CalibrateArgs {
   std::string log_path, out_path;
   std::optional<double> wand_length_m;
@@ -143,9 +174,17 @@ int run_calibrate(const CalibrateArgs& a) {
     return fail(command, "--wand-length must be a positive number of metres");
   DeviceStreams streams = decode_device_streams(log->events);
   const ReportCounts counts = streams.counts;
+  const ordered_json remotes = logged_remotes(streams);
   Result<WandCalibration> cal = calibrate_wand_streams(std::move(streams), options);
   if (!cal) return fail(command, a.log_path + ": " + cal.error());
-  if (Status w = write_file_atomic(a.out_path, rig_to_json(cal->rig)); !w) return fail(command, w.error);
+  std::string rig_text = rig_to_json(cal->rig);
+  if (!remotes.empty()) {
+    // The remotes the wand was seen by, so tracking can refuse a log drawn with other ones.
+    ordered_json rig = ordered_json::parse(rig_text);
+    rig["remotes"] = remotes;
+    rig_text = rig.dump(2) + "\n";
+  }
+  if (Status w = write_file_atomic(a.out_path, rig_text); !w) return fail(command, w.error);
 
   const CalibrationResult& r = cal->rig;
   ordered_json out;
@@ -229,7 +268,12 @@ int run_track(const TrackArgs& a) {
   if (args.truth && !truth.has_cameras)
     return fail(command, args.log_path + ": --truth needs the simulator's truth lines (truth camera 0 and 1), and the log has none");
 
+  const auto rig_remotes = wiimote::remotes_from_rig_json(*rig_text, args.rig_path);
+  if (!rig_remotes) return fail(command, rig_remotes.error());
+
   DeviceStreams streams = decode_device_streams(log->events);
+  if (const std::string why = other_remotes(streams, *rig_remotes, args.log_path, args.rig_path); !why.empty())
+    return fail(command, why);
   for (CameraFrames& f : streams.cameras) fit_frame_clock(f);
   TimeOffsetEstimate offset;
   if (args.time_offset_ms) {
