@@ -39,7 +39,7 @@ class Random {
 // share the rig (drawn from rig_seed) but no noise.
 enum Scenario : uint64_t { kWandScenario = 1, kSketchScenario = 2 };
 enum Stream : uint64_t { kRigStream, kClockStream, kStrayStream, kMotionStream, kNoiseStream0, kNoiseStream1,
-                         kTimingStream0, kTimingStream1, kOcclusionStream0, kOcclusionStream1 };
+                         kTimingStream0, kTimingStream1, kOcclusionStream0, kOcclusionStream1, kBurstStream };
 uint64_t stream_of(Scenario scenario, Stream s) { return 64 * scenario + s; }
 
 constexpr double kMergeDistancePx = 8.0;  // one pixel of the 128 x 96 sensor
@@ -74,7 +74,8 @@ Status check_rig(const RigOptions& o) {
       {"focal error", o.focal_error}, {"k1", o.k1},                   {"k2", o.k2},
       {"noise", o.noise_px},        {"rate", o.rate_hz},              {"drift", o.drift_ppm},
       {"latency", o.latency_ms},    {"clock offset", o.clock_offset_ms}, {"jitter", o.jitter_ms},
-      {"dropout", o.dropout},       {"stray", o.stray},               {"occlusion", o.occlusion_per_s}};
+      {"dropout", o.dropout},       {"stray", o.stray},               {"occlusion", o.occlusion_per_s},
+      {"burst", o.burst}};
   for (const auto& [name, value] : named)
     if (!std::isfinite(value)) return Status::failure(std::string("the ") + name + " must be a finite number");
   if (!(o.baseline_m > 0) || !(o.target_distance_m > 0)) return Status::failure("baseline and distance must be positive");
@@ -85,6 +86,7 @@ Status check_rig(const RigOptions& o) {
   if (!(std::abs(o.drift_ppm) < 10000)) return Status::failure("the drift must be within +-10000 ppm");
   if (o.latency_ms < 0 || o.latency_ms + o.clock_offset_ms < 0) return Status::failure("both cameras' latencies must be non-negative");
   if (!(o.dropout >= 0 && o.dropout < 1)) return Status::failure("dropout must be within [0, 1)");
+  if (!(o.burst >= 0 && o.burst < 1)) return Status::failure("burst must be within [0, 1)");
   if (!(o.stray >= 0 && o.stray <= 1)) return Status::failure("stray must be within [0, 1]");
   return Status::success();
 }
@@ -217,7 +219,8 @@ std::string rig_options_text(const RigOptions& o) {
          " rate_hz=" + format_double(o.rate_hz) + " drift_ppm=" + format_double(o.drift_ppm) +
          " latency_ms=" + format_double(o.latency_ms) + " clock_offset_ms=" + format_double(o.clock_offset_ms) +
          " jitter_ms=" + format_double(o.jitter_ms) + " dropout=" + format_double(o.dropout) +
-         " stray=" + format_double(o.stray) + " occlusion_per_s=" + format_double(o.occlusion_per_s);
+         " stray=" + format_double(o.stray) + " occlusion_per_s=" + format_double(o.occlusion_per_s) +
+         " burst=" + format_double(o.burst);
 }
 
 // Runs both cameras over [0, duration) and writes the session: header facts, then every report
@@ -323,6 +326,17 @@ SimulatedSession run_session(const RigOptions& o, Scenario scenario, const Simul
       reports.push_back({std::llround(arrival * 1e6), d, exposure, encode_ir_report(report), std::move(sample)});
       ++stats.reports[d];
     }
+  }
+  // Bluetooth delivers a remote's reports in order, so a late one holds back those behind it; and now and
+  // then one is held until the next and both arrive at once. Reports are in exposure order per device.
+  Random burst_rng(o.seed, stream_of(scenario, kBurstStream));
+  for (int d = 0; d < 2; ++d) {
+    std::vector<PendingReport*> own;
+    for (PendingReport& r : reports)
+      if (r.device == d) own.push_back(&r);
+    for (size_t k = 1; k < own.size(); ++k) own[k]->t_us = std::max(own[k]->t_us, own[k - 1]->t_us);
+    for (size_t k = own.size(); k-- > 1;)
+      if (burst_rng.uniform() < o.burst) own[k - 1]->t_us = own[k]->t_us;
   }
   std::stable_sort(reports.begin(), reports.end(), [](const PendingReport& a, const PendingReport& b) {
     return a.t_us != b.t_us ? a.t_us < b.t_us : a.device < b.device;

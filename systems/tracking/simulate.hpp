@@ -47,6 +47,7 @@ struct RigOptions {
   double latency_ms = 6;           // camera 0's report latency
   double clock_offset_ms = 2;      // camera 1's extra latency
   double jitter_ms = 0.3;          // standard deviation of the arrival jitter
+  double burst = 0;                // probability that a report is held and arrives with the next one
   double dropout = 0.005;          // probability that a report is lost
   double stray = 0.25;             // fraction of the time camera 1 sees a stray reflection
   double occlusion_per_s = 0;      // rate of brief hand occlusions (50 to 300 ms) per camera

@@ -83,6 +83,8 @@ void add_rig_options(CLI::App* cmd, SimulateArgs& a) {
       ->capture_default_str();
   cmd->add_option("--jitter-ms", r.jitter_ms, "standard deviation of the report arrival jitter, milliseconds")->capture_default_str();
   cmd->add_option("--dropout", r.dropout, "probability that a report is lost")->capture_default_str();
+  cmd->add_option("--burst", r.burst, "probability that a report is held and arrives together with the next one (Bluetooth bursts)")
+      ->capture_default_str();
   cmd->add_option("--stray", r.stray, "fraction of the time camera 1 sees a stray reflection blob")->capture_default_str();
   cmd->add_option("--occlusion", r.occlusion_per_s, "brief hand occlusions (50 to 300 ms) per second per camera")->capture_default_str();
 }
