@@ -309,6 +309,14 @@ void Mesh::begin_frame(Frame f) {
   frame_ = f;
 }
 
+MeshMark Mesh::journal_marks() const {
+  MeshMark m;
+  for_each_column([&](const auto& column) {
+    m.columns.push_back({static_cast<uint32_t>(column.size()), static_cast<uint32_t>(column.journal().size())});
+  });
+  return m;
+}
+
 void Mesh::forget_history() {
   for_each_column([](auto& column) { column.forget_journal(); });
 }

@@ -175,6 +175,8 @@ class Mesh {
   // Restores the pools to `mark` (the most recent transaction not rolled back yet).
   void rollback(const MeshMark& mark);
   void forget_history();
+  // Every column's size and journal length now: what begin_transaction() would return, without opening one.
+  MeshMark journal_marks() const;
 
   // ---- sync point
   // Squeezes out dead slots, keeping each survivor's stamp, and records the map in last_compaction().
