@@ -6,7 +6,7 @@
 //   DIR/settings.json                 the systems' settings, written once when the session is created
 //   DIR/input.log                     the append-only input log (engine/INPUT_LOG.md) with durability records
 //   DIR/rig.json, DIR/marks.json      the rig and the marks it was drawn with, when the session has them
-//   DIR/snapshot-<frame>.fsnap        snapshots: the state before frame <frame> (20 digits) runs, newest kept
+//   DIR/snapshot-<frame>.fsnap        snapshots: the state after frame <frame> (20 digits) ran, newest kept
 #include <array>
 #include <cstdint>
 #include <cstring>

@@ -36,7 +36,7 @@ Result<ReopenedSession> reopen(const std::string& command, const std::string& di
   if (!r) return r;
   for (const std::string& note : r->notes) std::cerr << command << ": " << note << "\n";
   std::cerr << command << ": " << dir << ": "
-            << (r->snapshot ? "snapshot before frame " + std::to_string(*r->snapshot) : std::string("no snapshot"))
+            << (r->snapshot ? "snapshot after frame " + std::to_string(*r->snapshot) : std::string("no snapshot"))
             << ", then " << r->events_replayed << " event(s) of the log replayed\n";
   return r;
 }
@@ -103,7 +103,9 @@ int run_replay(const ReplayOptions& o) {
         std::cerr << "fire replay: " << writer.error() << "\n";
         return 1;
       }
-      if (Status s = replay_into_session(*world, *scheduler_owner, *writer, {o.snapshot_every, {}}); !s) {
+      SessionWriteOptions options;
+      options.snapshot_every = o.snapshot_every;
+      if (Status s = replay_into_session(*world, *scheduler_owner, *writer, options); !s) {
         std::cerr << "fire replay: " << s.error << "\n";
         return 1;
       }

@@ -63,8 +63,8 @@ void continue_replay(World& w, Scheduler& scheduler, const ReplayHooks& hooks) {
     }
     if (hooks.before_frame) hooks.before_frame(w);
     scheduler.run_frame();
-    begin_frame(w, w.frame.index + 1, w.frame.end_us);
     if (hooks.after_frame) hooks.after_frame(w);
+    begin_frame(w, w.frame.index + 1, w.frame.end_us);
   }
 }
 

@@ -160,7 +160,9 @@ Status load_world_snapshot(SnapshotReader& in, const SessionContents& session, W
       std::partition_point(w.log.events.begin(), w.log.events.end(),
                            [&](const InputEvent& e) { return e.line <= prefix_lines; }) -
       w.log.events.begin());
+  // The index as the frame's last system left it, then the next frame begun, as replay_headless does.
   w.snap.sync(w.mesh);
+  begin_frame(w, w.frame.index + 1, w.frame.end_us);
   return Status::success();
 }
 
@@ -179,6 +181,7 @@ Status replay_into_session(World& w, Scheduler& scheduler, SessionWriter& out, c
   auto snapshot = [&](const World& world) {
     commit();
     if (status) status = out.write_snapshot(world.frame.index, snapshot_world(world, out.log_bytes(), out.log_hash()));
+    if (status && options.on_snapshot) options.on_snapshot(world.frame.index);
     last_snapshot = world.frame.index;
   };
   ReplayHooks hooks;
@@ -198,11 +201,12 @@ Status replay_into_session(World& w, Scheduler& scheduler, SessionWriter& out, c
     if (commit_point) commit();
   };
   hooks.after_frame = [&](const World& world) {
-    if (options.snapshot_every > 0 && world.frame.index >= last_snapshot + options.snapshot_every) snapshot(world);
+    const bool last = world.cursor.next >= world.log.events.size() && world.sketch.pending.empty();
+    if (options.snapshot_every > 0 && (last || world.frame.index >= last_snapshot + options.snapshot_every))
+      snapshot(world);
   };
   replay_headless(w, scheduler, hooks);
   commit();
-  if (options.snapshot_every > 0 && last_snapshot != w.frame.index) snapshot(w);
   return status;
 }
 

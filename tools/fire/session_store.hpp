@@ -19,23 +19,26 @@ namespace fire {
 std::string settings_json(const World& w);
 Status apply_settings_json(std::string_view json, const std::string& source, World& w);
 
-// The snapshot file of `w` between frames (after a frame, the next one begun), continuing from the
-// session log's first `log_bytes` bytes, whose FNV-1a 64 is `log_hash`.
+// The snapshot file of `w` after a frame ran (before the next one begins), continuing from the session
+// log's first `log_bytes` bytes, whose FNV-1a 64 is `log_hash`.
 std::string snapshot_world(const World& w, uint64_t log_bytes, uint64_t log_hash);
 // Loads a snapshot into `w` (settings applied, no frame run yet) whose log is the recovered `session`
-// log: the state, the snapping index rebuilt, and the cursor on the first event after the snapshot's
-// prefix. Fails, naming the problem, on a prefix the log does not have or content that does not load.
+// log: the state, the snapping index rebuilt, the cursor on the first event after the snapshot's prefix
+// and the next frame begun, ready for continue_replay. Fails, naming the problem, on a prefix the log does not have or content that does not load.
 Status load_world_snapshot(SnapshotReader& in, const SessionContents& session, World& w);
 
 struct SessionWriteOptions {
-  uint64_t snapshot_every = 0;  // frames between snapshots (0: none); a last one when the replay ends
   // After each commit: the pen-ups and commands now known to be on disk.
-  std::function<void(uint64_t committed_ups, uint64_t committed_commands)> on_commit;
+  using Commit = std::function<void(uint64_t committed_ups, uint64_t committed_commands)>;
+  uint64_t snapshot_every = 0;  // frames between snapshots (0: none); a last one when the replay ends
+  Commit on_commit;
+  // After each snapshot is on disk, with the frame it was taken after.
+  std::function<void(uint64_t frame)> on_snapshot;
 };
 
 // replay_headless, writing a session: each event is appended to the log before the frame that delivers
 // it, the log is committed (durability record, fsync) whenever those events hold a pen-up or a command,
-// and a snapshot follows every `snapshot_every` frames. Each event's `line` becomes its line in the
+// and a snapshot follows every `snapshot_every` frames and the last frame. Each event's `line` becomes its line in the
 // session log. Stops writing at the first failed write and
 // returns it (the replay itself runs on).
 Status replay_into_session(World& w, Scheduler& scheduler, SessionWriter& out, const SessionWriteOptions& options);
