@@ -172,7 +172,8 @@ void add_network_commands(CLI::App& app, Registry& registry) {
       "replay", "Replay an input log headless through the frame systems (input, sketch, split, refine, subdivide, snap)");
   replay->add_option("LOG", o->log_path,
                      "input log (format: engine/INPUT_LOG.md), or a session folder (engine/SESSION.md) to reopen: its "
-                     "last good snapshot, then its log's tail, a torn last record dropped")
+                     "last good snapshot, then its log's tail, a torn last record dropped; a folder's settings.json "
+                     "fixes --snap, --levels, --fairness and --no-surface")
       ->required();
   replay->add_option("--session", o->session_dir,
                      "write a session folder while replaying LOG: the input log, fsynced with a durability record at "
@@ -207,8 +208,8 @@ void add_network_commands(CLI::App& app, Registry& registry) {
   open->add_option("DIR", *dir, "session folder, as `fire replay LOG --session DIR` writes it")->required();
   open->footer(
       "Loads the newest snapshot that is whole (a damaged one is named and the one before used), replays the log's "
-      "tail, drops a torn last record (saying how many bytes) and prints the hash of the pools and surface, the same "
-      "as `fire replay DIR/input.log --hash`. Exit 1 when nothing can be recovered (no folder, no log, a log corrupt "
+      "tail, drops a torn last record (saying how many bytes) and prints the hash of the pools and surface: that of a "
+      "clean replay of the log that survived (`fire replay DIR/input.log --hash` when no record was torn). Exit 1 when nothing can be recovered (no folder, no log, a log corrupt "
       "before its last line, bad settings.json).");
   open->callback([dir, &registry] {
     auto r = reopen("fire open", *dir);
