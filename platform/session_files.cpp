@@ -25,9 +25,33 @@ Result<SessionWriter> SessionWriter::create(const std::string& dir, std::string_
   return w;
 }
 
+Result<SessionWriter> SessionWriter::resume(const SessionContents& session) {
+  using R = Result<SessionWriter>;
+  auto names = list_directory(session.paths.dir);
+  if (!names) return R::failure(names.error());
+  for (const std::string& name : *names)
+    if (name.find(".fsnap.tmp.") != std::string::npos)
+      if (Status s = remove_file(session.paths.file(name)); !s) return R::failure(s.error);
+  auto log = AppendFile::open(session.paths.log(), session.log.kept_bytes);
+  if (!log) return R::failure(log.error());
+  if (log->size() != session.log.kept_bytes)
+    return R::failure(session.paths.log() + ": changed since it was read (" + std::to_string(log->size()) + " bytes, " +
+                      std::to_string(session.log.kept_bytes) + " expected)");
+  SessionWriter w(session.paths, std::move(*log));
+  const std::string_view kept = std::string_view(session.log_bytes).substr(0, session.log.kept_bytes);
+  w.log_hash_.mix(kept.data(), kept.size());
+  w.lines_ = static_cast<uint32_t>(std::count(kept.begin(), kept.end(), '\n'));
+  if (!session.log.log.events.empty()) w.last_t_us_ = session.log.log.events.back().t_us;
+  w.dirty_ = session.log.kept_bytes > session.log.durable_bytes;
+  w.snapshots_.assign(session.snapshot_frames.rbegin(), session.snapshot_frames.rend());
+  if (Status s = sync_directory(session.paths.dir); !s) return R::failure(s.error);
+  return w;
+}
+
 Status SessionWriter::write(std::string_view bytes) {
   if (Status s = log_.append(bytes); !s) return s;
   log_hash_.mix(bytes.data(), bytes.size());
+  lines_ += static_cast<uint32_t>(std::count(bytes.begin(), bytes.end(), '\n'));
   return Status::success();
 }
 

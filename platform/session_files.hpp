@@ -1,7 +1,7 @@
 #pragma once
 // The session folder of engine/SESSION.md on disk: a writer that appends the input log and makes it
-// durable at commit points, writes snapshots atomically and keeps the newest few; and a reader that
-// recovers the log a crash left and lists the snapshots, newest first. What a snapshot holds is its
+// durable at commit points, writes snapshots atomically and keeps the newest few (and resumes a session
+// after a crash); and a reader that recovers the log a crash left and lists the snapshots, newest first. What a snapshot holds is its
 // writer's business (tools/fire/session_store.hpp for a World).
 #include <cstdint>
 #include <functional>
@@ -16,10 +16,22 @@
 
 namespace fire {
 
+struct SessionContents {
+  SessionPaths paths;
+  std::string settings;   // settings.json as written
+  std::string log_bytes;  // the log as found, torn tail included
+  RecoveredLog log;
+  std::vector<uint64_t> snapshot_frames;  // newest first
+};
+
 class SessionWriter {
  public:
   // Makes `dir` (missing or empty) and writes the settings and the log's header, durably.
   static Result<SessionWriter> create(const std::string& dir, std::string_view settings_json);
+  // Opens a session that read_session recovered for appending after a crash: cuts its torn last record
+  // off the log (durably), so the next record starts a line of its own, and removes the temporary files a
+  // killed writer left. The records kept count as not yet on disk until the next commit.
+  static Result<SessionWriter> resume(const SessionContents& session);
 
   // Appends one record (format_event); in the kernel when this returns, on disk after the next commit().
   Status append(const InputEvent& event);
@@ -36,6 +48,7 @@ class SessionWriter {
   // FNV-1a 64 of the whole log so far (log_prefix_hash of its bytes), kept as it grows.
   uint64_t log_hash() const { return log_hash_.value; }
   uint64_t commits() const { return commits_; }
+  uint32_t lines() const { return lines_; }  // lines in the log so far, header included
 
  private:
   SessionWriter(SessionPaths paths, AppendFile log) : paths_(std::move(paths)), log_(std::move(log)) {}
@@ -46,16 +59,10 @@ class SessionWriter {
   int64_t last_t_us_ = 0;
   bool dirty_ = false;
   uint64_t commits_ = 0;
+  uint32_t lines_ = 0;
   std::vector<uint64_t> snapshots_;  // frames of the snapshots on disk, oldest first
 };
 
-struct SessionContents {
-  SessionPaths paths;
-  std::string settings;   // settings.json as written
-  std::string log_bytes;  // the log as found, torn tail included
-  RecoveredLog log;
-  std::vector<uint64_t> snapshot_frames;  // newest first
-};
 
 // Reads a session folder: errors name the folder or the file and the problem (no folder, no log, a log
 // corrupt before its last line). A torn last record is not an error: RecoveredLog says what was dropped.

@@ -168,14 +168,11 @@ Status load_world_snapshot(SnapshotReader& in, const SessionContents& session, W
 
 Status replay_into_session(World& w, Scheduler& scheduler, SessionWriter& out, const SessionWriteOptions& options) {
   Status status;
-  size_t appended = 0;
+  size_t appended = w.cursor.next;  // a reopened world's events are in the log already
   uint64_t ups = 0, commands = 0, last_snapshot = w.frame.index;
-  uint32_t line = 2;  // the session log's line the next record goes to (line 1 is the header)
   auto commit = [&] {
     if (!status) return;
-    const uint64_t before = out.commits();
     status = out.commit();
-    line += static_cast<uint32_t>(out.commits() - before);
     if (status && options.on_commit) options.on_commit(ups, commands);
   };
   auto snapshot = [&](const World& world) {
@@ -192,7 +189,7 @@ Status replay_into_session(World& w, Scheduler& scheduler, SessionWriter& out, c
     for (; appended < w.log.events.size() && w.log.events[appended].t_us < w.frame.end_us; ++appended) {
       InputEvent& e = w.log.events[appended];
       if (is_durable_record(e)) continue;  // a replayed session's own records name offsets in its log, not this one
-      e.line = line++;
+      e.line = out.lines() + 1;
       if (status) status = out.append(e);
       ups += e.kind == EventKind::Up;
       commands += e.kind == EventKind::Command;
@@ -205,7 +202,8 @@ Status replay_into_session(World& w, Scheduler& scheduler, SessionWriter& out, c
     if (options.snapshot_every > 0 && (last || world.frame.index >= last_snapshot + options.snapshot_every))
       snapshot(world);
   };
-  replay_headless(w, scheduler, hooks);
+  if (w.cursor.next == 0) replay_headless(w, scheduler, hooks);
+  else continue_replay(w, scheduler, hooks);
   commit();
   return status;
 }

@@ -38,8 +38,9 @@ struct SessionWriteOptions {
 
 // replay_headless, writing a session: each event is appended to the log before the frame that delivers
 // it, the log is committed (durability record, fsync) whenever those events hold a pen-up or a command,
-// and a snapshot follows every `snapshot_every` frames and the last frame. Each event's `line` becomes its line in the
-// session log. Stops writing at the first failed write and
+// and a snapshot follows every `snapshot_every` frames and the last frame. Each event's `line` becomes its
+// line in the session log. A world reopened from `out`'s session (reopen_session, SessionWriter::resume)
+// continues where it stands instead: events added to its log after the recovered ones are written and run. Stops writing at the first failed write and
 // returns it (the replay itself runs on).
 Status replay_into_session(World& w, Scheduler& scheduler, SessionWriter& out, const SessionWriteOptions& options);
 
