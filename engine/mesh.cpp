@@ -474,6 +474,8 @@ bool Mesh::load(SnapshotReader& in) {
       edges.point_count.size() != e || edges.generation.size() != e || faces.edge_offset.size() != f ||
       faces.edge_count.size() != f || faces.generation.size() != f)
     in.fail();
+  // Every slot has a stamp (rollback truncates slots, never stamps).
+  if (vertices.changes.stamp.size() < v || edges.changes.stamp.size() < e || faces.changes.stamp.size() < f) in.fail();
   return in.ok();
 }
 
