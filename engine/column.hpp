@@ -27,6 +27,8 @@ class Column {
   std::span<const T> span() const { return data_; }
   std::span<const T> span(size_t offset, size_t count) const { return std::span<const T>(data_).subspan(offset, count); }
   const std::vector<T>& values() const { return data_; }
+  // What undo can still restore: (slot, old value) pairs in the order they were recorded.
+  const std::vector<std::pair<uint32_t, T>>& journal() const { return journal_; }
 
   void set(size_t i, const T& v) {
     if (recording_ && i < base_size_) journal_.emplace_back(static_cast<uint32_t>(i), data_[i]);
@@ -40,6 +42,12 @@ class Column {
   void assign(std::vector<T> v) {
     FIRE_ASSERT(!recording_, "assign replaces the whole column, which a transaction cannot undo");
     data_ = std::move(v);
+  }
+  // Replaces values and journal with those a snapshot recorded (outside a transaction).
+  void restore(std::vector<T> data, std::vector<std::pair<uint32_t, T>> journal) {
+    FIRE_ASSERT(!recording_, "a snapshot is loaded between frames, never inside a transaction");
+    data_ = std::move(data);
+    journal_ = std::move(journal);
   }
   void reserve(size_t n) { data_.reserve(n); }
   void clear() { data_.clear(); journal_.clear(); }

@@ -1,9 +1,11 @@
 #include "engine/mesh.hpp"
 
 #include "engine/hash.hpp"
+#include "engine/session_dir.hpp"
 
 #include <algorithm>
 #include <cstring>
+#include <type_traits>
 
 namespace fire {
 
@@ -307,6 +309,14 @@ void Mesh::begin_frame(Frame f) {
   frame_ = f;
 }
 
+MeshMark Mesh::journal_marks() const {
+  MeshMark m;
+  for_each_column([&](const auto& column) {
+    m.columns.push_back({static_cast<uint32_t>(column.size()), static_cast<uint32_t>(column.journal().size())});
+  });
+  return m;
+}
+
 void Mesh::forget_history() {
   for_each_column([](auto& column) { column.forget_journal(); });
 }
@@ -407,6 +417,66 @@ uint64_t Mesh::hash() const {
   Fnv1a h;
   for_each_column([&](const auto& column) { h.mix_array(column.values()); });
   return h.value;
+}
+
+namespace {
+
+void save_stamps(SnapshotWriter& out, const ChangeStamps& c) {
+  out.put(c.stamp);
+  out.put(c.frame);
+  out.put(c.range.begin);
+  out.put(c.range.end);
+}
+
+bool load_stamps(SnapshotReader& in, ChangeStamps& c) {
+  return in.get(c.stamp) && in.get(c.frame) && in.get(c.range.begin) && in.get(c.range.end);
+}
+
+}  // namespace
+
+void Mesh::save(SnapshotWriter& out) const {
+  for_each_column([&](const auto& column) {
+    out.put(column.values());
+    out.put(column.journal());
+  });
+  for (const ChangeStamps* c : {&vertices.changes, &edges.changes, &faces.changes, &point_changes, &face_edge_changes})
+    save_stamps(out, *c);
+  out.put(frame_);
+  out.put(last_compaction_.count);
+  out.put(last_compaction_.frame);
+  out.put(last_compaction_.map.vertex);
+  out.put(last_compaction_.map.edge);
+  out.put(last_compaction_.map.face);
+}
+
+bool Mesh::load(SnapshotReader& in) {
+  for_each_column([&](auto& column) {
+    using Values = std::remove_cvref_t<decltype(column.values())>;
+    using Journal = std::remove_cvref_t<decltype(column.journal())>;
+    Values values;
+    Journal journal;
+    in.get(values);
+    in.get(journal);
+    column.restore(std::move(values), std::move(journal));
+  });
+  for (ChangeStamps* c : {&vertices.changes, &edges.changes, &faces.changes, &point_changes, &face_edge_changes})
+    load_stamps(in, *c);
+  in.get(frame_);
+  in.get(last_compaction_.count);
+  in.get(last_compaction_.frame);
+  in.get(last_compaction_.map.vertex);
+  in.get(last_compaction_.map.edge);
+  in.get(last_compaction_.map.face);
+  // The pools' columns grow together; validate() checks the rest once the caller has everything.
+  const size_t v = vertex_slots(), e = edge_slots(), f = face_slots();
+  if (vertices.position.size() != v || vertices.first_edge.size() != v || vertices.generation.size() != v ||
+      edges.vertex.size() != e || edges.face.size() != e || edges.next.size() != e || edges.point_offset.size() != e ||
+      edges.point_count.size() != e || edges.generation.size() != e || faces.edge_offset.size() != f ||
+      faces.edge_count.size() != f || faces.generation.size() != f)
+    in.fail();
+  // Every slot has a stamp (rollback truncates slots, never stamps).
+  if (vertices.changes.stamp.size() < v || edges.changes.stamp.size() < e || faces.changes.stamp.size() < f) in.fail();
+  return in.ok();
 }
 
 bool Mesh::same_pools(const Mesh& other) const {

@@ -78,6 +78,8 @@ struct FacePool {
 };
 
 struct MeshMark;
+class SnapshotWriter;
+class SnapshotReader;
 
 // Old-to-new slot maps produced by compaction (kNone for removed slots).
 struct CompactionMap {
@@ -173,6 +175,8 @@ class Mesh {
   // Restores the pools to `mark` (the most recent transaction not rolled back yet).
   void rollback(const MeshMark& mark);
   void forget_history();
+  // Every column's size and journal length now: what begin_transaction() would return, without opening one.
+  MeshMark journal_marks() const;
 
   // ---- sync point
   // Squeezes out dead slots, keeping each survivor's stamp, and records the map in last_compaction().
@@ -185,6 +189,12 @@ class Mesh {
   bool same_pools(const Mesh& other) const;
   size_t pool_bytes() const;     // bytes held by the pools' arrays
   size_t journal_bytes() const;  // bytes held by the undo journals
+
+  // ---- snapshots (engine/SESSION.md): every column with its undo journal, the change stamps, the frame
+  // and the last compaction, so that a loaded mesh continues (undo included) bit for bit. Call between
+  // frames, outside a transaction. load() fails on impossible sizes and leaves validate() to the caller.
+  void save(SnapshotWriter& out) const;
+  bool load(SnapshotReader& in);
 
   // ---- invariants (thesis 5.1 plus pool consistency); empty string when valid
   std::string validate() const;

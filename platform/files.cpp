@@ -1,11 +1,16 @@
 #include "platform/files.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace fire {
@@ -36,6 +41,97 @@ Status write_file_atomic(const std::string& path, std::string_view data) {
     std::remove(tmp.c_str());
     return Status::failure(path + ": cannot replace (" + std::strerror(err) + ")");
   }
+  return Status::success();
+}
+
+Status write_file_durable(const std::string& path, std::string_view data) {
+  if (Status s = write_file_atomic(path, data); !s) return s;
+  const std::string folder = std::filesystem::path(path).parent_path().string();
+  return sync_directory(folder.empty() ? "." : folder);
+}
+
+Status make_directory(const std::string& path) {
+  if (::mkdir(path.c_str(), 0777) == 0 || (errno == EEXIST && is_directory(path))) return Status::success();
+  return Status::failure(path + ": cannot make the folder (" + std::strerror(errno) + ")");
+}
+
+bool is_directory(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+Result<std::vector<std::string>> list_directory(const std::string& path) {
+  std::error_code ec;
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(path, ec)) names.push_back(entry.path().filename().string());
+  if (ec) return Result<std::vector<std::string>>::failure(path + ": cannot list the folder (" + ec.message() + ")");
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+Status sync_directory(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return Status::failure(path + ": cannot open the folder to sync it (" + std::strerror(errno) + ")");
+  const bool ok = ::fsync(fd) == 0;
+  const int err = errno;
+  ::close(fd);
+  if (!ok) return Status::failure(path + ": fsync of the folder failed (" + std::strerror(err) + ")");
+  return Status::success();
+}
+
+Status remove_file(const std::string& path) {
+  if (::unlink(path.c_str()) == 0) return Status::success();
+  return Status::failure(path + ": cannot remove (" + std::strerror(errno) + ")");
+}
+
+Result<AppendFile> AppendFile::open(const std::string& path, uint64_t truncate_to) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0666);
+  auto fail = [&](const char* what) {
+    const int err = errno;
+    if (fd >= 0) ::close(fd);
+    return Result<AppendFile>::failure(path + ": " + what + " (" + std::strerror(err) + ")");
+  };
+  if (fd < 0) return fail("cannot open for appending");
+  struct stat st;
+  if (::fstat(fd, &st) != 0) return fail("cannot read its size");
+  uint64_t size = static_cast<uint64_t>(st.st_size);
+  if (truncate_to < size) {
+    if (::ftruncate(fd, static_cast<off_t>(truncate_to)) != 0 || ::fsync(fd) != 0) return fail("cannot cut off the torn tail");
+    size = truncate_to;
+  }
+  return AppendFile(fd, path, size);
+}
+
+AppendFile::AppendFile(AppendFile&& other) noexcept
+    : fd_(std::exchange(other.fd_, -1)), path_(std::move(other.path_)), size_(other.size_) {}
+
+AppendFile& AppendFile::operator=(AppendFile&& other) noexcept {
+  if (this != &other) {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = std::exchange(other.fd_, -1);
+    path_ = std::move(other.path_);
+    size_ = other.size_;
+  }
+  return *this;
+}
+
+AppendFile::~AppendFile() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+Status AppendFile::append(std::string_view data) {
+  while (!data.empty()) {
+    const ssize_t n = ::write(fd_, data.data(), data.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return Status::failure(path_ + ": write failed (" + std::strerror(errno) + ")");
+    data.remove_prefix(static_cast<size_t>(n));
+    size_ += static_cast<uint64_t>(n);
+  }
+  return Status::success();
+}
+
+Status AppendFile::sync() {
+  if (::fdatasync(fd_) != 0) return Status::failure(path_ + ": fsync failed (" + std::strerror(errno) + ")");
   return Status::success();
 }
 

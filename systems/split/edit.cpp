@@ -1,5 +1,7 @@
 #include "systems/split/edit.hpp"
 
+#include "engine/session_dir.hpp"
+
 #include <algorithm>
 
 namespace fire {
@@ -286,6 +288,87 @@ EditOutcome EditHistory::redo(Mesh& mesh) {
   EditOutcome outcome = run(mesh, command);
   if (!outcome.ok) redo_.push_back(std::move(command));
   return outcome;
+}
+
+namespace {
+
+void save_command(SnapshotWriter& out, const EditCommand& c) {
+  out.put(uint8_t(c.kind));
+  out.put(c.points);
+  out.put(c.face);
+  out.put(c.start.edge);
+  out.put(c.start.point);
+  out.put(c.end.edge);
+  out.put(c.end.point);
+  out.put(c.edge);
+  out.put(c.snap_distance);
+}
+
+bool load_command(SnapshotReader& in, EditCommand& c) {
+  uint8_t kind = 0;
+  in.get(kind);
+  in.get(c.points);
+  in.get(c.face);
+  in.get(c.start.edge);
+  in.get(c.start.point);
+  in.get(c.end.edge);
+  in.get(c.end.point);
+  in.get(c.edge);
+  in.get(c.snap_distance);
+  if (kind > uint8_t(EditKind::DeleteCurve)) in.fail();
+  c.kind = EditKind(kind);
+  return in.ok();
+}
+
+}  // namespace
+
+void EditHistory::save(SnapshotWriter& out) const {
+  out.put(uint64_t(undo_.size()));
+  for (const Entry& e : undo_) {
+    save_command(out, e.command);
+    out.put(uint64_t(e.mark.columns.size()));
+    for (const ColumnMark& m : e.mark.columns) {
+      out.put(m.size);
+      out.put(m.journal);
+    }
+  }
+  out.put(uint64_t(redo_.size()));
+  for (const EditCommand& c : redo_) save_command(out, c);
+}
+
+bool EditHistory::load(SnapshotReader& in, const Mesh& mesh) {
+  // A mark must name journal entries the mesh has, in the order transactions made them, and a size the
+  // column had (it shrinks only by journaled pops).
+  const MeshMark now = mesh.journal_marks();
+  undo_.clear();
+  redo_.clear();
+  uint64_t n = 0;
+  if (!in.get(n)) return false;
+  for (uint64_t k = 0; k < n && in.ok(); ++k) {
+    Entry e;
+    uint64_t columns = 0;
+    load_command(in, e.command);
+    in.get(columns);
+    if (columns != now.columns.size()) in.fail();
+    for (uint64_t c = 0; c < columns && in.ok(); ++c) {
+      ColumnMark m;
+      in.get(m.size);
+      in.get(m.journal);
+      const uint32_t floor = undo_.empty() ? 0 : undo_.back().mark.columns[c].journal;
+      if (m.journal > now.columns[c].journal || m.journal < floor ||
+          uint64_t(m.size) > uint64_t(now.columns[c].size) + now.columns[c].journal)
+        in.fail();
+      e.mark.columns.push_back(m);
+    }
+    undo_.push_back(std::move(e));
+  }
+  if (!in.get(n)) return false;
+  for (uint64_t k = 0; k < n && in.ok(); ++k) {
+    EditCommand c;
+    load_command(in, c);
+    redo_.push_back(std::move(c));
+  }
+  return in.ok();
 }
 
 void EditHistory::clear(Mesh& mesh) {

@@ -33,6 +33,11 @@ class EditHistory {
   size_t redo_depth() const { return redo_.size(); }
   // Forgets everything (needed after Mesh::compact, which cannot be undone).
   void clear(Mesh& mesh);
+  // A snapshot of the history (engine/SESSION.md): each undoable command with its marks into the
+  // mesh's journals, and the redo commands. load() needs the mesh loaded from the same snapshot and
+  // fails on marks its journals cannot hold.
+  void save(SnapshotWriter& out) const;
+  bool load(SnapshotReader& in, const Mesh& mesh);
 
  private:
   EditOutcome run(Mesh& mesh, const EditCommand& command);

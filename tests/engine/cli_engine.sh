@@ -45,5 +45,27 @@ expect_error "network version" "unsupported network version 3" "$fire" export-ne
 expect_error "empty network" "empty file" "$fire" export-network "$tmp/empty.fnet" -o "$tmp/x.obj"
 check "no partial output after errors" "[ ! -e '$tmp/x.obj' ]"
 expect_error "unwritable output" "cannot write" "$fire" export-network "$tmp/demo.fnet" -o "$tmp/no/such/dir/x.obj"
+# Session folders (engine/SESSION.md): written while replaying, reopened to the same hash, damage named.
+check "replay --help tells of --session" "'$fire' replay --help | grep -q -- '--snapshot-every'"
+check "open --help" "'$fire' open --help | grep -q 'torn last record'"
+check "replay --session writes a log and snapshots" "'$fire' replay '$src/tools/demo/sketch.log' --session '$tmp/s' --snapshot-every 300 >/dev/null 2>&1 && [ -s '$tmp/s/input.log' ] && ls '$tmp/s' | grep -q 'snapshot-.*fsnap'"
+check "fire open prints the demo's hash" "[ \"\$('$fire' open '$tmp/s' 2>/dev/null)\" = '$golden' ]"
+check "fire replay DIR reopens it" "[ \"\$('$fire' replay '$tmp/s' --hash 2>/dev/null)\" = '$golden' ]"
+check "the session's log replays alone to the same hash" "[ \"\$('$fire' replay '$tmp/s/input.log' --hash 2>/dev/null)\" = '$golden' ]"
+expect_error "a session is written into a new folder" "not empty" "$fire" replay "$src/tools/demo/sketch.log" --session "$tmp/s"
+expect_error "--snapshot-every needs --session" "needs --session" "$fire" replay "$src/tools/demo/sketch.log" --snapshot-every 5
+expect_error "session settings are not overridden" "settings.json" "$fire" replay "$tmp/s" --levels 2
+expect_error "missing session folder" "nope: no such session folder" "$fire" open "$tmp/nope"
+cp -r "$tmp/s" "$tmp/bad"; newest=$(ls "$tmp/bad"/snapshot-* | tail -1)
+printf 'XXXX' | dd of="$newest" bs=1 seek=200 conv=notrunc 2>/dev/null
+"$fire" open "$tmp/bad" >"$tmp/out" 2>"$tmp/err"
+check "a damaged snapshot is named and the one before used" "grep -q \"$(basename "$newest"): checksum mismatch\" '$tmp/err' && [ \"\$(cat '$tmp/out')\" = '$golden' ]"
+cp -r "$tmp/s" "$tmp/torn"; rm "$tmp/torn"/snapshot-*; printf '16900000 pen 0.1 0.1' >>"$tmp/torn/input.log"
+"$fire" open "$tmp/torn" >"$tmp/out" 2>"$tmp/err"
+check "a torn last record is dropped with its size" "grep -q 'torn last record dropped (20 bytes' '$tmp/err' && [ \"\$(cat '$tmp/out')\" = '$golden' ]"
+sed -i '5s/pen/pne/' "$tmp/torn/input.log"
+expect_error "corruption before the last line is refused" "input.log:5: unknown event kind 'pne'" "$fire" open "$tmp/torn"
+rm "$tmp/torn/settings.json"
+expect_error "a session without settings" "settings.json: cannot open" "$fire" open "$tmp/torn"
 expect_error "unknown subcommand" "" "$fire" frobnicate
 exit $fail

@@ -1,22 +1,26 @@
-// fire replay, fire export-network: the engine foundation's commands.
+// fire replay, fire open, fire export-network: the engine foundation's commands.
 #include <cinttypes>
 #include <cstdio>
 #include <iostream>
 #include <memory>
 
 #include "platform/clock.hpp"
+#include "platform/files.hpp"
 #include "platform/network_file.hpp"
 #include "platform/surface_io.hpp"
 #include "tools/fire/commands.hpp"
 #include "tools/fire/session.hpp"
+#include "tools/fire/session_store.hpp"
 
 namespace fire::cli {
 
 namespace {
 
 struct ReplayOptions {
-  std::string log_path, out_path, obj_path, surface_path;
+  std::string log_path, out_path, obj_path, surface_path, session_dir;
+  uint64_t snapshot_every = 0;
   bool hash = false, timings = false, no_surface = false;
+  bool settings_given = false;  // --snap, --levels, --fairness or --no-surface on the command line
   double snap = SketchSettings{}.snap_distance;
   reconstruct::Options surface;
 };
@@ -26,10 +30,30 @@ void print_timing(const SystemTiming& t) {
               t.mean_ns() / 1e3, double(t.percentile_ns(99)) / 1e3, double(t.max_ns) / 1e3, double(t.total_ns) / 1e6);
 }
 
+// Reopens a session folder (engine/SESSION.md), saying on stderr what recovery dropped and passed over.
+Result<ReopenedSession> reopen(const std::string& command, const std::string& dir) {
+  auto r = reopen_session(dir, monotonic_ns);
+  if (!r) return r;
+  for (const std::string& note : r->notes) std::cerr << command << ": " << note << "\n";
+  std::cerr << command << ": " << dir << ": "
+            << (r->snapshot ? "snapshot after frame " + std::to_string(*r->snapshot) : std::string("no snapshot"))
+            << ", then " << r->events_replayed << " event(s) of the log replayed\n";
+  return r;
+}
+
 int run_replay(const ReplayOptions& o) {
-  auto log = read_input_log(o.log_path);
-  if (!log) {
-    std::cerr << "fire replay: " << log.error() << "\n";
+  const bool session_in = is_directory(o.log_path);
+  if (session_in && o.settings_given) {
+    std::cerr << "fire replay: " << o.log_path << " is a session folder: its settings.json sets --snap, --levels, "
+              << "--fairness and --no-surface\n";
+    return 1;
+  }
+  if (session_in && !o.session_dir.empty()) {
+    std::cerr << "fire replay: --session writes a new session from a log; " << o.log_path << " is a session already\n";
+    return 1;
+  }
+  if (o.snapshot_every > 0 && o.session_dir.empty()) {
+    std::cerr << "fire replay: --snapshot-every needs --session DIR to write the snapshots to\n";
     return 1;
   }
   if (!(o.snap > 0)) {
@@ -46,18 +70,54 @@ int run_replay(const ReplayOptions& o) {
       return 1;
     }
   }
-  auto world = std::make_unique<World>();
-  world->log = std::move(*log);
-  world->sketch_settings.snap_distance = o.snap;
-  world->build_surface = !o.no_surface;
-  world->surface_options = o.surface;
-  Scheduler scheduler = make_scheduler(*world, monotonic_ns);
-  replay_headless(*world, scheduler);
+  std::unique_ptr<World> world;
+  std::unique_ptr<Scheduler> scheduler_owner;
+  // Where rejections' lines are: the log read, or the log of the session written or reopened.
+  std::string lines_of = o.log_path;
+  if (session_in) {
+    auto r = reopen("fire replay", o.log_path);
+    if (!r) {
+      std::cerr << "fire replay: " << r.error() << "\n";
+      return 1;
+    }
+    world = std::move(r->world);
+    scheduler_owner = std::move(r->scheduler);
+    lines_of = SessionPaths{o.log_path}.log();
+  } else {
+    auto log = read_input_log(o.log_path);
+    if (!log) {
+      std::cerr << "fire replay: " << log.error() << "\n";
+      return 1;
+    }
+    world = std::make_unique<World>();
+    world->log = std::move(*log);
+    world->sketch_settings.snap_distance = o.snap;
+    world->build_surface = !o.no_surface;
+    world->surface_options = o.surface;
+    scheduler_owner = std::make_unique<Scheduler>(make_scheduler(*world, monotonic_ns));
+    if (o.session_dir.empty()) {
+      replay_headless(*world, *scheduler_owner);
+    } else {
+      auto writer = SessionWriter::create(o.session_dir, settings_json(*world));
+      if (!writer) {
+        std::cerr << "fire replay: " << writer.error() << "\n";
+        return 1;
+      }
+      SessionWriteOptions options;
+      options.snapshot_every = o.snapshot_every;
+      if (Status s = replay_into_session(*world, *scheduler_owner, *writer, options); !s) {
+        std::cerr << "fire replay: " << s.error << "\n";
+        return 1;
+      }
+      lines_of = writer->paths().log();
+    }
+  }
+  Scheduler& scheduler = *scheduler_owner;
 
   for (const Rejection& r : world->rejections)
-    std::cerr << o.log_path << ":" << r.line << ": rejected: " << r.reason << "\n";
+    std::cerr << lines_of << ":" << r.line << ": rejected: " << r.reason << "\n";
   if (world->log.rejected_hid_lines)
-    std::cerr << o.log_path << ": " << world->log.rejected_hid_lines << " garbled device report line(s) skipped\n";
+    std::cerr << lines_of << ": " << world->log.rejected_hid_lines << " garbled device report line(s) skipped\n";
   std::string problem = world->mesh.validate();
   if (!problem.empty()) {
     std::cerr << "fire replay: internal error, the replayed network is invalid: " << problem << "\n";
@@ -110,7 +170,17 @@ void add_network_commands(CLI::App& app, Registry& registry) {
   auto o = std::make_shared<ReplayOptions>();
   CLI::App* replay = app.add_subcommand(
       "replay", "Replay an input log headless through the frame systems (input, sketch, split, refine, subdivide, snap)");
-  replay->add_option("LOG", o->log_path, "input log (format: engine/INPUT_LOG.md)")->required();
+  replay->add_option("LOG", o->log_path,
+                     "input log (format: engine/INPUT_LOG.md), or a session folder (engine/SESSION.md) to reopen: its "
+                     "last good snapshot, then its log's tail, a torn last record dropped; a folder's settings.json "
+                     "fixes --snap, --levels, --fairness and --no-surface")
+      ->required();
+  replay->add_option("--session", o->session_dir,
+                     "write a session folder while replaying LOG: the input log, fsynced with a durability record at "
+                     "every pen-up and command, and snapshots (a new or empty folder)");
+  replay->add_option("--snapshot-every", o->snapshot_every,
+                     "with --session: write a snapshot every N frames and one at the end (0: none)")
+      ->capture_default_str();
   replay->add_option("-o,--output", o->out_path, "write the final curve network here (format: engine/NETWORK_FORMAT.md)");
   replay->add_option("--export-obj", o->obj_path, "also write the network's polylines as OBJ lines");
   replay->add_option("--surface", o->surface_path,
@@ -126,7 +196,35 @@ void add_network_commands(CLI::App& app, Registry& registry) {
                    "print a 64-bit hash of the final pools and surface (identical on every run and machine)");
   replay->add_flag("--timings", o->timings, "print per-system timings (mean, p99, max per frame) and final counts");
   replay->add_option("--snap", o->snap, "snap distance for stroke ends, in model units")->capture_default_str();
-  replay->callback([o, &registry] { registry.exit_code = run_replay(*o); });
+  replay->callback([o, replay, &registry] {
+    o->settings_given = replay->count("--snap") + replay->count("--levels") + replay->count("--fairness") +
+                            replay->count("--no-surface") > 0;
+    registry.exit_code = run_replay(*o);
+  });
+
+  auto dir = std::make_shared<std::string>();
+  CLI::App* open = app.add_subcommand(
+      "open", "Reopen a session folder (engine/SESSION.md) after a clean exit or a crash and print its world hash");
+  open->add_option("DIR", *dir, "session folder, as `fire replay LOG --session DIR` writes it")->required();
+  open->footer(
+      "Loads the newest snapshot that is whole (a damaged one is named and the one before used), replays the log's "
+      "tail, drops a torn last record (saying how many bytes) and prints the hash of the pools and surface: that of a "
+      "clean replay of the log that survived (`fire replay DIR/input.log --hash` when no record was torn). Exit 1 when nothing can be recovered (no folder, no log, a log corrupt "
+      "before its last line, bad settings.json).");
+  open->callback([dir, &registry] {
+    auto r = reopen("fire open", *dir);
+    if (!r) {
+      std::cerr << "fire open: " << r.error() << "\n";
+      registry.exit_code = 1;
+      return;
+    }
+    if (std::string problem = r->world->mesh.validate(); !problem.empty()) {
+      std::cerr << "fire open: internal error, the reopened network is invalid: " << problem << "\n";
+      registry.exit_code = 2;
+      return;
+    }
+    std::printf("%016" PRIx64 "\n", world_hash(*r->world));
+  });
 
   auto net = std::make_shared<std::string>();
   auto out = std::make_shared<std::string>();

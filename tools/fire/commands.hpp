@@ -8,7 +8,7 @@ struct Registry {
   int exit_code = 0;
 };
 
-// replay, export-network (engine foundation)
+// replay, open, export-network (engine foundation)
 void add_network_commands(CLI::App& app, Registry& registry);
 // network-from-mesh (synthetic curve networks, systems/synth)
 void add_synth_commands(CLI::App& app, Registry& registry);

@@ -48,16 +48,22 @@ void begin_frame(World& w, uint64_t index, int64_t begin_us) {
   w.mesh.begin_frame(index);
 }
 
-void replay_headless(World& w, Scheduler& scheduler) {
+void replay_headless(World& w, Scheduler& scheduler, const ReplayHooks& hooks) {
   if (w.log.events.empty()) return;
   begin_frame(w, 0, w.log.events.front().t_us);
+  continue_replay(w, scheduler, hooks);
+}
+
+void continue_replay(World& w, Scheduler& scheduler, const ReplayHooks& hooks) {
   while (w.cursor.next < w.log.events.size() || !w.sketch.pending.empty()) {
     // Skip stretches with nothing to do: the frames still count, so frame numbers match a live session.
     if (w.sketch.pending.empty() && w.log.events[w.cursor.next].t_us >= w.frame.end_us) {
       const int64_t steps = (w.log.events[w.cursor.next].t_us - w.frame.begin_us) / kFrameStepUs;
       begin_frame(w, w.frame.index + uint64_t(steps), w.frame.begin_us + steps * kFrameStepUs);
     }
+    if (hooks.before_frame) hooks.before_frame(w);
     scheduler.run_frame();
+    if (hooks.after_frame) hooks.after_frame(w);
     begin_frame(w, w.frame.index + 1, w.frame.end_us);
   }
 }

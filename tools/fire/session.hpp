@@ -7,6 +7,7 @@
 // Each system is declared with the world data it reads and writes (names below), so the scheduler can
 // refuse an order in which a system reads what a later one writes in the same frame.
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -52,8 +53,16 @@ std::vector<SystemSpec> session_systems(World& world);
 Scheduler make_scheduler(World& world, Scheduler::Clock clock);
 // Starts frame `index` covering [begin_us, begin_us + kFrameStepUs): the pools stamp what follows with it.
 void begin_frame(World& world, uint64_t index, int64_t begin_us);
+// Called before each frame runs (its events not delivered yet) and after it (before the next one begins,
+// so the snapping index has synced with every write of the frame): the session writer's log appends and
+// snapshots (tools/fire/session_store.hpp).
+struct ReplayHooks {
+  std::function<void(const World&)> before_frame, after_frame;
+};
 // Runs fixed-step frames from the first event until every event is consumed and no request waits.
-void replay_headless(World& world, Scheduler& scheduler);
+void replay_headless(World& world, Scheduler& scheduler, const ReplayHooks& hooks = {});
+// The same from where `world` stands: a frame begun, as replay_headless and a loaded snapshot leave it.
+void continue_replay(World& world, Scheduler& scheduler, const ReplayHooks& hooks = {});
 // Hash of the pools and the surface: what a replay must reproduce bit for bit.
 uint64_t world_hash(const World& world);
 

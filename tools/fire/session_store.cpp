@@ -1,0 +1,248 @@
+#include "tools/fire/session_store.hpp"
+
+#include <algorithm>
+#include <nlohmann/json.hpp>
+
+namespace fire {
+
+namespace {
+
+using nlohmann::json;
+
+void save_event(SnapshotWriter& out, const InputEvent& e) {
+  out.put(e.t_us);
+  out.put(uint8_t(e.kind));
+  out.put(e.p);
+  out.put(uint8_t(e.command));
+  out.put(int32_t(e.device));
+  out.put(uint8_t(e.hid_ok));
+  out.put(e.bytes);
+  out.put(e.name);
+  out.put(e.values);
+  out.put(e.text);
+  out.put(e.line);
+}
+
+bool load_event(SnapshotReader& in, InputEvent& e) {
+  uint8_t kind = 0, command = 0, hid_ok = 0;
+  int32_t device = 0;
+  in.get(e.t_us);
+  in.get(kind);
+  in.get(e.p);
+  in.get(command);
+  in.get(device);
+  in.get(hid_ok);
+  in.get(e.bytes);
+  in.get(e.name);
+  in.get(e.values);
+  in.get(e.text);
+  in.get(e.line);
+  if (kind > uint8_t(EventKind::Meta) || command > uint8_t(CommandKind::Delete)) in.fail();
+  e.kind = EventKind(kind);
+  e.command = CommandKind(command);
+  e.device = device;
+  e.hid_ok = hid_ok != 0;
+  return in.ok();
+}
+
+bool is_durable_record(const InputEvent& e) { return e.kind == EventKind::Meta && e.name == kDurableKey; }
+
+}  // namespace
+
+std::string settings_json(const World& w) {
+  json j;
+  j["version"] = 1;
+  j["snap_distance"] = w.sketch_settings.snap_distance;
+  j["close_samples"] = w.sketch_settings.close_samples;
+  j["surface"] = w.build_surface;
+  j["method"] = w.surface_options.method == reconstruct::Method::fire ? "fire" : "thesis";
+  j["coons_steps"] = w.surface_options.coons_steps;
+  j["levels"] = w.surface_options.levels;
+  j["planarity"] = static_cast<int>(w.surface_options.planarity);
+  j["fairness"] = w.surface_options.fairness;
+  return j.dump(2) + "\n";
+}
+
+Status apply_settings_json(std::string_view text, const std::string& source, World& w) {
+  const json j = json::parse(text, nullptr, false);
+  auto fail = [&](const std::string& why) { return Status::failure(source + ": " + why); };
+  if (j.is_discarded() || !j.is_object()) return fail("not valid JSON");
+  if (j.value("version", 0) != 1) return fail("unsupported settings version (this build reads version 1)");
+  const char* keys[] = {"snap_distance", "close_samples", "surface", "method", "coons_steps", "levels", "planarity", "fairness"};
+  for (const char* key : keys)
+    if (!j.contains(key)) return fail(std::string("missing '") + key + "'");
+  if (!j["snap_distance"].is_number() || !j["fairness"].is_number() || !j["close_samples"].is_number_unsigned() ||
+      !j["surface"].is_boolean() || !j["method"].is_string() || !j["coons_steps"].is_number_unsigned() ||
+      !j["levels"].is_number_unsigned() || !j["planarity"].is_number_unsigned())
+    return fail("a setting has the wrong type");
+  const double snap = j["snap_distance"], fairness = j["fairness"];
+  const uint64_t close = j["close_samples"], coons = j["coons_steps"], levels = j["levels"], planarity = j["planarity"];
+  const std::string method = j["method"];
+  if (!(snap > 0) || close < 2 || close > 1'000'000 || (method != "fire" && method != "thesis") || coons < 1 ||
+      coons > reconstruct::kMaxCoonsSteps || levels < 1 || levels > reconstruct::kMaxSurfaceLevels ||
+      planarity > static_cast<uint64_t>(reconstruct::Planarity::least_squares) || !(fairness >= 0 && fairness <= 1))
+    return fail("a setting is out of range");
+  w.sketch_settings.snap_distance = snap;
+  w.sketch_settings.close_samples = static_cast<uint32_t>(close);
+  w.build_surface = j["surface"];
+  w.surface_options.method = method == "fire" ? reconstruct::Method::fire : reconstruct::Method::thesis;
+  w.surface_options.coons_steps = static_cast<uint32_t>(coons);
+  w.surface_options.levels = static_cast<uint32_t>(levels);
+  w.surface_options.planarity = static_cast<reconstruct::Planarity>(planarity);
+  w.surface_options.fairness = fairness;
+  return Status::success();
+}
+
+std::string snapshot_world(const World& w, uint64_t log_bytes, uint64_t log_hash) {
+  SnapshotWriter out;
+  out.put(log_bytes);
+  out.put(log_hash);
+  out.put(w.frame.index);
+  out.put(w.frame.begin_us);
+  out.put(w.frame.end_us);
+  w.mesh.save(out);
+  w.history.save(out);
+  out.put(uint8_t(w.sketch.pen_down));
+  out.put(w.sketch.stroke);
+  out.put(uint64_t(w.sketch.pending.size()));
+  for (const InputEvent& e : w.sketch.pending) save_event(out, e);
+  save_surface(out, w.surface);
+  out.put(w.surface_build.problem);
+  out.put(w.surface_build.updates);
+  out.put(uint64_t(w.rejections.size()));
+  for (const Rejection& r : w.rejections) {
+    out.put(r.t_us);
+    out.put(r.line);
+    out.put(r.reason);
+  }
+  return out.finish();
+}
+
+Status load_world_snapshot(SnapshotReader& in, const SessionContents& session, World& w) {
+  uint64_t log_bytes = 0, log_hash = 0, count = 0;
+  in.get(log_bytes);
+  in.get(log_hash);
+  if (!in.ok()) return Status::failure("cut off");
+  if (log_bytes > session.log.kept_bytes ||
+      log_prefix_hash(std::string_view(session.log_bytes).substr(0, log_bytes)) != log_hash)
+    return Status::failure("continues from the first " + std::to_string(log_bytes) + " bytes of a log that " +
+                           session.paths.log() + " does not begin with");
+  in.get(w.frame.index);
+  in.get(w.frame.begin_us);
+  in.get(w.frame.end_us);
+  if (!w.mesh.load(in)) return Status::failure("the pools do not load");
+  if (!w.history.load(in, w.mesh)) return Status::failure("the undo history does not load");
+  uint8_t pen_down = 0;
+  in.get(pen_down);
+  in.get(w.sketch.stroke);
+  w.sketch.pen_down = pen_down != 0;
+  in.get(count);
+  for (uint64_t k = 0; k < count && in.ok(); ++k) load_event(in, w.sketch.pending.emplace_back());
+  if (!load_surface(in, w.surface)) return Status::failure("the surface does not load");
+  in.get(w.surface_build.problem);
+  in.get(w.surface_build.updates);
+  in.get(count);
+  for (uint64_t k = 0; k < count && in.ok(); ++k) {
+    Rejection& r = w.rejections.emplace_back();
+    in.get(r.t_us);
+    in.get(r.line);
+    in.get(r.reason);
+  }
+  if (!in.ok() || !in.at_end()) return Status::failure("cut off or followed by bytes it does not hold (damaged)");
+  if (std::string problem = w.mesh.validate(); !problem.empty())
+    return Status::failure("the pools break an invariant: " + problem);
+  if (w.mesh.frame() != w.frame.index) return Status::failure("the pools' frame is not the snapshot's");
+  // The events of the log's prefix are in the snapshot's state: the next one is the first on a later line.
+  const uint32_t prefix_lines =
+      static_cast<uint32_t>(std::count(session.log_bytes.begin(), session.log_bytes.begin() + log_bytes, '\n'));
+  w.log = session.log.log;
+  w.cursor.next = static_cast<size_t>(
+      std::partition_point(w.log.events.begin(), w.log.events.end(),
+                           [&](const InputEvent& e) { return e.line <= prefix_lines; }) -
+      w.log.events.begin());
+  // The index as the frame's last system left it, then the next frame begun, as replay_headless does.
+  w.snap.sync(w.mesh);
+  begin_frame(w, w.frame.index + 1, w.frame.end_us);
+  return Status::success();
+}
+
+Status replay_into_session(World& w, Scheduler& scheduler, SessionWriter& out, const SessionWriteOptions& options) {
+  Status status;
+  size_t appended = w.cursor.next;  // a reopened world's events are in the log already
+  uint64_t ups = 0, commands = 0, last_snapshot = w.frame.index;
+  auto commit = [&] {
+    if (!status) return;
+    status = out.commit();
+    if (status && options.on_commit) options.on_commit(ups, commands);
+  };
+  auto snapshot = [&](const World& world) {
+    commit();
+    if (status) status = out.write_snapshot(world.frame.index, snapshot_world(world, out.log_bytes(), out.log_hash()));
+    if (status && options.on_snapshot) options.on_snapshot(world.frame.index);
+    last_snapshot = world.frame.index;
+  };
+  ReplayHooks hooks;
+  // The events this frame delivers (input_system: t_us before the frame's end) go to the log first, and
+  // take the line they have there, so rejections name the session log's lines, as after reopening.
+  hooks.before_frame = [&](const World&) {
+    bool commit_point = false;
+    for (; appended < w.log.events.size() && w.log.events[appended].t_us < w.frame.end_us; ++appended) {
+      InputEvent& e = w.log.events[appended];
+      if (is_durable_record(e)) continue;  // a replayed session's own records name offsets in its log, not this one
+      e.line = out.lines() + 1;
+      if (status) status = out.append(e);
+      ups += e.kind == EventKind::Up;
+      commands += e.kind == EventKind::Command;
+      commit_point = commit_point || e.kind == EventKind::Up || e.kind == EventKind::Command;
+    }
+    if (commit_point) commit();
+  };
+  hooks.after_frame = [&](const World& world) {
+    const bool last = world.cursor.next >= world.log.events.size() && world.sketch.pending.empty();
+    if (options.snapshot_every > 0 && (last || world.frame.index >= last_snapshot + options.snapshot_every))
+      snapshot(world);
+  };
+  if (w.cursor.next == 0) replay_headless(w, scheduler, hooks);
+  else continue_replay(w, scheduler, hooks);
+  commit();
+  return status;
+}
+
+Result<ReopenedSession> reopen_session(const std::string& dir, Scheduler::Clock clock) {
+  auto contents = read_session(dir);
+  if (!contents) return Result<ReopenedSession>::failure(contents.error());
+  const SessionContents& c = *contents;
+  auto fresh = [&] {
+    auto w = std::make_unique<World>();
+    Status s = apply_settings_json(c.settings, c.paths.settings(), *w);
+    return std::make_pair(std::move(w), s);
+  };
+  if (Status s = fresh().second; !s) return Result<ReopenedSession>::failure(s.error);
+  ReopenedSession r;
+  if (c.log.dropped_bytes > 0)
+    r.notes.push_back(c.paths.log() + ":" + std::to_string(c.log.torn_line) + ": torn last record dropped (" +
+                      std::to_string(c.log.dropped_bytes) + " bytes without an end of line): the writer stopped inside it");
+  r.snapshot = load_last_good_snapshot(
+      c,
+      [&](SnapshotReader& in) {
+        auto [w, settings] = fresh();
+        Status s = load_world_snapshot(in, c, *w);
+        if (s) r.world = std::move(w);
+        return s;
+      },
+      r.notes);
+  if (!r.world) {
+    r.world = fresh().first;
+    r.world->log = c.log.log;
+  }
+  r.scheduler = std::make_unique<Scheduler>(make_scheduler(*r.world, clock));
+  const size_t from = r.world->cursor.next;
+  if (r.snapshot) continue_replay(*r.world, *r.scheduler);
+  else replay_headless(*r.world, *r.scheduler);
+  r.events_replayed = r.world->log.events.size() - from;
+  r.log_info = c.log;
+  r.log_info.log = {};
+  return r;
+}
+
+}  // namespace fire
