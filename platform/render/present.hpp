@@ -43,6 +43,8 @@ class Presenter {
   VkRenderPass overlay_pass() const { return overlay_pass_; }
   uint32_t image_count() const { return uint32_t(images_.size()); }
   uint32_t min_image_count() const { return min_image_count_; }
+  // Whether the window's images encode to sRGB on write (colours drawn into them are then linear).
+  bool srgb() const { return format_.format == VK_FORMAT_B8G8R8A8_SRGB || format_.format == VK_FORMAT_R8G8B8A8_SRGB; }
   uint32_t width() const { return extent_.width; }
   uint32_t height() const { return extent_.height; }
 

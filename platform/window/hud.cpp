@@ -4,7 +4,7 @@
 #include <imgui_impl_glfw.h>
 #include <imgui_impl_vulkan.h>
 
-#include <cstdio>
+#include <cmath>
 
 namespace fire::window {
 
@@ -28,6 +28,9 @@ Result<std::unique_ptr<Hud>> Hud::create(render::Context& context, render::Prese
   io.IniFilename = nullptr;  // no imgui.ini left in the working directory
   ImGui::StyleColorsDark();
   ImGui::GetStyle().Alpha = 0.92f;
+  if (presenter.srgb())  // ImGui's colours are sRGB values: written to an sRGB image they must be linear first
+    for (ImVec4& c : ImGui::GetStyle().Colors)
+      for (float* v : {&c.x, &c.y, &c.z}) *v = *v <= 0.04045f ? *v / 12.92f : std::pow((*v + 0.055f) / 1.055f, 2.4f);
   hud->glfw_ = ImGui_ImplGlfw_InitForVulkan(window.handle(), true);
   if (!hud->glfw_) return R::failure("ImGui_ImplGlfw_InitForVulkan failed");
 

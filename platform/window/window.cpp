@@ -135,6 +135,8 @@ void Window::framebuffer_size(uint32_t& width, uint32_t& height) const {
   height = uint32_t(std::max(h, 0));
 }
 
+void Window::request_size(uint32_t width, uint32_t height) { glfwSetWindowSize(window_, int(width), int(height)); }
+
 void Window::inject(const WindowEvent& e) {
   // Reads back what GLFW would call: setting a callback returns the one installed.
   auto installed = [this](auto set) {

@@ -55,6 +55,8 @@ class Window {
 
   // A scripted event through the callbacks GLFW installed (the HUD's, then ours), the cursor moved first.
   void inject(const WindowEvent& event);
+  // Asks the window system for a new size (it may refuse or adjust it); the swapchain follows.
+  void request_size(uint32_t width, uint32_t height);
 
  private:
   Window() = default;

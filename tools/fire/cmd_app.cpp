@@ -60,10 +60,12 @@ const std::vector<std::string> kKeys = {
     "Esc             quit",
 };
 
-// A scripted event of --script: at display frame `frame`, `event` goes through the window's callbacks.
+// A scripted event of --script: at display frame `frame`, `event` goes through the window's callbacks, or,
+// with a resize size, the window asks the window system for that size (as a person dragging its border).
 struct ScriptEvent {
   uint64_t frame = 0;
   window::WindowEvent event;
+  uint32_t resize_width = 0, resize_height = 0;
 };
 
 Result<int> parse_key(const std::string& name) {
@@ -76,7 +78,8 @@ Result<int> parse_key(const std::string& name) {
 }
 
 // The --script format, one event a line ('#' starts a comment):
-//   FRAME move X Y | press left|right|middle | release left|right|middle | scroll DY | key [ctrl+][shift+]KEY | close
+//   FRAME move X Y | press left|right|middle | release left|right|middle | scroll DY | key [ctrl+][shift+]KEY |
+//   resize WIDTH HEIGHT | close
 // FRAME is the display frame (from 0) before which the event is delivered; frames never decrease.
 Result<std::vector<ScriptEvent>> read_script(const std::string& path) {
   using R = Result<std::vector<ScriptEvent>>;
@@ -124,10 +127,13 @@ Result<std::vector<ScriptEvent>> read_script(const std::string& path) {
       auto key = parse_key(name);
       if (!key) return bad(key.error());
       e.key = *key;
+    } else if (kind == "resize") {
+      if (!(in >> s.resize_width >> s.resize_height) || s.resize_width < 64 || s.resize_height < 64)
+        return bad("resize needs WIDTH HEIGHT, at least 64 each");
     } else if (kind == "close") {
       e.kind = window::EventKind::Close;
     } else {
-      return bad("unknown event '" + kind + "' (move, press, release, scroll, key, close)");
+      return bad("unknown event '" + kind + "' (move, press, release, scroll, key, resize, close)");
     }
     std::string extra;
     if (in >> extra) return bad("unexpected '" + extra + "'");
@@ -371,8 +377,11 @@ int run_app(const AppArgs& a) {
   };
 
   while (status && !window.should_close()) {
-    for (; next_script < script.size() && script[next_script].frame <= display_frame; ++next_script)
-      window.inject(script[next_script].event);
+    for (; next_script < script.size() && script[next_script].frame <= display_frame; ++next_script) {
+      const ScriptEvent& s = script[next_script];
+      if (s.resize_width) window.request_size(s.resize_width, s.resize_height);
+      else window.inject(s.event);
+    }
     window.poll();
     for (const window::WindowEvent& e : window.events()) handle(e);
     window.events().clear();
@@ -448,7 +457,8 @@ void add_app_commands(CLI::App& app, Registry& registry) {
   cmd->add_option("--script", a->script_path,
                   "test hook: input events delivered through the window's GLFW callbacks, one a line: "
                   "'FRAME move X Y', 'FRAME press|release left|right|middle', 'FRAME scroll DY', "
-                  "'FRAME key [ctrl+][shift+]KEY', 'FRAME close'; FRAME is the display frame");
+                  "'FRAME key [ctrl+][shift+]KEY', 'FRAME resize W H' (asks the window system), 'FRAME close'; FRAME is "
+                  "the display frame");
   cmd->add_option("--screenshot", a->screenshot_path, "on exit, write the last presented frame (HUD included) as PNG");
   cmd->callback([a, &registry] { registry.exit_code = run_app(*a); });
 }

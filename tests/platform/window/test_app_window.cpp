@@ -1,0 +1,190 @@
+// `fire app` in a real window under Xvfb (Debian xvfb; tools/run installs it), on lavapipe or a GPU with the
+// validation layer on: a scripted interaction through the window's GLFW callbacks (an orbit drag, a zoom, the
+// help overlay, an undo, a resize, a close), a screenshot of the presented frame checked by pixel statistics,
+// the recorded input log replayed to the same hash, and no display: a clear message, no crash.
+#include <catch2/catch.hpp>
+#include <cstdlib>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "platform/files.hpp"
+#include "platform/render/image.hpp"
+#include "platform/render/renderer.hpp"
+
+namespace {
+
+using fire::render::Image;
+using fire::render::Palette;
+namespace fs = std::filesystem;
+
+struct Run {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string quote(const std::string& s) { return "'" + s + "'"; }
+
+// Runs a shell command with its output in files of `dir`.
+Run run(const std::string& command, const fs::path& dir) {
+  const std::string out = (dir / "stdout").string(), err = (dir / "stderr").string();
+  const int status = std::system((command + " >" + quote(out) + " 2>" + quote(err)).c_str());
+  Run r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  if (auto text = fire::read_text_file(out)) r.out = *text;
+  if (auto text = fire::read_text_file(err)) r.err = *text;
+  return r;
+}
+
+bool has_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
+
+// fire app under a fresh X server; the validation layer on, LeakSanitizer's suppressions for Mesa in the
+// sanitizer build.
+std::string app_command(const std::string& args) {
+  return std::string("env FIRE_VK_VALIDATION=1 LSAN_OPTIONS=suppressions=") + FIRE_LSAN_SUPPRESSIONS +
+         ":print_suppressions=0 xvfb-run -a -s '-screen 0 1280x800x24' timeout 240 " + quote(FIRE_BINARY) +
+         " app " + args;
+}
+
+fs::path scratch(const std::string& name) {
+  fs::path dir = fs::temp_directory_path() / ("fire_app_window_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+bool near(const uint8_t* p, const uint8_t (&c)[3], int tolerance) {
+  for (int k = 0; k < 3; ++k)
+    if (std::abs(int(p[k]) - int(c[k])) > tolerance) return false;
+  return true;
+}
+
+// The lit surface: a neutral grey brighter than any background row.
+bool surface_like(const uint8_t* p) {
+  const int lo = std::min({p[0], p[1], p[2]}), hi = std::max({p[0], p[1], p[2]});
+  return hi - lo < 40 && (p[0] + p[1] + p[2]) / 3 > 100;
+}
+
+// Pixels of [x0, x1) x [y0, y1) well darker than the background's top rows there (the HUD's translucent panels).
+double dark_fraction(const Image& im, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1) {
+  size_t dark = 0;
+  for (uint32_t y = y0; y < y1; ++y)
+    for (uint32_t x = x0; x < x1; ++x) dark += std::max({im.pixel(x, y)[0], im.pixel(x, y)[1], im.pixel(x, y)[2]}) < 50;
+  return double(dark) / double((x1 - x0) * (y1 - y0));
+}
+
+size_t curve_pixels(const Image& im) {
+  size_t n = 0;
+  for (uint32_t y = 0; y < im.height; ++y)
+    for (uint32_t x = 0; x < im.width; ++x) n += near(im.pixel(x, y), Palette::curve, 40);
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("fire app: a scripted session in a window, its screenshot and its replay", "[app][window]") {
+  INFO("the window test needs xvfb-run: apt-get install xvfb (tools/run test installs it)");
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("session");
+  const std::string shot = (dir / "shot.png").string(), record = (dir / "session.log").string();
+  const Run app = run(app_command(quote(FIRE_DEMO_LOG) + " --size 960x600 --script " +
+                                  quote(FIRE_WINDOW_TEST_DIR "/session.script") + " --screenshot " + quote(shot) +
+                                  " --record " + quote(record)),
+                      dir);
+  INFO("stdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  CHECK(app.err.find("validation") == std::string::npos);
+  const auto json = nlohmann::json::parse(app.out);
+  CHECK(json["validation"] == true);
+  CHECK(json["display_frames"] == 41);  // the close at frame 40 ends the loop after that frame
+  CHECK(json["system_frames"].get<uint64_t>() > 0);
+
+  {  // the recorded log ends with the undo and replays to the app's hash
+    const auto log = fire::read_text_file(record);
+    REQUIRE(log);
+    CHECK(log->rfind(" cmd undo\n") == log->size() - std::string(" cmd undo\n").size());
+    const Run replay = run(quote(FIRE_BINARY) + " replay " + quote(record) + " --hash", dir);
+    REQUIRE(replay.exit_code == 0);
+    CHECK(replay.out == json["hash"].get<std::string>() + "\n");
+    const Run original = run(quote(FIRE_BINARY) + " replay " + quote(FIRE_DEMO_LOG) + " --hash", dir);
+    CHECK(original.out != replay.out);  // the undo changed the network
+  }
+
+  {  // the screenshot shows the resized window: background, surface, curves and the HUD
+    auto image = fire::render::read_png(shot);
+    REQUIRE(image);
+    const Image& im = *image;
+    REQUIRE(im.width == 800);
+    REQUIRE(im.height == 520);
+    // The background's bottom row at both corners; the surface never reaches them.
+    CHECK(near(im.pixel(2, im.height - 2), Palette::background_bottom, 8));
+    CHECK(near(im.pixel(im.width - 3, im.height - 2), Palette::background_bottom, 8));
+    // The surface covers a large central region.
+    size_t surface = 0;
+    double cx = 0, cy = 0;
+    for (uint32_t y = 0; y < im.height; ++y)
+      for (uint32_t x = 0; x < im.width; ++x)
+        if (surface_like(im.pixel(x, y))) {
+          ++surface;
+          cx += x;
+          cy += y;
+        }
+    const double coverage = double(surface) / double(im.width * im.height);
+    INFO("surface coverage " << coverage);
+    CHECK(coverage > 0.12);
+    CHECK(coverage < 0.75);
+    CHECK(std::abs(cx / double(surface) - im.width / 2.0) < im.width * 0.2);
+    CHECK(std::abs(cy / double(surface) - im.height / 2.0) < im.height * 0.2);
+    // Curves on top of it.
+    const size_t curves = curve_pixels(im);
+    INFO("curve pixels " << curves);
+    CHECK(curves > 1500);
+    CHECK(curves < surface);
+    // The HUD's panel at the top left and the help overlay at the top right, both darker than the background.
+    INFO("dark HUD pixels: " << dark_fraction(im, 14, 14, 200, 120) << " left, "
+                               << dark_fraction(im, im.width - 150, 14, im.width - 14, 60) << " right");
+    CHECK(dark_fraction(im, 14, 14, 200, 120) > 0.5);
+    CHECK(dark_fraction(im, im.width - 150, 14, im.width - 14, 60) > 0.5);
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("fire app: curves toggled off are not drawn", "[app][window]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("curves_off");
+  const std::string shot = (dir / "shot.png").string();
+  const Run app = run(app_command(quote(FIRE_DEMO_LOG) + " --size 640x400 --script " +
+                                  quote(FIRE_WINDOW_TEST_DIR "/curves_off.script") + " --screenshot " + quote(shot)),
+                      dir);
+  INFO("stdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  auto image = fire::render::read_png(shot);
+  REQUIRE(image);
+  CHECK(curve_pixels(*image) < 20);
+  size_t surface = 0;
+  for (uint32_t y = 0; y < image->height; ++y)
+    for (uint32_t x = 0; x < image->width; ++x) surface += surface_like(image->pixel(x, y));
+  CHECK(surface > image->width * image->height / 10);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("fire app without a display: a clear message, exit 1, no crash", "[app][window]") {
+  const fs::path dir = scratch("no_display");
+  const Run app = run("env -u DISPLAY -u WAYLAND_DISPLAY " + quote(FIRE_BINARY) + " app " + quote(FIRE_DEMO_LOG), dir);
+  INFO("stderr: " << app.err);
+  CHECK(app.exit_code == 1);
+  CHECK(app.err.find("no display") != std::string::npos);
+  CHECK(app.err.find("fire render") != std::string::npos);
+  CHECK(app.out.empty());
+  fs::remove_all(dir);
+}
+
+TEST_CASE("fire app: a script that does not parse is refused before a window opens", "[app][window]") {
+  const fs::path dir = scratch("bad_script");
+  const std::string script = (dir / "bad.script").string();
+  REQUIRE(fire::write_file_atomic(script, "1 move 10 10\n0 close\n"));
+  const Run app = run("env -u DISPLAY -u WAYLAND_DISPLAY " + quote(FIRE_BINARY) + " app --script " + quote(script), dir);
+  CHECK(app.exit_code == 1);
+  CHECK(app.err.find("bad.script:2: frames must not decrease") != std::string::npos);
+  fs::remove_all(dir);
+}
