@@ -94,6 +94,11 @@ void Orbit::pan(float dx, float dy, uint32_t height) {
   target += (-dx * right + dy * up) * pixel;
 }
 
+float Orbit::pixel_size(const glm::vec3& p, uint32_t height) const {
+  const float depth = glm::dot(p - target, -orbit_back(*this)) + distance;  // along the view direction
+  return 2.0f * std::max(depth, 0.0f) * std::tan(kOrbitFovY * 0.5f) / float(std::max(height, 1u));
+}
+
 void Orbit::zoom(float steps) { distance = std::clamp(distance * std::pow(0.88f, steps), radius * 0.05f, radius * 40.0f); }
 
 Orbit frame_orbit(const Box& box, uint32_t width, uint32_t height) {
@@ -124,6 +129,12 @@ Camera orbit_camera(const Orbit& o, uint32_t width, uint32_t height) {
   camera.projection[1][1] *= -1.0f;  // Vulkan's clip space has y pointing down
   camera.key_light = glm::normalize(0.6f * back + 0.9f * up - 0.6f * right);
   return camera;
+}
+
+glm::vec3 ray_through_pixel(const Camera& camera, glm::vec2 pixel, uint32_t width, uint32_t height) {
+  const glm::vec2 ndc(pixel.x / float(std::max(width, 1u)) * 2.0f - 1.0f, pixel.y / float(std::max(height, 1u)) * 2.0f - 1.0f);
+  const glm::vec4 far_point = glm::inverse(camera.view_projection()) * glm::vec4(ndc, 1.0f, 1.0f);
+  return glm::normalize(glm::vec3(far_point) / far_point.w - camera.eye);
 }
 
 glm::vec2 project_to_pixels(const Camera& camera, const Vec3& p, uint32_t width, uint32_t height) {

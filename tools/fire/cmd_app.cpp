@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -23,6 +24,7 @@
 #include "platform/render/present.hpp"
 #include "platform/window/hud.hpp"
 #include "platform/window/window.hpp"
+#include "systems/evaluate/evaluate.hpp"
 #include "tools/fire/commands.hpp"
 #include "tools/fire/session.hpp"
 
@@ -33,6 +35,8 @@ namespace {
 struct AppArgs {
   std::string input_path, reference_path, out_path, record_path, script_path, screenshot_path, size = "1280x720";
   uint32_t levels = 3;
+  int reference_levels = 3;
+  double snap_pixels = 12;
 };
 
 int fail(const std::string& message) {
@@ -46,8 +50,9 @@ bool ends_with(const std::string& s, const std::string& tail) {
 
 // The help overlay and `fire app --help` list the same keys.
 const std::vector<std::string> kKeys = {
-    "left drag       orbit",
-    "right drag      pan (also Shift + left drag)",
+    "left drag       orbit; with --reference: draw a stroke on it (logged)",
+    "right drag      pan; with --reference: orbit",
+    "Shift + drag    pan",
     "scroll          zoom",
     "Ctrl+Z          undo (logged)",
     "Ctrl+Shift+Z    redo (logged; also Ctrl+Y)",
@@ -199,18 +204,22 @@ int run_app(const AppArgs& a) {
     if (!s) return fail("--script: " + s.error());
     script = std::move(*s);
   }
-  std::vector<Vec3> reference_positions;
-  std::vector<uint32_t> reference_triangles;
+  if (a.reference_levels < 0 || a.reference_levels > 5) return fail("--reference-levels must be 0 to 5");
+  if (!(a.snap_pixels > 0) || a.snap_pixels > 200) return fail("--snap-pixels must be above 0 and at most 200");
+  // The reference as drawn on: its Catmull-Clark limit surface (a control mesh), or its faces as fans (level 0).
+  evaluate::TriangleMesh reference;
   if (!a.reference_path.empty()) {
     auto mesh = read_obj(a.reference_path);
     if (!mesh) return fail("--reference: " + mesh.error());
-    reference_positions = mesh->positions;
-    for (size_t f = 0; f < mesh->face_count(); ++f) {
-      const uint32_t* v = &mesh->face_vertices[mesh->face_offsets[f]];
-      for (uint32_t k = 1; k + 1 < mesh->face_size(f); ++k)
-        reference_triangles.insert(reference_triangles.end(), {v[0], v[k], v[k + 1]});
-    }
+    auto triangles = a.reference_levels > 0
+                         ? evaluate::reference_limit_surface(mesh->positions, mesh->face_offsets, mesh->face_vertices,
+                                                             a.reference_levels)
+                         : evaluate::triangulate(mesh->positions, mesh->face_offsets, mesh->face_vertices);
+    if (!triangles) return fail("--reference: " + a.reference_path + ": " + triangles.error());
+    reference = std::move(*triangles);
   }
+  const evaluate::TriangleBvh reference_bvh(reference);
+  const std::vector<Vec3>& reference_positions = reference.positions;
 
   // The session: a network to continue from, or an input log replayed first, or nothing.
   auto world = std::make_unique<World>();
@@ -248,7 +257,7 @@ int run_app(const AppArgs& a) {
   if (!presenter) return fail(presenter.error());
   auto renderer = render::Renderer::create(**context, {std::max(width, 1u), std::max(height, 1u)});
   if (!renderer) return fail(renderer.error());
-  if (Status s = (*renderer)->set_reference(reference_positions, reference_triangles); !s) return fail(s.error);
+  if (Status s = (*renderer)->set_reference(reference.positions, reference.triangles); !s) return fail(s.error);
   auto hud = window::Hud::create(**context, **presenter, window);
   if (!hud) return fail(hud.error());
 
@@ -268,28 +277,52 @@ int run_app(const AppArgs& a) {
     return session_origin_us +
            std::chrono::duration_cast<std::chrono::microseconds>(WallClock::now() - wall_start).count();
   };
+  render::Camera camera;  // the view of the last displayed frame: what the cursor points at
+  auto log_event = [&](InputEvent e) {
+    // Never before the frame about to run, nor before the last event: the log stays in time order.
+    e.t_us = std::max({session_us(), w.frame.begin_us, w.log.events.back().t_us});
+    e.line = uint32_t(w.log.events.size() + 2);  // its line in the recorded log (after the header)
+    w.log.events.push_back(std::move(e));
+  };
   auto log_command = [&](CommandKind command, const Vec3& p) {
     InputEvent e;
     e.kind = EventKind::Command;
     e.command = command;
     e.p = p;
-    // Never before the frame about to run, nor before the last event: the log stays in time order.
-    e.t_us = std::max({session_us(), w.frame.begin_us, w.log.events.back().t_us});
-    e.line = uint32_t(w.log.events.size() + 2);  // its line in the recorded log (after the header)
-    w.log.events.push_back(e);
+    log_event(std::move(e));
+  };
+  auto log_pen = [&](EventKind kind) {
+    InputEvent e;
+    e.kind = kind;
+    log_event(std::move(e));
+  };
+  // The mouse pen: the ray from the cursor onto the reference; a hit is a pen sample with the snap radius
+  // of --snap-pixels at its depth, both logged, so the drawing replays without the view.
+  auto pen_sample = [&](glm::vec2 pixel) {
+    const glm::vec3 direction = render::ray_through_pixel(camera, pixel, width, height);
+    const evaluate::TriangleBvh::Hit hit = reference_bvh.ray_cast(
+        Vec3(camera.eye.x, camera.eye.y, camera.eye.z), Vec3(direction.x, direction.y, direction.z));
+    if (hit.triangle == evaluate::kNoTriangle) return false;
+    InputEvent e;
+    e.kind = EventKind::Pen;
+    e.p = hit.point;
+    const glm::vec3 p(float(hit.point.x()), float(hit.point.y()), float(hit.point.z()));
+    e.snap = a.snap_pixels * double(orbit.pixel_size(p, std::max(height, 1u)));
+    log_event(std::move(e));
+    return true;
   };
   auto run_frame = [&] {
     scheduler.run_frame();
     begin_frame(w, w.frame.index + 1, w.frame.end_us);
   };
 
-  bool dragging = false, panning = false;
+  bool dragging = false, panning = false, drawing = false;
+  const bool can_draw = !reference.triangles.empty();
   glm::vec2 cursor(0.0f);
   uint64_t display_frame = 0;
   size_t next_script = 0;
   auto last_frame = WallClock::now();
   Status status;
-  render::Camera camera;
 
   auto handle = [&](const window::WindowEvent& e) {
     using window::EventKind;
@@ -299,17 +332,31 @@ int run_app(const AppArgs& a) {
         const glm::vec2 now(float(e.x), float(e.y)), d = now - cursor;
         if (dragging) orbit.rotate(d.x, d.y);
         if (panning) orbit.pan(d.x, d.y, std::max(height, 1u));
+        if (drawing) {  // samples every 2 pixels along the move, so a fast drag still makes a dense stroke
+          const int steps = std::max(1, int(std::ceil(glm::length(d) / 2.0f)));
+          for (int k = 1; k <= steps; ++k) pen_sample(cursor + d * (float(k) / float(steps)));
+        }
         cursor = now;
         break;
       }
       case EventKind::ButtonPress:
         cursor = glm::vec2(float(e.x), float(e.y));
-        if ((*hud)->wants_mouse()) break;
-        if (e.button == window::Button::Left && !shift) dragging = true;
-        else if (e.button == window::Button::Right || e.button == window::Button::Middle || e.button == window::Button::Left) panning = true;
+        if ((*hud)->wants_mouse() || dragging || panning || drawing) break;
+        if (shift || e.button == window::Button::Middle) panning = true;
+        else if (e.button == window::Button::Left && can_draw) {
+          // A stroke starts only on the reference: the pen goes down with its first sample.
+          log_pen(fire::EventKind::Down);
+          drawing = pen_sample(cursor);
+          if (!drawing) {
+            w.log.events.pop_back();  // the down: not yet delivered, since events wait for the next frame
+            hud_data.status = "press on the reference mesh to draw";
+          }
+        } else if (e.button == window::Button::Left || (e.button == window::Button::Right && can_draw)) dragging = true;
+        else panning = true;
         break;
       case EventKind::ButtonRelease:
-        dragging = panning = false;
+        if (drawing) log_pen(fire::EventKind::Up);
+        dragging = panning = drawing = false;
         break;
       case EventKind::Scroll:
         if (!(*hud)->wants_mouse()) orbit.zoom(float(e.y));
@@ -448,7 +495,16 @@ void add_app_commands(CLI::App& app, Registry& registry) {
       "surface_quads, hash (as `fire replay --hash`), device, validation. FIRE_VK_VALIDATION=1 turns the "
       "validation layer on; any message then fails the command.\n\nKeys:\n" + keys);
   cmd->add_option("NET", a->input_path, "curve network (.fnet) or input log to start from");
-  cmd->add_option("--reference", a->reference_path, "OBJ mesh drawn see-through over the scene");
+  cmd->add_option("--reference", a->reference_path,
+                  "OBJ mesh drawn see-through; a left drag draws on it (ray casts through a BVH): a pen sample at "
+                  "every hit, logged with its snap radius");
+  cmd->add_option("--reference-levels", a->reference_levels,
+                  "the reference as its Catmull-Clark limit surface at this level (so strokes lie on the surface "
+                  "fire eval measures against); 0: its faces as they are")
+      ->capture_default_str();
+  cmd->add_option("--snap-pixels", a->snap_pixels,
+                  "snap radius of the mouse pen in screen pixels, converted to model units at each sample")
+      ->capture_default_str();
   cmd->add_option("-o,--output", a->out_path, "where Ctrl+S saves the network (default: INPUT-app.fnet beside the "
                                               "input, or fire-app.fnet)");
   cmd->add_option("--record", a->record_path, "write the session's input log here on exit (not with a .fnet input)");

@@ -1,13 +1,15 @@
 // `fire app` in a real window under Xvfb (Debian xvfb; tools/run installs it), on lavapipe or a GPU with the
 // validation layer on: a scripted interaction through the window's GLFW callbacks (an orbit drag, a zoom, the
 // help overlay, an undo, a resize, a close), a screenshot of the presented frame checked by pixel statistics,
-// the recorded input log replayed to the same hash, and no display: a clear message, no crash.
+// the recorded input log replayed to the same hash; strokes drawn with the mouse on pawn.obj, replayed bit for
+// bit; and no display: a clear message, no crash.
 #include <catch2/catch.hpp>
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "engine/input_log.hpp"
 #include "platform/files.hpp"
 #include "platform/render/image.hpp"
 #include "platform/render/renderer.hpp"
@@ -165,6 +167,57 @@ TEST_CASE("fire app: curves toggled off are not drawn", "[app][window]") {
   for (uint32_t y = 0; y < image->height; ++y)
     for (uint32_t x = 0; x < image->width; ++x) surface += surface_like(image->pixel(x, y));
   CHECK(surface > image->width * image->height / 10);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("fire app: strokes drawn with the mouse on a reference mesh replay bit for bit", "[app][window][sketch]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("draw");
+  const std::string shot = (dir / "shot.png").string(), record = (dir / "draw.log").string();
+  const Run app = run(app_command("--reference " + quote(FIRE_PAWN) + " --size 960x720 --script " +
+                                  quote(FIRE_WINDOW_TEST_DIR "/draw_on_pawn.script") + " --screenshot " + quote(shot) +
+                                  " --record " + quote(record)),
+                      dir);
+  INFO("stdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  const auto json = nlohmann::json::parse(app.out);
+  // A closed border of 4 curves, split once (its curve and the halves of the two edges it ends on).
+  CHECK(json["faces"] == 2);
+  CHECK(json["edges"] == 7);
+  CHECK(json["surface_quads"].get<int>() > 0);
+
+  const auto log = fire::read_text_file(record);
+  REQUIRE(log);
+  auto parsed = fire::parse_input_log(*log, record);
+  REQUIRE(parsed);
+  size_t pens = 0, downs = 0, ups = 0;
+  for (const fire::InputEvent& e : parsed->events) {
+    pens += e.kind == fire::EventKind::Pen;
+    downs += e.kind == fire::EventKind::Down;
+    ups += e.kind == fire::EventKind::Up;
+    // Every sample carries the 12 pixels of snap radius in model units: a hundredth or so on the pawn.
+    if (e.kind == fire::EventKind::Pen) CHECK((e.snap > 0.001 && e.snap < 0.1));
+  }
+  CHECK(downs == 6);
+  CHECK(ups == 6);
+  CHECK(pens > 6 * 10);
+  CHECK(log->rfind(" cmd undo\n") == log->size() - std::string(" cmd undo\n").size());
+  for (int run_index = 0; run_index < 2; ++run_index) {  // the same hash on every replay
+    const Run replay = run(quote(FIRE_BINARY) + " replay " + quote(record) + " --hash", dir);
+    REQUIRE(replay.exit_code == 0);
+    CHECK(replay.out == json["hash"].get<std::string>() + "\n");
+  }
+
+  auto image = fire::render::read_png(shot);
+  REQUIRE(image);
+  // The curves are where the strokes were drawn (the square 430..530 x 180..260), and nowhere else.
+  size_t inside = 0, outside = 0;
+  for (uint32_t y = 0; y < image->height; ++y)
+    for (uint32_t x = 0; x < image->width; ++x)
+      if (near(image->pixel(x, y), Palette::curve, 40)) (x >= 420 && x <= 540 && y >= 170 && y <= 270 ? inside : outside)++;
+  INFO("curve pixels inside " << inside << ", outside " << outside);
+  CHECK(inside > 400);
+  CHECK(outside < 20);
   fs::remove_all(dir);
 }
 
