@@ -11,6 +11,7 @@
 
 #include "engine/input_log.hpp"
 #include "platform/files.hpp"
+#include "platform/network_file.hpp"
 #include "platform/render/image.hpp"
 #include "platform/render/renderer.hpp"
 
@@ -88,10 +89,11 @@ TEST_CASE("fire app: a scripted session in a window, its screenshot and its repl
   INFO("the window test needs xvfb-run: apt-get install xvfb (tools/run test installs it)");
   REQUIRE(has_xvfb());
   const fs::path dir = scratch("session");
-  const std::string shot = (dir / "shot.png").string(), record = (dir / "session.log").string();
+  const std::string shot = (dir / "shot.png").string(), record = (dir / "session.log").string(),
+                    saved = (dir / "saved.fnet").string();
   const Run app = run(app_command(quote(FIRE_DEMO_LOG) + " --size 960x600 --script " +
                                   quote(FIRE_WINDOW_TEST_DIR "/session.script") + " --screenshot " + quote(shot) +
-                                  " --record " + quote(record)),
+                                  " --record " + quote(record) + " -o " + quote(saved)),
                       dir);
   INFO("stdout: " << app.out << "\nstderr: " << app.err);
   REQUIRE(app.exit_code == 0);
@@ -100,6 +102,12 @@ TEST_CASE("fire app: a scripted session in a window, its screenshot and its repl
   CHECK(json["validation"] == true);
   CHECK(json["display_frames"] == 41);  // the close at frame 40 ends the loop after that frame
   CHECK(json["system_frames"].get<uint64_t>() > 0);
+  {  // Ctrl+S saved the network as it was after the undo
+    auto network = fire::load_network(saved);
+    REQUIRE(network);
+    CHECK(network->edge_count() == json["edges"].get<size_t>());
+    CHECK(app.err.find("saved " + std::to_string(network->edge_count()) + " curves to " + saved) != std::string::npos);
+  }
 
   {  // the recorded log ends with the undo and replays to the app's hash
     const auto log = fire::read_text_file(record);
