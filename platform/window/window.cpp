@@ -82,7 +82,8 @@ Result<std::unique_ptr<Window>> Window::create(const std::string& title, uint32_
     return R::failure("cannot open the display (" + g_glfw_error + "); use `fire render` to render without one");
   if (!glfwVulkanSupported()) {
     glfwTerminate();
-    return R::failure("GLFW finds no Vulkan loader (Debian package libvulkan1) or no window surface support");
+    return R::failure("GLFW finds no Vulkan loader or no driver that can draw into a window (Debian packages "
+                      "libvulkan1, and mesa-vulkan-drivers for lavapipe without a GPU)");
   }
   glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
   glfwWindowHint(GLFW_RESIZABLE, GLFW_TRUE);

@@ -43,8 +43,8 @@ bool has_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0
 
 // fire app under a fresh X server; the validation layer on, LeakSanitizer's suppressions for Mesa in the
 // sanitizer build.
-std::string app_command(const std::string& args) {
-  return std::string("env FIRE_VK_VALIDATION=1 LSAN_OPTIONS=suppressions=") + FIRE_LSAN_SUPPRESSIONS +
+std::string app_command(const std::string& args, const std::string& env = "") {
+  return "env " + env + " FIRE_VK_VALIDATION=1 LSAN_OPTIONS=suppressions=" + FIRE_LSAN_SUPPRESSIONS +
          ":print_suppressions=0 xvfb-run -a -s '-screen 0 1280x800x24' timeout 240 " + quote(FIRE_BINARY) +
          " app " + args;
 }
@@ -237,6 +237,23 @@ TEST_CASE("fire app without a display: a clear message, exit 1, no crash", "[app
   CHECK(app.err.find("no display") != std::string::npos);
   CHECK(app.err.find("fire render") != std::string::npos);
   CHECK(app.out.empty());
+  fs::remove_all(dir);
+}
+
+TEST_CASE("fire app: no Vulkan device, a reference that does not load: a clear message, exit 1", "[app][window]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("bad_input");
+  const Run no_device =
+      run(app_command("--size 320x200 " + quote(FIRE_DEMO_LOG),
+                      "VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json"),
+          dir);
+  INFO("stderr: " << no_device.err);
+  CHECK(no_device.exit_code == 1);
+  CHECK(no_device.err.find("mesa-vulkan-drivers") != std::string::npos);
+  const Run bad_reference = run(app_command("--reference " + quote((dir / "missing.obj").string())), dir);
+  INFO("stderr: " << bad_reference.err);
+  CHECK(bad_reference.exit_code == 1);
+  CHECK(bad_reference.err.find("--reference: " + (dir / "missing.obj").string()) != std::string::npos);
   fs::remove_all(dir);
 }
 
