@@ -94,11 +94,6 @@ void Orbit::pan(float dx, float dy, uint32_t height) {
   target += (-dx * right + dy * up) * pixel;
 }
 
-float Orbit::pixel_size(const glm::vec3& p, uint32_t height) const {
-  const float depth = glm::dot(p - target, -orbit_back(*this)) + distance;  // along the view direction
-  return 2.0f * std::max(depth, 0.0f) * std::tan(kOrbitFovY * 0.5f) / float(std::max(height, 1u));
-}
-
 void Orbit::zoom(float steps) { distance = std::clamp(distance * std::pow(0.88f, steps), radius * 0.05f, radius * 40.0f); }
 
 Orbit frame_orbit(const Box& box, uint32_t width, uint32_t height) {
@@ -129,6 +124,12 @@ Camera orbit_camera(const Orbit& o, uint32_t width, uint32_t height) {
   camera.projection[1][1] *= -1.0f;  // Vulkan's clip space has y pointing down
   camera.key_light = glm::normalize(0.6f * back + 0.9f * up - 0.6f * right);
   return camera;
+}
+
+float pixel_size_at(const Camera& camera, const glm::vec3& p, uint32_t height) {
+  const float depth = -(camera.view * glm::vec4(p, 1.0f)).z;  // along the view direction
+  // projection[1][1] is 1 / tan(fov_y / 2), negated for Vulkan's y; a lens shift does not change it.
+  return 2.0f * std::max(depth, 0.0f) / (std::abs(camera.projection[1][1]) * float(std::max(height, 1u)));
 }
 
 glm::vec3 ray_through_pixel(const Camera& camera, glm::vec2 pixel, uint32_t width, uint32_t height) {

@@ -46,13 +46,13 @@ struct Orbit {
   void rotate(float dx, float dy);
   void pan(float dx, float dy, uint32_t height);
   void zoom(float steps);  // positive: closer
-  // The model length one pixel spans at p's depth: what a snap radius in pixels is in model units there.
-  float pixel_size(const glm::vec3& p, uint32_t height) const;
 };
 // The iso view of `box`, at the distance that frame_box would choose for it.
 Orbit frame_orbit(const Box& box, uint32_t width, uint32_t height);
 Camera orbit_camera(const Orbit& orbit, uint32_t width, uint32_t height);
 
+// The model length one pixel spans at p's depth (a perspective camera): a radius in pixels in model units.
+float pixel_size_at(const Camera& camera, const glm::vec3& p, uint32_t height);
 // The unit direction from camera.eye through a point of the image given in pixels from the top-left corner.
 glm::vec3 ray_through_pixel(const Camera& camera, glm::vec2 pixel, uint32_t width, uint32_t height);
 

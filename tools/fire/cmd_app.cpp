@@ -307,7 +307,7 @@ int run_app(const AppArgs& a) {
     e.kind = EventKind::Pen;
     e.p = hit.point;
     const glm::vec3 p(float(hit.point.x()), float(hit.point.y()), float(hit.point.z()));
-    e.snap = a.snap_pixels * double(orbit.pixel_size(p, std::max(height, 1u)));
+    e.snap = a.snap_pixels * double(render::pixel_size_at(camera, p, height));
     log_event(std::move(e));
     return true;
   };
