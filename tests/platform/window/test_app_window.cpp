@@ -42,11 +42,12 @@ Run run(const std::string& command, const fs::path& dir) {
 bool has_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
 
 // fire app under a fresh X server; the validation layer on, LeakSanitizer's suppressions for Mesa in the
-// sanitizer build.
-std::string app_command(const std::string& args, const std::string& env = "") {
+// sanitizer build. Each test case searches for a free display from its own number: xvfb-run -a alone races
+// when ctest -j starts two at once (both take :99).
+std::string app_command(int display, const std::string& args, const std::string& env = "") {
   return "env " + env + " FIRE_VK_VALIDATION=1 LSAN_OPTIONS=suppressions=" + FIRE_LSAN_SUPPRESSIONS +
-         ":print_suppressions=0 xvfb-run -a -s '-screen 0 1280x800x24' timeout 240 " + quote(FIRE_BINARY) +
-         " app " + args;
+         ":print_suppressions=0 xvfb-run -a -n " + std::to_string(display) +
+         " -s '-screen 0 1280x800x24' timeout 240 " + quote(FIRE_BINARY) + " app " + args;
 }
 
 fs::path scratch(const std::string& name) {
@@ -91,7 +92,7 @@ TEST_CASE("fire app: a scripted session in a window, its screenshot and its repl
   const fs::path dir = scratch("session");
   const std::string shot = (dir / "shot.png").string(), record = (dir / "session.log").string(),
                     saved = (dir / "saved.fnet").string();
-  const Run app = run(app_command(quote(FIRE_DEMO_LOG) + " --size 960x600 --script " +
+  const Run app = run(app_command(120, quote(FIRE_DEMO_LOG) + " --size 960x600 --script " +
                                   quote(FIRE_WINDOW_TEST_DIR "/session.script") + " --screenshot " + quote(shot) +
                                   " --record " + quote(record) + " -o " + quote(saved)),
                       dir);
@@ -163,7 +164,7 @@ TEST_CASE("fire app: curves toggled off are not drawn", "[app][window]") {
   REQUIRE(has_xvfb());
   const fs::path dir = scratch("curves_off");
   const std::string shot = (dir / "shot.png").string();
-  const Run app = run(app_command(quote(FIRE_DEMO_LOG) + " --size 640x400 --script " +
+  const Run app = run(app_command(140, quote(FIRE_DEMO_LOG) + " --size 640x400 --script " +
                                   quote(FIRE_WINDOW_TEST_DIR "/curves_off.script") + " --screenshot " + quote(shot)),
                       dir);
   INFO("stdout: " << app.out << "\nstderr: " << app.err);
@@ -182,7 +183,7 @@ TEST_CASE("fire app: strokes drawn with the mouse on a reference mesh replay bit
   REQUIRE(has_xvfb());
   const fs::path dir = scratch("draw");
   const std::string shot = (dir / "shot.png").string(), record = (dir / "draw.log").string();
-  const Run app = run(app_command("--reference " + quote(FIRE_PAWN) + " --size 960x720 --script " +
+  const Run app = run(app_command(160, "--reference " + quote(FIRE_PAWN) + " --size 960x720 --script " +
                                   quote(FIRE_WINDOW_TEST_DIR "/draw_on_pawn.script") + " --screenshot " + quote(shot) +
                                   " --record " + quote(record)),
                       dir);
@@ -244,13 +245,13 @@ TEST_CASE("fire app: no Vulkan device, a reference that does not load: a clear m
   REQUIRE(has_xvfb());
   const fs::path dir = scratch("bad_input");
   const Run no_device =
-      run(app_command("--size 320x200 " + quote(FIRE_DEMO_LOG),
+      run(app_command(180, "--size 320x200 " + quote(FIRE_DEMO_LOG),
                       "VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json"),
           dir);
   INFO("stderr: " << no_device.err);
   CHECK(no_device.exit_code == 1);
   CHECK(no_device.err.find("mesa-vulkan-drivers") != std::string::npos);
-  const Run bad_reference = run(app_command("--reference " + quote((dir / "missing.obj").string())), dir);
+  const Run bad_reference = run(app_command(200, "--reference " + quote((dir / "missing.obj").string())), dir);
   INFO("stderr: " << bad_reference.err);
   CHECK(bad_reference.exit_code == 1);
   CHECK(bad_reference.err.find("--reference: " + (dir / "missing.obj").string()) != std::string::npos);
