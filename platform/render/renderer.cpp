@@ -195,7 +195,7 @@ Renderer::~Renderer() {
   VkDevice device = context_.device();
   vkDeviceWaitIdle(device);  // nothing else to do on failure: everything is destroyed either way
   for (Buffer* b : {&readback_, &points_, &vertices_, &surface_vertices_, &surface_indices_, &reference_vertices_,
-                    &reference_indices_})
+                    &reference_indices_, &stroke_})
     destroy(*b);
   for (Target* t : {&color_, &resolve_, &depth_}) destroy(*t);
   for (VkPipeline p : {background_, surface_, reference_pipeline_, curves_, markers_, wireframe_})
@@ -436,6 +436,19 @@ Status Renderer::upload_surface(const SurfaceLevels& s) {
   return Status::success();
 }
 
+Status Renderer::set_stroke(std::span<const Vec3> points) {
+  stroke_count_ = 0;
+  if (points.size() < 2) return Status::success();
+  bool grown = false;
+  FIRE_TRY(reserve(stroke_, points.size() * sizeof(glm::vec3), kVertex, grown));
+  std::vector<glm::vec3> floats;
+  floats.reserve(points.size());
+  for (const Vec3& p : points) floats.push_back(to_float(p));
+  copy_into(stroke_, 0, floats.data(), floats.size() * sizeof(glm::vec3));
+  stroke_count_ = uint32_t(points.size());
+  return Status::success();
+}
+
 Status Renderer::set_reference(std::span<const Vec3> positions, std::span<const uint32_t> triangles) {
   reference_index_count_ = 0;
   if (triangles.empty()) return Status::success();
@@ -586,6 +599,15 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
     vkCmdBindVertexBuffers(cmd, 0, 1, &reference_vertices_.buffer, &zero);
     vkCmdBindIndexBuffer(cmd, reference_indices_.buffer, 0, VK_INDEX_TYPE_UINT32);
     vkCmdDrawIndexed(cmd, reference_index_count_, 1, 0, 0, 0);
+  }
+  if (stroke_count_) {  // after the see-through reference, so the pen's trace shows in full
+    pc.color = linear(Palette::stroke);
+    pc.params.x = std::max(1.0f, 2.0f * scale);
+    pc.params.w = camera.line_depth_pull * 2.0f;
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, curves_);
+    push();
+    vkCmdBindVertexBuffers(cmd, 0, 1, &stroke_.buffer, &zero);
+    vkCmdDraw(cmd, 6, stroke_count_ - 1, 0, 0);
   }
   vkCmdEndRendering(cmd);
 

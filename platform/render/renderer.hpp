@@ -42,6 +42,7 @@ struct Palette {
   static constexpr uint8_t marker[3] = {250, 250, 250};
   static constexpr uint8_t reference[3] = {120, 170, 255};
   static constexpr uint8_t wireframe[3] = {40, 44, 52};
+  static constexpr uint8_t stroke[3] = {255, 220, 60};  // the stroke being drawn, not yet a curve
 };
 
 // What a frame shows: the app's toggles. The wireframe (the surface's quads as lines) needs the device's
@@ -68,6 +69,10 @@ class Renderer {
   // Brings the GPU copies of the network and the surface up to date (see the top of this file).
   Status upload(const Mesh& network, const SurfaceLevels& surface);
   const UploadStats& last_upload() const { return stats_; }
+  // The stroke in progress (the sketch's samples since pen down), drawn over everything else; empty: none.
+  // Its points are copied whole each call, after upload() so they count in last_upload(): a stroke is short
+  // next to the scene.
+  Status set_stroke(std::span<const Vec3> points);
   // A mesh drawn see-through over the scene (triangles: 3 indices each); empty triangles removes it.
   Status set_reference(std::span<const Vec3> positions, std::span<const uint32_t> triangles);
 
@@ -149,6 +154,8 @@ class Renderer {
   uint32_t surface_index_count_ = 0;
   bool surface_settled_ = true;
 
+  Buffer stroke_;
+  uint32_t stroke_count_ = 0;
   Buffer reference_vertices_, reference_indices_;
   uint32_t reference_index_count_ = 0;
 

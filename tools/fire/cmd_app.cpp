@@ -399,6 +399,8 @@ int run_app(const AppArgs& a) {
     camera = render::orbit_camera(orbit, width, height);
     if (status = (*presenter)->wait(); !status) return false;
     if (status = (*renderer)->upload(w.mesh, w.surface); !status) return false;
+    const std::span<const Vec3> stroke = w.sketch.pen_down ? std::span<const Vec3>(w.sketch.stroke) : std::span<const Vec3>();
+    if (status = (*renderer)->set_stroke(stroke); !status) return false;
     const auto wall_now = WallClock::now();
     hud_data.frame_ms = std::chrono::duration<double, std::milli>(wall_now - last_frame).count();
     last_frame = wall_now;

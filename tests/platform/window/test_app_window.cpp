@@ -230,6 +230,31 @@ TEST_CASE("fire app: strokes drawn with the mouse on a reference mesh replay bit
   fs::remove_all(dir);
 }
 
+TEST_CASE("fire app: the stroke in progress is drawn before it becomes a curve", "[app][window][sketch]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("stroke");
+  const std::string shot = (dir / "shot.png").string();
+  const Run app = run(app_command(220, "--reference " + quote(FIRE_PAWN) + " --size 960x720 --script " +
+                                           quote(FIRE_WINDOW_TEST_DIR "/stroke_in_progress.script") +
+                                           " --screenshot " + quote(shot)),
+                      dir);
+  INFO("stdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  CHECK(nlohmann::json::parse(app.out)["edges"] == 0);  // the pen never went up
+  auto image = fire::render::read_png(shot);
+  REQUIRE(image);
+  // Along the drag from (430, 180) to (530, 210), and nowhere else.
+  size_t inside = 0, outside = 0;
+  for (uint32_t y = 0; y < image->height; ++y)
+    for (uint32_t x = 0; x < image->width; ++x)
+      if (near(image->pixel(x, y), Palette::stroke, 40)) (x >= 420 && x <= 540 && y >= 170 && y <= 220 ? inside : outside)++;
+  INFO("stroke pixels inside " << inside << ", outside " << outside);
+  CHECK(inside > 150);
+  CHECK(outside < 10);
+  CHECK(curve_pixels(*image) < 20);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("fire app without a display: a clear message, exit 1, no crash", "[app][window]") {
   const fs::path dir = scratch("no_display");
   const Run app = run("env -u DISPLAY -u WAYLAND_DISPLAY " + quote(FIRE_BINARY) + " app " + quote(FIRE_DEMO_LOG), dir);
