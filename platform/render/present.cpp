@@ -129,11 +129,11 @@ Status Presenter::create_swapchain(uint32_t width, uint32_t height) {
     return Status::failure("the window's images cannot be a transfer destination (needed to show the rendered frame)");
   can_capture_ = caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
 
-  min_image_count_ = std::max(caps.minImageCount + 1, 2u);
-  if (caps.maxImageCount) min_image_count_ = std::min(min_image_count_, caps.maxImageCount);
+  uint32_t min_images = std::max(caps.minImageCount + 1, 2u);  // one to draw while one is shown
+  if (caps.maxImageCount) min_images = std::min(min_images, caps.maxImageCount);
   VkSwapchainCreateInfoKHR info{VK_STRUCTURE_TYPE_SWAPCHAIN_CREATE_INFO_KHR};
   info.surface = surface_;
-  info.minImageCount = min_image_count_;
+  info.minImageCount = min_images;
   info.imageFormat = format_.format;
   info.imageColorSpace = format_.colorSpace;
   info.imageExtent = extent;

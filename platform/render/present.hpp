@@ -35,18 +35,15 @@ class Presenter {
   // presented is read back into it (RGBA, top row first), waiting for the frame.
   Result<bool> frame(Renderer& renderer, const Camera& camera, const DrawOptions& options, const Overlay& overlay,
                      Image* capture = nullptr);
-  // Recreates the swapchain for a window of this size; a zero size (minimised) leaves none until a later call.
+  // Recreates the swapchain for a window of this size; at a zero size (minimised) frame() shows nothing
+  // until a later call.
   Status resize(uint32_t width, uint32_t height);
   // Commands recorded once and waited for (the HUD's font upload).
   Status run_once(const std::function<void(VkCommandBuffer)>& record);
 
   VkRenderPass overlay_pass() const { return overlay_pass_; }
-  uint32_t image_count() const { return uint32_t(images_.size()); }
-  uint32_t min_image_count() const { return min_image_count_; }
   // Whether the window's images encode to sRGB on write (colours drawn into them are then linear).
   bool srgb() const { return format_.format == VK_FORMAT_B8G8R8A8_SRGB || format_.format == VK_FORMAT_R8G8B8A8_SRGB; }
-  uint32_t width() const { return extent_.width; }
-  uint32_t height() const { return extent_.height; }
 
  private:
   explicit Presenter(Context& context, VkSurfaceKHR surface) : context_(context), surface_(surface) {}
@@ -60,7 +57,6 @@ class Presenter {
   VkSurfaceFormatKHR format_{};
   VkSwapchainKHR swapchain_ = VK_NULL_HANDLE;
   VkExtent2D extent_{0, 0};
-  uint32_t min_image_count_ = 2;
   bool can_capture_ = false;  // the swapchain images can be a transfer source
   std::vector<VkImage> images_;
   std::vector<VkImageView> views_;

@@ -83,7 +83,6 @@ class Renderer {
   // color_image(), is left in TRANSFER_SRC_OPTIMAL, its writes made visible to transfers.
   void record(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options);
   VkImage color_image() const { return resolve_.image; }
-  VkFormat color_format() const { return color_format_; }
   // New target size (a resized window); waits for the device first. Uploaded data is kept.
   Status resize(uint32_t width, uint32_t height);
 
