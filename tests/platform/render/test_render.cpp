@@ -315,7 +315,7 @@ TEST_CASE("framing keeps every corner of the box inside the image") {
   }
 }
 
-TEST_CASE("the app's orbit camera: a ray through a pixel lands on that pixel; pixel sizes; gestures") {
+TEST_CASE("the app's orbit camera: a ray through a pixel lands on it, pixel sizes, pan, zoom and pitch") {
   Box box;
   box.add(Vec3(-1, -0.5, 0));
   box.add(Vec3(1, 0.5, 2));
