@@ -3,6 +3,7 @@
 #include "engine/text.hpp"
 
 #include <charconv>
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -89,7 +90,14 @@ Result<InputLog> parse_input_log(std::string_view text, const std::string& sourc
     std::string_view kind = f[1];
     if (kind == "pen") {
       e.kind = EventKind::Pen;
-      if (!parse_point(f, 2, e.p)) return fail(line_no, "pen needs three numbers x y z");
+      // An optional fourth number: the snap radius the sample was drawn with (a mouse's, from screen pixels).
+      const bool with_snap = f.size() == 6;
+      if (with_snap) {
+        if (!parse_double(f[5], e.snap) || !(e.snap > 0) || !std::isfinite(e.snap))
+          return fail(line_no, "pen's snap radius must be a positive finite number");
+        f.pop_back();
+      }
+      if (!parse_point(f, 2, e.p)) return fail(line_no, "pen needs three numbers x y z and an optional snap radius");
     } else if (kind == "down" || kind == "up") {
       e.kind = kind == "down" ? EventKind::Down : EventKind::Up;
       if (f.size() != 2) return fail(line_no, std::string(kind) + " takes no fields");
@@ -158,7 +166,10 @@ std::string format_event(const InputEvent& e) {
     return format_double(p.x()) + ' ' + format_double(p.y()) + ' ' + format_double(p.z());
   };
   switch (e.kind) {
-    case EventKind::Pen: s += "pen " + point(e.p); break;
+    case EventKind::Pen:
+      s += "pen " + point(e.p);
+      if (e.snap > 0) s += ' ' + format_double(e.snap);
+      break;
     case EventKind::Down: s += "down"; break;
     case EventKind::Up: s += "up"; break;
     case EventKind::Command:

@@ -16,6 +16,7 @@ struct InputEvent {
   int64_t t_us = 0;
   EventKind kind = EventKind::Pen;
   Vec3 p = Vec3::Zero();              // Pen sample; Delete command's pick point
+  double snap = 0;                    // Pen: snap radius for a stroke end at this sample; 0: the session's setting
   CommandKind command = CommandKind::Undo;
   int device = 0;                     // Hid
   bool hid_ok = true;                 // Hid: false when the hex was garbled (bytes then empty)

@@ -37,6 +37,25 @@ struct Camera {
 // most of the image and far enough that every corner stays inside it.
 Camera frame_box(const Box& box, View view, uint32_t width, uint32_t height);
 
+// The app's camera: orbits `target` at `distance`, `yaw` about Z from +X, `pitch` above the XY plane.
+struct Orbit {
+  glm::vec3 target{0.0f};
+  float distance = 1.0f, yaw = 0.0f, pitch = 0.0f;
+  float radius = 1.0f;  // of the scene: sets the depth range and how far curves are pulled towards the viewer
+  // Mouse gestures, in window pixels.
+  void rotate(float dx, float dy);
+  void pan(float dx, float dy, uint32_t height);
+  void zoom(float steps);  // positive: closer
+};
+// The iso view of `box`, at the distance that frame_box would choose for it.
+Orbit frame_orbit(const Box& box, uint32_t width, uint32_t height);
+Camera orbit_camera(const Orbit& orbit, uint32_t width, uint32_t height);
+
+// The model length one pixel spans at p's depth (a perspective camera): a radius in pixels in model units.
+float pixel_size_at(const Camera& camera, const glm::vec3& p, uint32_t height);
+// The unit direction from camera.eye through a point of the image given in pixels from the top-left corner.
+glm::vec3 ray_through_pixel(const Camera& camera, glm::vec2 pixel, uint32_t width, uint32_t height);
+
 // Where a world point lands in the image, in pixels from the top-left corner.
 glm::vec2 project_to_pixels(const Camera& camera, const Vec3& p, uint32_t width, uint32_t height);
 

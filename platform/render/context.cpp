@@ -116,18 +116,23 @@ Status Context::init(const ContextOptions& options) {
   messenger.pfnUserCallback = on_validation_message;
   messenger.pUserData = this;
   const char* layers[] = {kValidationLayer};
-  const char* extensions[] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME};
+  std::vector<const char*> extensions;
+  for (const std::string& e : options.instance_extensions) extensions.push_back(e.c_str());
   VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
   info.pApplicationInfo = &app;
   if (options.validation) {
     info.enabledLayerCount = 1;
     info.ppEnabledLayerNames = layers;
-    info.enabledExtensionCount = 1;
-    info.ppEnabledExtensionNames = extensions;
+    extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
     info.pNext = &messenger;  // also reports on instance creation and destruction
   }
+  info.enabledExtensionCount = uint32_t(extensions.size());
+  info.ppEnabledExtensionNames = extensions.data();
   const VkResult created = vkCreateInstance(&info, nullptr, &instance_);
   if (created == VK_ERROR_INCOMPATIBLE_DRIVER) return Status::failure(kNoDevice);
+  if (created == VK_ERROR_EXTENSION_NOT_PRESENT && !options.instance_extensions.empty())
+    return Status::failure("vkCreateInstance failed: the Vulkan loader lacks an instance extension the window needs "
+                           "(VK_KHR_surface and the X11 or Wayland surface extension)");
   if (created != VK_SUCCESS) return Status::failure(vk_failure("vkCreateInstance", created));
   if (options.validation) {
     auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
@@ -135,7 +140,7 @@ Status Context::init(const ContextOptions& options) {
     if (!create_messenger) return Status::failure("vkCreateDebugUtilsMessengerEXT is not available");
     FIRE_VK_TRY(create_messenger(instance_, &messenger, nullptr, &messenger_));
   }
-  FIRE_TRY(pick_device());
+  FIRE_TRY(pick_device(options));
 
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo queue{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
@@ -145,16 +150,39 @@ Status Context::init(const ContextOptions& options) {
   VkPhysicalDeviceVulkan13Features features13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
   features13.dynamicRendering = VK_TRUE;
   features13.synchronization2 = VK_TRUE;
+  VkPhysicalDeviceFeatures supported{};
+  vkGetPhysicalDeviceFeatures(physical_, &supported);
+  VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  features.pNext = &features13;
+  features.features.fillModeNonSolid = supported.fillModeNonSolid;
+  wireframe_ = supported.fillModeNonSolid;
+  const char* swapchain[] = {VK_KHR_SWAPCHAIN_EXTENSION_NAME};
   VkDeviceCreateInfo device{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
-  device.pNext = &features13;
+  device.pNext = &features;
   device.queueCreateInfoCount = 1;
   device.pQueueCreateInfos = &queue;
+  if (options.can_present) {
+    device.enabledExtensionCount = 1;
+    device.ppEnabledExtensionNames = swapchain;
+  }
   FIRE_VK_TRY(vkCreateDevice(physical_, &device, nullptr, &device_));
   vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
   return Status::success();
 }
 
-Status Context::pick_device() {
+namespace {
+bool has_device_extension(VkPhysicalDevice device, const char* name) {
+  uint32_t count = 0;
+  if (vkEnumerateDeviceExtensionProperties(device, nullptr, &count, nullptr) != VK_SUCCESS) return false;
+  std::vector<VkExtensionProperties> extensions(count);
+  if (vkEnumerateDeviceExtensionProperties(device, nullptr, &count, extensions.data()) != VK_SUCCESS) return false;
+  for (const auto& e : extensions)
+    if (std::strcmp(e.extensionName, name) == 0) return true;
+  return false;
+}
+}  // namespace
+
+Status Context::pick_device(const ContextOptions& options) {
   uint32_t count = 0;
   const VkResult listed = vkEnumeratePhysicalDevices(instance_, &count, nullptr);
   if (listed == VK_ERROR_INITIALIZATION_FAILED || (listed == VK_SUCCESS && count == 0)) return Status::failure(kNoDevice);
@@ -171,12 +199,14 @@ Status Context::pick_device() {
     f.pNext = &f13;
     vkGetPhysicalDeviceFeatures2(d, &f);
     if (!f13.dynamicRendering || !f13.synchronization2) continue;
+    if (options.can_present && !has_device_extension(d, VK_KHR_SWAPCHAIN_EXTENSION_NAME)) continue;
     uint32_t families = 0;
     vkGetPhysicalDeviceQueueFamilyProperties(d, &families, nullptr);
     std::vector<VkQueueFamilyProperties> props(families);
     vkGetPhysicalDeviceQueueFamilyProperties(d, &families, props.data());
     for (uint32_t q = 0; q < families; ++q) {
       if (!(props[q].queueFlags & VK_QUEUE_GRAPHICS_BIT)) continue;
+      if (options.can_present && !options.can_present(instance_, d, q)) continue;
       if (device_rank(p.deviceType) > best_rank) {
         best_rank = device_rank(p.deviceType);
         physical_ = d;
@@ -186,6 +216,9 @@ Status Context::pick_device() {
       break;
     }
   }
+  if (!physical_ && options.can_present)
+    return Status::failure(std::string(kNoDevice) + " (a device was needed whose queue can present to the window, "
+                           "with VK_KHR_swapchain)");
   if (!physical_) return Status::failure(kNoDevice);
   vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
   return Status::success();

@@ -13,6 +13,7 @@
 // names the call that failed.
 #include <vulkan/vulkan.h>
 
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -45,6 +46,10 @@ bool validation_default();
 
 struct ContextOptions {
   bool validation = validation_default();
+  // For a window: the instance extensions its surface needs (from GLFW), and a test of whether a queue
+  // family of a device can present to it; with it set, VK_KHR_swapchain is required of the device too.
+  std::vector<std::string> instance_extensions;
+  std::function<bool(VkInstance, VkPhysicalDevice, uint32_t family)> can_present;
 };
 
 class Context {
@@ -63,6 +68,8 @@ class Context {
   std::string device_name() const { return properties_.deviceName; }
   bool is_cpu_device() const { return properties_.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU; }
   bool validation() const { return messenger_ != VK_NULL_HANDLE; }
+  // Whether polygons can be drawn as lines (the renderer's wireframe).
+  bool wireframe_supported() const { return wireframe_; }
 
   // A memory type among `type_bits` with all of `flags`.
   Result<uint32_t> memory_type(uint32_t type_bits, VkMemoryPropertyFlags flags) const;
@@ -76,7 +83,7 @@ class Context {
  private:
   Context() = default;
   Status init(const ContextOptions& options);
-  Status pick_device();
+  Status pick_device(const ContextOptions& options);
 
   VkInstance instance_ = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
@@ -85,6 +92,7 @@ class Context {
   VkQueue queue_ = VK_NULL_HANDLE;
   uint32_t queue_family_ = 0;
   VkPhysicalDeviceProperties properties_{};
+  bool wireframe_ = false;
   VkPhysicalDeviceMemoryProperties memory_{};
   mutable std::mutex messages_mutex_;  // the layer may report from any thread that calls Vulkan
   std::vector<std::string> messages_;

@@ -13,6 +13,7 @@
 #include "shaders/marker_vert.h"
 #include "shaders/surface_frag.h"
 #include "shaders/surface_vert.h"
+#include "shaders/wireframe_frag.h"
 
 namespace fire::render {
 
@@ -47,6 +48,7 @@ struct PipelineDesc {
   std::vector<VkVertexInputBindingDescription> bindings;
   std::vector<VkVertexInputAttributeDescription> attributes;
   bool depth_test = true, depth_write = true, blend = false;
+  bool lines = false;  // polygons as lines, pulled towards the viewer by a depth bias (the wireframe)
 };
 
 }  // namespace
@@ -69,15 +71,7 @@ Status Renderer::init() {
   if (!(depth_props.optimalTilingFeatures & VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT))
     depth_format_ = VK_FORMAT_X8_D24_UNORM_PACK32;  // one of the two is always supported
 
-  if (samples_ != VK_SAMPLE_COUNT_1_BIT)
-    FIRE_TRY(create_target(color_, color_format_, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSIENT_ATTACHMENT_BIT,
-                           samples_, VK_IMAGE_ASPECT_COLOR_BIT));
-  FIRE_TRY(create_target(resolve_, color_format_, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                         VK_SAMPLE_COUNT_1_BIT, VK_IMAGE_ASPECT_COLOR_BIT));
-  FIRE_TRY(create_target(depth_, depth_format_, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, samples_,
-                         VK_IMAGE_ASPECT_DEPTH_BIT));
-  bool grown = false;
-  FIRE_TRY(reserve(readback_, VkDeviceSize(settings_.width) * settings_.height * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, grown));
+  FIRE_TRY(create_targets());
 
   VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
@@ -91,6 +85,29 @@ Status Renderer::init() {
   VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   FIRE_VK_TRY(vkCreateFence(device, &fence, nullptr, &fence_));
   return create_pipelines();
+}
+
+Status Renderer::create_targets() {
+  if (samples_ != VK_SAMPLE_COUNT_1_BIT)
+    FIRE_TRY(create_target(color_, color_format_, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSIENT_ATTACHMENT_BIT,
+                           samples_, VK_IMAGE_ASPECT_COLOR_BIT));
+  FIRE_TRY(create_target(resolve_, color_format_, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                         VK_SAMPLE_COUNT_1_BIT, VK_IMAGE_ASPECT_COLOR_BIT));
+  FIRE_TRY(create_target(depth_, depth_format_, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, samples_,
+                         VK_IMAGE_ASPECT_DEPTH_BIT));
+  bool grown = false;
+  return reserve(readback_, VkDeviceSize(settings_.width) * settings_.height * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, grown);
+}
+
+Status Renderer::resize(uint32_t width, uint32_t height) {
+  if (width == 0 || height == 0 || width > 8192 || height > 8192)
+    return Status::failure("image size must be 1 to 8192 pixels a side");
+  FIRE_VK_TRY(vkDeviceWaitIdle(context_.device()));  // the old targets may still be in use
+  for (Target* t : {&color_, &resolve_, &depth_}) destroy(*t);
+  destroy(readback_);
+  settings_.width = width;
+  settings_.height = height;
+  return create_targets();
 }
 
 Status Renderer::create_target(Target& target, VkFormat format, VkImageUsageFlags usage, VkSampleCountFlagBits samples,
@@ -178,10 +195,10 @@ Renderer::~Renderer() {
   VkDevice device = context_.device();
   vkDeviceWaitIdle(device);  // nothing else to do on failure: everything is destroyed either way
   for (Buffer* b : {&readback_, &points_, &vertices_, &surface_vertices_, &surface_indices_, &reference_vertices_,
-                    &reference_indices_})
+                    &reference_indices_, &stroke_})
     destroy(*b);
   for (Target* t : {&color_, &resolve_, &depth_}) destroy(*t);
-  for (VkPipeline p : {background_, surface_, reference_pipeline_, curves_, markers_})
+  for (VkPipeline p : {background_, surface_, reference_pipeline_, curves_, markers_, wireframe_})
     if (p) vkDestroyPipeline(device, p, nullptr);
   if (layout_) vkDestroyPipelineLayout(device, layout_, nullptr);
   if (fence_) vkDestroyFence(device, fence_, nullptr);
@@ -226,7 +243,10 @@ Status Renderer::create_pipelines() {
       viewport.viewportCount = 1;
       viewport.scissorCount = 1;
       VkPipelineRasterizationStateCreateInfo raster{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
-      raster.polygonMode = VK_POLYGON_MODE_FILL;
+      raster.polygonMode = d.lines ? VK_POLYGON_MODE_LINE : VK_POLYGON_MODE_FILL;
+      raster.depthBiasEnable = d.lines;
+      raster.depthBiasConstantFactor = d.lines ? -4.0f : 0.0f;
+      raster.depthBiasSlopeFactor = d.lines ? -1.0f : 0.0f;
       raster.cullMode = VK_CULL_MODE_NONE;  // open surfaces are seen from both sides
       raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
       raster.lineWidth = 1.0f;
@@ -295,6 +315,12 @@ Status Renderer::create_pipelines() {
   FIRE_TRY(build(surface, surface_));
   FIRE_TRY(build(reference, reference_pipeline_));
   FIRE_TRY(build(curves, curves_));
+  if (context_.wireframe_supported()) {
+    PipelineDesc wireframe = surface;
+    wireframe.frag = wireframe_frag;
+    wireframe.lines = true;
+    FIRE_TRY(build(wireframe, wireframe_));
+  }
   return build(markers, markers_);
 }
 
@@ -410,6 +436,19 @@ Status Renderer::upload_surface(const SurfaceLevels& s) {
   return Status::success();
 }
 
+Status Renderer::set_stroke(std::span<const Vec3> points) {
+  stroke_count_ = 0;
+  if (points.size() < 2) return Status::success();
+  bool grown = false;
+  FIRE_TRY(reserve(stroke_, points.size() * sizeof(glm::vec3), kVertex, grown));
+  std::vector<glm::vec3> floats;
+  floats.reserve(points.size());
+  for (const Vec3& p : points) floats.push_back(to_float(p));
+  copy_into(stroke_, 0, floats.data(), floats.size() * sizeof(glm::vec3));
+  stroke_count_ = uint32_t(points.size());
+  return Status::success();
+}
+
 Status Renderer::set_reference(std::span<const Vec3> positions, std::span<const uint32_t> triangles) {
   reference_index_count_ = 0;
   if (triangles.empty()) return Status::success();
@@ -437,14 +476,7 @@ Status Renderer::set_reference(std::span<const Vec3> positions, std::span<const 
   return Status::success();
 }
 
-Status Renderer::draw(const Camera& camera) {
-  VkDevice device = context_.device();
-  VkCommandBuffer cmd = commands_;
-  FIRE_VK_TRY(vkResetFences(device, 1, &fence_));
-  FIRE_VK_TRY(vkResetCommandBuffer(cmd, 0));
-  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  FIRE_VK_TRY(vkBeginCommandBuffer(cmd, &begin));
+void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options) {
 
   // Every target starts undefined: the frame clears or overwrites all of it.
   auto to_attachment = [](VkImage image, VkImageLayout layout, VkImageAspectFlags aspect, VkPipelineStageFlags2 stage,
@@ -526,7 +558,7 @@ Status Renderer::draw(const Camera& camera) {
     vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof bg, &bg);
     vkCmdDraw(cmd, 3, 1, 0, 0);
   }
-  if (surface_index_count_) {
+  if (surface_index_count_ && options.surface) {
     pc.color = linear(surface_settled_ ? Palette::surface : Palette::provisional_surface);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, surface_);
     push();
@@ -534,7 +566,15 @@ Status Renderer::draw(const Camera& camera) {
     vkCmdBindIndexBuffer(cmd, surface_indices_.buffer, 0, VK_INDEX_TYPE_UINT32);
     vkCmdDrawIndexed(cmd, surface_index_count_, 1, 0, 0, 0);
   }
-  if (!curve_draws_.empty()) {
+  if (surface_index_count_ && options.wireframe && wireframe_) {
+    pc.color = linear(Palette::wireframe);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, wireframe_);
+    push();
+    vkCmdBindVertexBuffers(cmd, 0, 1, &surface_vertices_.buffer, &zero);
+    vkCmdBindIndexBuffer(cmd, surface_indices_.buffer, 0, VK_INDEX_TYPE_UINT32);
+    vkCmdDrawIndexed(cmd, surface_index_count_, 1, 0, 0, 0);
+  }
+  if (!curve_draws_.empty() && options.curves) {
     pc.color = linear(Palette::curve);
     pc.params.x = std::max(1.0f, 1.6f * scale);
     pc.params.w = camera.line_depth_pull;
@@ -543,7 +583,7 @@ Status Renderer::draw(const Camera& camera) {
     vkCmdBindVertexBuffers(cmd, 0, 1, &points_.buffer, &zero);
     for (const auto& [first, count] : curve_draws_) vkCmdDraw(cmd, 6, count - 1, 0, first);
   }
-  if (!marker_draws_.empty()) {
+  if (!marker_draws_.empty() && options.curves) {
     pc.color = linear(Palette::marker);
     pc.params.x = std::max(2.5f, 4.5f * scale);
     pc.params.w = camera.line_depth_pull * 2.0f;
@@ -560,13 +600,22 @@ Status Renderer::draw(const Camera& camera) {
     vkCmdBindIndexBuffer(cmd, reference_indices_.buffer, 0, VK_INDEX_TYPE_UINT32);
     vkCmdDrawIndexed(cmd, reference_index_count_, 1, 0, 0, 0);
   }
+  if (stroke_count_) {  // after the see-through reference, so the pen's trace shows in full
+    pc.color = linear(Palette::stroke);
+    pc.params.x = std::max(1.0f, 2.0f * scale);
+    pc.params.w = camera.line_depth_pull * 2.0f;
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, curves_);
+    push();
+    vkCmdBindVertexBuffers(cmd, 0, 1, &stroke_.buffer, &zero);
+    vkCmdDraw(cmd, 6, stroke_count_ - 1, 0, 0);
+  }
   vkCmdEndRendering(cmd);
 
-  // The resolved image to the readback buffer, then visible to the host.
+  // The resolved image ready to be copied (readback) or blitted (present).
   VkImageMemoryBarrier2 to_copy{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
   to_copy.srcStageMask = color_stage;
   to_copy.srcAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
-  to_copy.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+  to_copy.dstStageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;  // a copy (readback) or a blit (present)
   to_copy.dstAccessMask = VK_ACCESS_2_TRANSFER_READ_BIT;
   to_copy.oldLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
   to_copy.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
@@ -577,6 +626,17 @@ Status Renderer::draw(const Camera& camera) {
   dependency.imageMemoryBarrierCount = 1;
   dependency.pImageMemoryBarriers = &to_copy;
   vkCmdPipelineBarrier2(cmd, &dependency);
+}
+
+Status Renderer::draw(const Camera& camera, const DrawOptions& options) {
+  VkDevice device = context_.device();
+  VkCommandBuffer cmd = commands_;
+  FIRE_VK_TRY(vkResetFences(device, 1, &fence_));
+  FIRE_VK_TRY(vkResetCommandBuffer(cmd, 0));
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  FIRE_VK_TRY(vkBeginCommandBuffer(cmd, &begin));
+  record(cmd, camera, options);
   VkBufferImageCopy region{};
   region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
   region.imageExtent = {settings_.width, settings_.height, 1};
@@ -589,7 +649,7 @@ Status Renderer::draw(const Camera& camera) {
   to_host.srcQueueFamilyIndex = to_host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   to_host.buffer = readback_.buffer;
   to_host.size = VK_WHOLE_SIZE;
-  dependency = {VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
   dependency.bufferMemoryBarrierCount = 1;
   dependency.pBufferMemoryBarriers = &to_host;
   vkCmdPipelineBarrier2(cmd, &dependency);

@@ -41,6 +41,14 @@ struct Palette {
   static constexpr uint8_t provisional_surface[3] = {132, 196, 214};  // light teal: not settled yet
   static constexpr uint8_t marker[3] = {250, 250, 250};
   static constexpr uint8_t reference[3] = {120, 170, 255};
+  static constexpr uint8_t wireframe[3] = {40, 44, 52};
+  static constexpr uint8_t stroke[3] = {255, 220, 60};  // the stroke being drawn, not yet a curve
+};
+
+// What a frame shows: the app's toggles. The wireframe (the surface's quads as lines) needs the device's
+// fillModeNonSolid (Context::wireframe_supported); without it the wireframe is not drawn.
+struct DrawOptions {
+  bool surface = true, curves = true, wireframe = false;
 };
 
 struct UploadStats {
@@ -61,12 +69,22 @@ class Renderer {
   // Brings the GPU copies of the network and the surface up to date (see the top of this file).
   Status upload(const Mesh& network, const SurfaceLevels& surface);
   const UploadStats& last_upload() const { return stats_; }
+  // The stroke in progress (the sketch's samples since pen down), drawn over everything else; empty: none.
+  // Its points are copied whole each call, after upload() so they count in last_upload(): a stroke is short
+  // next to the scene.
+  Status set_stroke(std::span<const Vec3> points);
   // A mesh drawn see-through over the scene (triangles: 3 indices each); empty triangles removes it.
   Status set_reference(std::span<const Vec3> positions, std::span<const uint32_t> triangles);
 
   // Draws one frame and waits for it; the result is then in image().
-  Status draw(const Camera& camera);
+  Status draw(const Camera& camera, const DrawOptions& options = {});
   Image image() const;
+  // The present path (present.hpp): records the frame into `cmd` without submitting it. The resolved image,
+  // color_image(), is left in TRANSFER_SRC_OPTIMAL, its writes made visible to transfers.
+  void record(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options);
+  VkImage color_image() const { return resolve_.image; }
+  // New target size (a resized window); waits for the device first. Uploaded data is kept.
+  Status resize(uint32_t width, uint32_t height);
 
   uint32_t width() const { return settings_.width; }
   uint32_t height() const { return settings_.height; }
@@ -87,6 +105,7 @@ class Renderer {
  private:
   explicit Renderer(Context& context, const RenderSettings& settings) : context_(context), settings_(settings) {}
   Status init();
+  Status create_targets();
   Status create_target(Target& target, VkFormat format, VkImageUsageFlags usage, VkSampleCountFlagBits samples,
                        VkImageAspectFlags aspect);
   // Makes `buffer` hold at least `bytes`; `grown` tells whether its old content was lost.
@@ -111,7 +130,7 @@ class Renderer {
   VkFence fence_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkPipeline background_ = VK_NULL_HANDLE, surface_ = VK_NULL_HANDLE, reference_pipeline_ = VK_NULL_HANDLE,
-             curves_ = VK_NULL_HANDLE, markers_ = VK_NULL_HANDLE;
+             curves_ = VK_NULL_HANDLE, markers_ = VK_NULL_HANDLE, wireframe_ = VK_NULL_HANDLE;
 
   // Network: float points at pool indices, and what was uploaded per edge slot.
   struct EdgeRecord {
@@ -134,6 +153,8 @@ class Renderer {
   uint32_t surface_index_count_ = 0;
   bool surface_settled_ = true;
 
+  Buffer stroke_;
+  uint32_t stroke_count_ = 0;
   Buffer reference_vertices_, reference_indices_;
   uint32_t reference_index_count_ = 0;
 

@@ -1,6 +1,8 @@
-// Bounding volume hierarchy for closest-point queries on triangles.
+// Bounding volume hierarchy for closest-point queries and ray casts on triangles.
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <numeric>
 
@@ -14,6 +16,38 @@ constexpr uint32_t kLeafSize = 4;
 
 double box_distance_squared(const Vec3& p, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   return (lo - p).cwiseMax(p - hi).cwiseMax(0.0).squaredNorm();
+}
+
+// Entry parameter of the ray into the box (0 if it starts inside), or infinity if it misses it.
+double box_entry(const Vec3& origin, const Vec3& inverse, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  double t_in = 0, t_out = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 3; ++k) {
+    double a = (lo[k] - origin[k]) * inverse[k], b = (hi[k] - origin[k]) * inverse[k];
+    if (std::isnan(a) || std::isnan(b)) {  // parallel to the slab and on its plane: inside along this axis
+      if (origin[k] < lo[k] || origin[k] > hi[k]) return std::numeric_limits<double>::infinity();
+      continue;
+    }
+    if (a > b) std::swap(a, b);
+    t_in = std::max(t_in, a);
+    t_out = std::min(t_out, b);
+  }
+  return t_in <= t_out ? t_in : std::numeric_limits<double>::infinity();
+}
+
+// Möller-Trumbore: the ray parameter where it meets triangle abc, or infinity.
+double triangle_hit(const Vec3& origin, const Vec3& direction, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 e1 = b - a, e2 = c - a, h = direction.cross(e2);
+  const double det = e1.dot(h);
+  if (std::abs(det) < 1e-300) return std::numeric_limits<double>::infinity();  // parallel or degenerate
+  const double inv = 1.0 / det;
+  const Vec3 s = origin - a;
+  const double u = inv * s.dot(h);
+  if (u < 0.0 || u > 1.0) return std::numeric_limits<double>::infinity();
+  const Vec3 q = s.cross(e1);
+  const double v = inv * direction.dot(q);
+  if (v < 0.0 || u + v > 1.0) return std::numeric_limits<double>::infinity();
+  const double t = inv * e2.dot(q);
+  return t > 0.0 ? t : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace
@@ -108,6 +142,47 @@ TriangleBvh::Hit TriangleBvh::closest(const Vec3& p, uint32_t hint) const {
     const double d_near = left_first ? d_left : d_right, d_far = left_first ? d_right : d_left;
     if (d_far < best.distance_squared) stack[top++] = far;
     if (d_near < best.distance_squared) stack[top++] = near;
+  }
+  return best;
+}
+
+TriangleBvh::Hit TriangleBvh::ray_cast(const Vec3& origin, const Vec3& direction) const {
+  Hit best;
+  double best_t = std::numeric_limits<double>::infinity();
+  if (nodes_.empty()) return best;
+  const Vec3 inverse = direction.cwiseInverse();  // +-infinity on an axis the ray does not move along
+  std::array<uint32_t, 64> stack;
+  size_t top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    const double entry = box_entry(origin, inverse, node.lo, node.hi);
+    if (entry == std::numeric_limits<double>::infinity() || entry > best_t) continue;
+    if (node.count > 0) {
+      for (uint32_t slot = node.first; slot < node.first + node.count; ++slot) {
+        const Vec3* c = &corners_[3 * size_t{slot}];
+        const double t = triangle_hit(origin, direction, c[0], c[1], c[2]);
+        if (t < best_t || (t == best_t && t < std::numeric_limits<double>::infinity() && order_[slot] < best.triangle)) {
+          best_t = t;
+          best.triangle = order_[slot];
+        }
+      }
+      continue;
+    }
+    // Nearer box first: push it last.
+    const double t_left = box_entry(origin, inverse, nodes_[node.first].lo, nodes_[node.first].hi);
+    const double t_right = box_entry(origin, inverse, nodes_[node.first + 1].lo, nodes_[node.first + 1].hi);
+    const bool left_first = t_left <= t_right;
+    const uint32_t near = left_first ? node.first : node.first + 1, far = left_first ? node.first + 1 : node.first;
+    // The parents' checks would drop a missed box too; this keeps the stack to boxes the ray may meet.
+    const double t_near = std::min(t_left, t_right), t_far = std::max(t_left, t_right);
+    const double inf = std::numeric_limits<double>::infinity();
+    if (t_far < inf && t_far <= best_t) stack[top++] = far;
+    if (t_near < inf && t_near <= best_t) stack[top++] = near;
+  }
+  if (best.triangle != kNoTriangle) {
+    best.point = origin + best_t * direction;
+    best.distance_squared = best_t * best_t * direction.squaredNorm();
   }
   return best;
 }

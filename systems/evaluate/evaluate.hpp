@@ -35,7 +35,7 @@ Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, cons
 Vec3 closest_point_on_segment(const Vec3& p, const Vec3& a, const Vec3& b);
 
 // A binary bounding volume hierarchy over a mesh's triangles (median split on the longest axis,
-// up to 4 triangles per leaf) answering exact closest-point queries.
+// up to 4 triangles per leaf) answering exact closest-point queries and ray casts (the app's mouse pen).
 class TriangleBvh {
  public:
   explicit TriangleBvh(const TriangleMesh& mesh);
@@ -48,6 +48,10 @@ class TriangleBvh {
   // `hint`: a triangle likely to be close (e.g. the previous query's), which tightens the search bound
   // from the start. The result does not depend on the hint except among equally close triangles.
   Hit closest(const Vec3& p, uint32_t hint = kNoTriangle) const;
+  // The first triangle a ray meets (from either side), at ray parameter t > 0: point = origin + t * direction,
+  // distance_squared its squared distance to origin; triangle == kNoTriangle when it meets none. Equal t on
+  // several triangles (a shared edge): the lowest triangle index.
+  Hit ray_cast(const Vec3& origin, const Vec3& direction) const;
   size_t node_count() const { return nodes_.size(); }
 
  private:

@@ -97,7 +97,10 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
         state.stroke.clear();
         break;
       case EventKind::Pen:
-        if (state.pen_down) state.stroke.push_back(ev.p);
+        if (!state.pen_down) break;
+        if (state.stroke.empty()) state.start_snap = ev.snap;
+        state.end_snap = ev.snap;
+        state.stroke.push_back(ev.p);
         break;
       case EventKind::Up: {
         if (!state.pen_down) {
@@ -118,21 +121,23 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           reject("the stroke has a pen sample that is not finite (NaN or infinity)");
           break;
         }
+        auto radius = [&](double logged) { return logged > 0 ? logged : settings.snap_distance; };
+        const double end_snap = radius(state.end_snap), both_snap = std::max(radius(state.start_snap), end_snap);
         if (mesh.edge_count() == 0) {
           r.command.kind = EditKind::StartBorder;
         } else if (border_open(mesh)) {
           auto [first, last] = border_ends(mesh);
           const Vec3& first_position = mesh.vertices.position[first];
           double gap = (r.command.points.back() - first_position).norm();
-          r.command.kind = gap <= settings.snap_distance ? EditKind::CloseBorder : EditKind::AppendBorder;
-          r.command.snap_distance = settings.snap_distance;
+          r.command.kind = gap <= end_snap ? EditKind::CloseBorder : EditKind::AppendBorder;
+          r.command.snap_distance = end_snap;
           blend_ends(r.command.points, mesh.vertices.position[last],
                      r.command.kind == EditKind::CloseBorder ? first_position : r.command.points.back());
         } else {
-          Snap s = snap_to_face(mesh, snap, r.command.points.front(), r.command.points.back(), settings.snap_distance);
+          Snap s = snap_to_face(mesh, snap, r.command.points.front(), r.command.points.back(), both_snap);
           if (s.face == kNone) {
             reject("the stroke does not start and end on the boundary of one face (no face has both ends within " +
-                   std::to_string(settings.snap_distance) + ")");
+                   std::to_string(both_snap) + ")");
             break;
           }
           r.command.kind = EditKind::SplitFace;

@@ -16,13 +16,15 @@
 namespace fire {
 
 struct SketchSettings {
-  double snap_distance = 0.01;  // how far a stroke end may be from the polyline it snaps to (model units)
+  double snap_distance = 0.01;  // how far a stroke end may be from the polyline it snaps to (model units),
+                                // unless the end's pen sample carries its own radius (InputEvent::snap)
   uint32_t close_samples = 16;  // points on the straight edge made by `cmd close`
 };
 
 struct SketchState {
   bool pen_down = false;
   std::vector<Vec3> stroke;
+  double start_snap = 0, end_snap = 0;  // the snap radii logged with the stroke's first and last samples (0: none)
   std::vector<InputEvent> pending;  // events after this frame's request, handled next frame
 };
 

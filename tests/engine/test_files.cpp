@@ -68,6 +68,16 @@ TEST_CASE("input log: every kind parses and formats back", "[files]") {
   CHECK(format_input_log(again->events) == format_input_log(log->events));
 }
 
+TEST_CASE("input log: a pen sample's snap radius reads and formats back; without one it is 0", "[files]") {
+  auto log = parse_input_log("FIRE-LOG 1\n10 pen 1 2 3 0.0125\n20 pen 1 2 3\n", "a.log");
+  REQUIRE(log.ok());
+  CHECK(log->events[0].p == Vec3(1, 2, 3));
+  CHECK(log->events[0].snap == 0.0125);
+  CHECK(log->events[1].snap == 0);
+  CHECK(format_event(log->events[0]) == "10 pen 1 2 3 0.0125\n");
+  CHECK(format_event(log->events[1]) == "20 pen 1 2 3\n");
+}
+
 TEST_CASE("input log: truncated, unknown version and malformed lines are refused", "[files][reject]") {
   auto refuse = [](const std::string& text, const char* part) {
     auto r = parse_input_log(text, "s.log");
@@ -81,6 +91,10 @@ TEST_CASE("input log: truncated, unknown version and malformed lines are refused
   refuse("", "empty");
   refuse("FIRE-LOG 1\n10 pen 1 2\n", "pen needs three numbers");
   refuse("FIRE-LOG 1\n10 pen 1 2 x\n", "pen needs three numbers");
+  refuse("FIRE-LOG 1\n10 pen 1 2 3 0\n", "snap radius must be a positive finite number");
+  refuse("FIRE-LOG 1\n10 pen 1 2 3 -1\n", "snap radius must be a positive finite number");
+  refuse("FIRE-LOG 1\n10 pen 1 2 3 inf\n", "snap radius must be a positive finite number");
+  refuse("FIRE-LOG 1\n10 pen 1 2 3 4 5\n", "pen needs three numbers");
   refuse("FIRE-LOG 1\n10 fly\n", "unknown event kind 'fly'");
   refuse("FIRE-LOG 1\n10 down\n5 up\n", "back in time");
   refuse("FIRE-LOG 1\nabc down\n", "bad timestamp");

@@ -101,6 +101,32 @@ TEST_CASE("a stroke with NaN or ends on two faces is rejected and nothing drawn 
   CHECK(w->mesh.same_pools(clean->mesh));
 }
 
+TEST_CASE("a snap radius logged with the end samples replaces the session's setting", "[replay]") {
+  int64_t t = 0;
+  std::string square = "FIRE-LOG 1\n";
+  square += stroke(t, {{0, 0, 0}, {0.05, 0, 0}, {0.1, 0, 0}});
+  square += stroke(t, {{0.1, 0, 0}, {0.1, 0.1, 0}});
+  square += stroke(t, {{0.1, 0.1, 0}, {0.05, 0.1, 0}, {0, 0.1, 0}});
+  square += stroke(t, {{0, 0.1, 0}, {0, 0, 0}});
+  // Ends 3 cm off the bottom and top edges' middle points: beyond the default 1 cm, within a logged 4 cm.
+  auto split = [&](const char* radius) {
+    int64_t u = t;
+    std::string s = std::to_string(u) + " down\n";
+    s += std::to_string(u += 10000) + " pen 0.05 -0.03 0" + radius + "\n";
+    s += std::to_string(u += 10000) + " pen 0.05 0.05 0\n";
+    s += std::to_string(u += 10000) + " pen 0.05 0.13 0" + radius + "\n";
+    s += std::to_string(u += 10000) + " up\n";
+    return s;
+  };
+  auto w = replay_text(square + split(""));
+  CHECK(w->mesh.face_count() == 1);
+  REQUIRE(w->rejections.size() == 1);
+  CHECK_THAT(w->rejections[0].reason, Catch::Matchers::Contains("within 0.010000"));
+  w = replay_text(square + split(" 0.04"));
+  CHECK(w->rejections.empty());
+  CHECK(w->mesh.face_count() == 2);
+}
+
 TEST_CASE("snapping bends the whole stroke instead of kinking its end", "[replay]") {
   int64_t t = 0;
   std::string text = "FIRE-LOG 1\n";

@@ -300,15 +300,18 @@ TEST_CASE("every snapshot plus the log's tail equals a full replay, hash for has
   }
   SECTION("commands in the frame of a pen-up, a snapshot every frame: events waiting for the next frame") {
     // A square border, then a split whose pen-up shares its frame with an undo and a redo, so the sketch
-    // system holds them over (one request per frame) across the snapshots.
-    std::string text = "FIRE-LOG 1\n";
+    // system holds them over (one request per frame) across the snapshots. The last stroke starts and ends 0.05 off
+    // the borders it joins, and only its first sample carries a snap radius (a mouse drawing's carry one
+    // each) that reaches them where the session's 0.01 would refuse it: a snapshot taken mid-stroke must
+    // keep the radius of a sample already consumed.
+    std::string text = "FIRE-LOG 1\n", without_radius;
     int64_t t = 0;
-    auto stroke = [&](const Vec3& a, const Vec3& b) {
+    auto stroke = [&](const Vec3& a, const Vec3& b, const std::string& radius = "") {
       text += std::to_string(t) + " down\n";
       for (int k = 0; k <= 4; ++k) {
         const Vec3 p = a + (b - a) * (k / 4.0);
         text += std::to_string(t += 10'000) + " pen " + format_double(p.x()) + " " + format_double(p.y()) + " " +
-                format_double(p.z()) + "\n";
+                format_double(p.z()) + (k == 0 ? radius : "") + "\n";
       }
       text += std::to_string(t += 10'000) + " up\n";
     };
@@ -319,9 +322,14 @@ TEST_CASE("every snapshot plus the log's tail equals a full replay, hash for has
     stroke({0.5, 0, 0}, {0.5, 1, 0.1});
     text += std::to_string(t + 1) + " cmd undo\n" + std::to_string(t + 2) + " cmd redo\n";
     t += 2;
-    stroke({0, 0.5, 0}, {0.5, 0.5, 0.1});
+    const std::string before_last = text;
+    stroke({0, 0.5, 0.05}, {1, 0.5, 0.05});
+    without_radius = text;
+    text = before_last;
+    stroke({0, 0.5, 0.05}, {1, 0.5, 0.05}, " 0.08");
     auto log = parse_input_log(text, "pending.log");
     REQUIRE(log.ok());
+    REQUIRE(clean_hash(log->events) != clean_hash(parse_input_log(without_radius, "no-radius.log")->events));
     WrittenSession s;
     write_with_snapshots(*log, 1, s);
     const uint64_t expected = clean_hash(log->events);

@@ -151,6 +151,57 @@ TEST_CASE("BVH closest points equal a linear scan over every triangle", "[evalua
   }
 }
 
+TEST_CASE("BVH ray casts equal a linear scan over every triangle", "[evaluate][bvh][ray]") {
+  const TriangleMesh mesh = triangulated_obj("pawn.obj");
+  const TriangleBvh bvh(mesh);
+  Vec3 lo = mesh.positions[0], hi = lo;
+  for (const Vec3& p : mesh.positions) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-0.5, 1.5), n(-1.0, 1.0);
+  int hits = 0;
+  for (int i = 0; i < 1000; ++i) {
+    // From outside or inside the box, towards a point inside it; every tenth ray along an axis.
+    const Vec3 origin = lo + Vec3(u(rng), u(rng), u(rng)).cwiseProduct(hi - lo);
+    const Vec3 target = lo + Vec3(u(rng), u(rng), u(rng)).cwiseProduct(hi - lo) * 0.5 + (hi - lo) * 0.25;
+    Vec3 direction = (target - origin).normalized();
+    if (i % 10 == 0) direction = Vec3::Unit(i / 10 % 3) * (n(rng) < 0 ? -1.0 : 1.0);
+    double best = std::numeric_limits<double>::infinity();
+    uint32_t best_triangle = kNoTriangle;
+    for (uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+      const Vec3 a = mesh.positions[mesh.triangles[3 * t]], b = mesh.positions[mesh.triangles[3 * t + 1]],
+                 c = mesh.positions[mesh.triangles[3 * t + 2]];
+      // The plane's parameter, then the point inside the triangle by its barycentric coordinates.
+      const Vec3 normal = (b - a).cross(c - a);
+      const double along = normal.dot(direction);
+      if (along == 0) continue;
+      const double t_hit = normal.dot(a - origin) / along;
+      if (!(t_hit > 0)) continue;
+      const Vec3 p = origin + t_hit * direction;
+      const double area = normal.squaredNorm();
+      const double wa = normal.dot((b - p).cross(c - p)) / area, wb = normal.dot((c - p).cross(a - p)) / area;
+      if (wa < -1e-12 || wb < -1e-12 || 1 - wa - wb < -1e-12) continue;
+      if (t_hit < best - 1e-12) {
+        best = t_hit;
+        best_triangle = t;
+      }
+    }
+    const TriangleBvh::Hit hit = bvh.ray_cast(origin, direction);
+    if (best_triangle == kNoTriangle) {
+      REQUIRE(hit.triangle == kNoTriangle);
+      continue;
+    }
+    ++hits;
+    REQUIRE(hit.triangle != kNoTriangle);
+    REQUIRE(std::sqrt(hit.distance_squared) == Approx(best).epsilon(1e-9));
+    REQUIRE((hit.point - (origin + best * direction)).norm() < 1e-9 * (hi - lo).norm());
+  }
+  CHECK(hits > 300);  // the test would be empty if the rays missed
+  CHECK(bvh.ray_cast(hi + (hi - lo), (hi - lo).normalized()).triangle == kNoTriangle);  // pointing away
+}
+
 TEST_CASE("a square against itself moved 0.1 along its normal", "[evaluate][analytic]") {
   const TriangleMesh a = square(0), b = square(0.1);
   const TriangleBvh a_bvh(a), b_bvh(b);

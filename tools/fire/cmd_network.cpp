@@ -195,7 +195,10 @@ void add_network_commands(CLI::App& app, Registry& registry) {
   replay->add_flag("--hash", o->hash,
                    "print a 64-bit hash of the final pools and surface (identical on every run and machine)");
   replay->add_flag("--timings", o->timings, "print per-system timings (mean, p99, max per frame) and final counts");
-  replay->add_option("--snap", o->snap, "snap distance for stroke ends, in model units")->capture_default_str();
+  replay->add_option("--snap", o->snap,
+                     "snap distance for stroke ends, in model units (a stroke end whose pen sample carries its own "
+                     "radius, as a mouse drawing from fire app does, uses that)")
+      ->capture_default_str();
   replay->callback([o, replay, &registry] {
     o->settings_given = replay->count("--snap") + replay->count("--levels") + replay->count("--fairness") +
                             replay->count("--no-surface") > 0;

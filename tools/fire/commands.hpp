@@ -26,5 +26,7 @@ void add_reconstruct_commands(CLI::App& app, Registry& registry);
 void add_devices_commands(CLI::App& app, Registry& registry);
 // render (headless Vulkan rendering to PNG, platform/render)
 void add_render_commands(CLI::App& app, Registry& registry);
+// app (the interactive window and HUD, platform/window)
+void add_app_commands(CLI::App& app, Registry& registry);
 
 }  // namespace fire::cli

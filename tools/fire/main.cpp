@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   fire::cli::add_reconstruct_commands(app, registry);
   fire::cli::add_devices_commands(app, registry);
   fire::cli::add_render_commands(app, registry);
+  fire::cli::add_app_commands(app, registry);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

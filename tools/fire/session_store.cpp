@@ -13,6 +13,7 @@ void save_event(SnapshotWriter& out, const InputEvent& e) {
   out.put(e.t_us);
   out.put(uint8_t(e.kind));
   out.put(e.p);
+  out.put(e.snap);
   out.put(uint8_t(e.command));
   out.put(int32_t(e.device));
   out.put(uint8_t(e.hid_ok));
@@ -29,6 +30,7 @@ bool load_event(SnapshotReader& in, InputEvent& e) {
   in.get(e.t_us);
   in.get(kind);
   in.get(e.p);
+  in.get(e.snap);
   in.get(command);
   in.get(device);
   in.get(hid_ok);
@@ -104,6 +106,8 @@ std::string snapshot_world(const World& w, uint64_t log_bytes, uint64_t log_hash
   w.history.save(out);
   out.put(uint8_t(w.sketch.pen_down));
   out.put(w.sketch.stroke);
+  out.put(w.sketch.start_snap);
+  out.put(w.sketch.end_snap);
   out.put(uint64_t(w.sketch.pending.size()));
   for (const InputEvent& e : w.sketch.pending) save_event(out, e);
   save_surface(out, w.surface);
@@ -135,6 +139,8 @@ Status load_world_snapshot(SnapshotReader& in, const SessionContents& session, W
   uint8_t pen_down = 0;
   in.get(pen_down);
   in.get(w.sketch.stroke);
+  in.get(w.sketch.start_snap);
+  in.get(w.sketch.end_snap);
   w.sketch.pen_down = pen_down != 0;
   in.get(count);
   for (uint64_t k = 0; k < count && in.ok(); ++k) load_event(in, w.sketch.pending.emplace_back());

@@ -315,6 +315,39 @@ TEST_CASE("framing keeps every corner of the box inside the image") {
   }
 }
 
+TEST_CASE("the app's orbit camera: a ray through a pixel lands on it, pixel sizes, pan, zoom and pitch") {
+  Box box;
+  box.add(Vec3(-1, -0.5, 0));
+  box.add(Vec3(1, 0.5, 2));
+  Orbit orbit = frame_orbit(box, 800, 500);
+  orbit.rotate(37, -21);
+  orbit.zoom(1.5f);
+  const Camera camera = orbit_camera(orbit, 800, 500);
+  for (const glm::vec2 pixel : {glm::vec2(0, 0), glm::vec2(400, 250), glm::vec2(799, 13), glm::vec2(123.5f, 480)}) {
+    const glm::vec3 direction = ray_through_pixel(camera, pixel, 800, 500);
+    CHECK(glm::length(direction) == Approx(1.0f).epsilon(1e-5));
+    const glm::vec3 p = camera.eye + 3.0f * direction;
+    const glm::vec2 back = project_to_pixels(camera, Vec3(p.x, p.y, p.z), 800, 500);
+    CHECK(glm::length(back - pixel) < 0.01f);
+    // One pixel_size_at along the camera's right axis (square to the view axis) is one pixel on screen.
+    const glm::vec3 side(camera.view[0][0], camera.view[1][0], camera.view[2][0]);
+    const glm::vec3 q = p + pixel_size_at(camera, p, 500) * side;
+    const float moved = glm::length(project_to_pixels(camera, Vec3(q.x, q.y, q.z), 800, 500) - back);
+    CHECK(moved == Approx(1.0f).epsilon(1e-3));
+  }
+  // Panning moves the target by the pixels' model length at its depth, whatever the zoom.
+  const glm::vec3 before = orbit.target;
+  orbit.pan(10, 0, 500);
+  const glm::vec2 a = project_to_pixels(camera, Vec3(before.x, before.y, before.z), 800, 500);
+  const glm::vec2 b = project_to_pixels(camera, Vec3(orbit.target.x, orbit.target.y, orbit.target.z), 800, 500);
+  CHECK(glm::length(b - a) == Approx(10.0f).epsilon(0.02));
+  const float distance = orbit.distance;
+  orbit.zoom(-2);
+  CHECK(orbit.distance > distance);
+  orbit.rotate(0, 10000);
+  CHECK(orbit.pitch < 1.56f);  // never over the pole
+}
+
 TEST_CASE("validation messages are counted, so the tests above would fail on one") {
   auto context = make_context();
   VkBufferCreateInfo invalid{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};

@@ -1,0 +1,148 @@
+#include "platform/window/hud.hpp"
+
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_vulkan.h>
+
+#include <cmath>
+
+namespace fire::window {
+
+namespace {
+
+VkResult g_backend_failure = VK_SUCCESS;  // the first failed VkResult inside ImGui's Vulkan backend
+
+void on_backend_result(VkResult r) {
+  if (r != VK_SUCCESS && g_backend_failure == VK_SUCCESS) g_backend_failure = r;
+}
+
+}  // namespace
+
+Result<std::unique_ptr<Hud>> Hud::create(render::Context& context, render::Presenter& presenter, Window& window) {
+  using R = Result<std::unique_ptr<Hud>>;
+  std::unique_ptr<Hud> hud(new Hud);
+  hud->device_ = context.device();
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGuiIO& io = ImGui::GetIO();
+  io.IniFilename = nullptr;  // no imgui.ini left in the working directory
+  ImGui::StyleColorsDark();
+  ImGui::GetStyle().Alpha = 0.92f;
+  if (presenter.srgb())  // ImGui's colours are sRGB values: written to an sRGB image they must be linear first
+    for (ImVec4& c : ImGui::GetStyle().Colors)
+      for (float* v : {&c.x, &c.y, &c.z}) *v = *v <= 0.04045f ? *v / 12.92f : std::pow((*v + 0.055f) / 1.055f, 2.4f);
+  hud->glfw_ = ImGui_ImplGlfw_InitForVulkan(window.handle(), true);
+  if (!hud->glfw_) return R::failure("ImGui_ImplGlfw_InitForVulkan failed");
+
+  // One combined image sampler: the font atlas.
+  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1};
+  VkDescriptorPoolCreateInfo pool{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pool.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;
+  pool.maxSets = 1;
+  pool.poolSizeCount = 1;
+  pool.pPoolSizes = &size;
+  if (VkResult r = vkCreateDescriptorPool(context.device(), &pool, nullptr, &hud->pool_); r != VK_SUCCESS)
+    return R::failure(render::vk_failure("vkCreateDescriptorPool", r));
+
+  ImGui_ImplVulkan_InitInfo info{};
+  info.Instance = context.instance();
+  info.PhysicalDevice = context.physical_device();
+  info.Device = context.device();
+  info.QueueFamily = context.queue_family();
+  info.Queue = context.queue();
+  info.DescriptorPool = hud->pool_;
+  info.Subpass = 0;
+  // The backend rotates its vertex buffers over ImageCount frames; the presenter keeps one frame in flight.
+  info.MinImageCount = 2;
+  info.ImageCount = 2;
+  info.MSAASamples = VK_SAMPLE_COUNT_1_BIT;
+  info.CheckVkResultFn = on_backend_result;
+  hud->vulkan_ = ImGui_ImplVulkan_Init(&info, presenter.overlay_pass());
+  if (!hud->vulkan_) return R::failure("ImGui_ImplVulkan_Init failed");
+  if (Status s = presenter.run_once([](VkCommandBuffer cmd) { ImGui_ImplVulkan_CreateFontsTexture(cmd); }); !s)
+    return R::failure("the HUD's font upload: " + s.error);
+  ImGui_ImplVulkan_DestroyFontUploadObjects();
+  if (Status s = hud->status(); !s) return R::failure(s.error);
+  return hud;
+}
+
+Hud::~Hud() {
+  if (device_) vkDeviceWaitIdle(device_);  // nothing else to do on failure: everything is destroyed either way
+  if (vulkan_) ImGui_ImplVulkan_Shutdown();
+  if (glfw_) ImGui_ImplGlfw_Shutdown();
+  if (ImGui::GetCurrentContext()) ImGui::DestroyContext();
+  if (pool_) vkDestroyDescriptorPool(device_, pool_, nullptr);
+}
+
+Status Hud::status() const {
+  if (g_backend_failure == VK_SUCCESS) return Status::success();
+  return Status::failure(std::string("a Vulkan call in ImGui's Vulkan backend failed: ") +
+                         render::vk_result_name(g_backend_failure));
+}
+
+bool Hud::wants_mouse() const { return ImGui::GetIO().WantCaptureMouse; }
+
+void Hud::build(const HudData& d) {
+  ImGui_ImplVulkan_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGui::NewFrame();
+
+  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_Always);
+  ImGui::SetNextWindowBgAlpha(0.75f);
+  const ImGuiWindowFlags fixed = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
+                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
+                                 ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoMove;
+  ImGui::Begin("FIRE", nullptr, fixed);
+  ImGui::Text("frame %.1f ms   system frames %llu", d.frame_ms, static_cast<unsigned long long>(d.frames));
+  if (d.timings && ImGui::BeginTable("timings", 4, ImGuiTableFlags_SizingFixedFit)) {
+    ImGui::TableSetupColumn("system");
+    ImGui::TableSetupColumn("mean us");
+    ImGui::TableSetupColumn("p99 us");
+    ImGui::TableSetupColumn("max us");
+    ImGui::TableHeadersRow();
+    auto row = [](const SystemTiming& t) {
+      ImGui::TableNextRow();
+      ImGui::TableNextColumn();
+      ImGui::TextUnformatted(t.name.c_str());
+      ImGui::TableNextColumn();
+      ImGui::Text("%.0f", t.mean_ns() / 1e3);
+      ImGui::TableNextColumn();
+      ImGui::Text("%.0f", double(t.percentile_ns(99)) / 1e3);
+      ImGui::TableNextColumn();
+      ImGui::Text("%.0f", double(t.max_ns) / 1e3);
+    };
+    for (const SystemTiming& t : *d.timings) row(t);
+    if (d.frame_timing) row(*d.frame_timing);
+    ImGui::EndTable();
+  }
+  ImGui::Separator();
+  ImGui::Text("vertices %zu  edges %zu  faces %zu", d.vertices, d.edges, d.faces);
+  ImGui::Text("points %zu  surface quads %zu", d.points, d.surface_quads);
+  ImGui::Text("mode: %s", d.border_mode ? "border (strokes extend the border)" : "split (strokes split faces)");
+  ImGui::Text("view: surface %s  curves %s  wireframe %s", d.view.surface ? "on" : "off", d.view.curves ? "on" : "off",
+              !d.wireframe_supported ? "n/a" : d.view.wireframe ? "on" : "off");
+  if (!d.last_rejection.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.55f, 0.45f, 1.0f));
+    ImGui::TextWrapped("rejected: %s", d.last_rejection.c_str());
+    ImGui::PopStyleColor();
+  }
+  if (!d.status.empty()) ImGui::TextUnformatted(d.status.c_str());
+  ImGui::TextDisabled("H: help");
+  ImGui::End();
+
+  if (d.help) {
+    const ImVec2 size = ImGui::GetIO().DisplaySize;
+    ImGui::SetNextWindowPos(ImVec2(size.x - 10, 10), ImGuiCond_Always, ImVec2(1.0f, 0.0f));
+    ImGui::SetNextWindowBgAlpha(0.85f);
+    ImGui::Begin("Keys", nullptr, fixed);
+    ImGui::TextUnformatted("Keys and mouse");
+    ImGui::Separator();
+    for (const std::string& line : d.keys) ImGui::TextUnformatted(line.c_str());
+    ImGui::End();
+  }
+  ImGui::Render();
+}
+
+void Hud::draw(VkCommandBuffer cmd) { ImGui_ImplVulkan_RenderDrawData(ImGui::GetDrawData(), cmd); }
+
+}  // namespace fire::window

@@ -1,0 +1,54 @@
+#pragma once
+// The HUD, drawn with Dear ImGui over the presented frame: frame time, per-system timings, the counts,
+// the sketch mode, the last rejected edit, the view toggles, and the help overlay listing the keys.
+// It shows what the app hands it in HudData (engine data read by the app); it calls nothing of the engine.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/scheduler.hpp"
+#include "platform/render/present.hpp"
+#include "platform/window/window.hpp"
+
+namespace fire::window {
+
+struct HudData {
+  double frame_ms = 0;       // wall time of the last displayed frame
+  uint64_t frames = 0;       // system frames run (the scheduler's fixed step)
+  const std::vector<SystemTiming>* timings = nullptr;
+  const SystemTiming* frame_timing = nullptr;
+  size_t vertices = 0, edges = 0, faces = 0, points = 0, surface_quads = 0;
+  bool border_mode = true;   // no face yet: strokes extend the border; else they split faces
+  std::string last_rejection; // the last edit refused, in words; empty if none
+  std::string status;         // a line of news (saved to, nothing to undo...)
+  render::DrawOptions view;
+  bool wireframe_supported = true;
+  bool help = false;
+  // The keys, one line each ("Ctrl+Z  undo"), for the help overlay.
+  std::vector<std::string> keys;
+};
+
+class Hud {
+ public:
+  // Installs ImGui's GLFW callbacks over the window's (they forward to them) and its Vulkan objects.
+  static Result<std::unique_ptr<Hud>> create(render::Context& context, render::Presenter& presenter, Window& window);
+  ~Hud();
+  Hud(const Hud&) = delete;
+  Hud& operator=(const Hud&) = delete;
+
+  // Lays out this frame's HUD; the draw happens in draw(), inside the presenter's overlay pass.
+  void build(const HudData& data);
+  void draw(VkCommandBuffer cmd);
+  // Whether the pointer or keyboard is over the HUD this frame: the scene then ignores them.
+  bool wants_mouse() const;
+  // A Vulkan call inside ImGui's backend failed (it reports through a callback that cannot return).
+  Status status() const;
+
+ private:
+  Hud() = default;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  bool glfw_ = false, vulkan_ = false;
+};
+
+}  // namespace fire::window

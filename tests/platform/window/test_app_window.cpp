@@ -1,0 +1,294 @@
+// `fire app` in a real window under Xvfb (Debian xvfb; tools/run installs it), on lavapipe or a GPU with the
+// validation layer on: a scripted interaction through the window's GLFW callbacks (an orbit drag, a zoom, the
+// help overlay, an undo, a resize, a close), a screenshot of the presented frame checked by pixel statistics,
+// the recorded input log replayed to the same hash; strokes drawn with the mouse on pawn.obj, replayed bit for
+// bit; and no display: a clear message, no crash.
+#include <catch2/catch.hpp>
+#include <cstdlib>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "engine/input_log.hpp"
+#include "platform/files.hpp"
+#include "platform/network_file.hpp"
+#include "platform/render/image.hpp"
+#include "platform/render/renderer.hpp"
+
+namespace {
+
+using fire::render::Image;
+using fire::render::Palette;
+namespace fs = std::filesystem;
+
+struct Run {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string quote(const std::string& s) { return "'" + s + "'"; }
+
+// Runs a shell command with its output in files of `dir`.
+Run run(const std::string& command, const fs::path& dir) {
+  const std::string out = (dir / "stdout").string(), err = (dir / "stderr").string();
+  const int status = std::system((command + " >" + quote(out) + " 2>" + quote(err)).c_str());
+  Run r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  if (auto text = fire::read_text_file(out)) r.out = *text;
+  if (auto text = fire::read_text_file(err)) r.err = *text;
+  return r;
+}
+
+bool has_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
+
+// fire app under a fresh X server; the validation layer on, LeakSanitizer's suppressions for Mesa in the
+// sanitizer build. Each test case searches for a free display from its own number: xvfb-run -a alone races
+// when ctest -j starts two at once (both take :99).
+std::string app_command(int display, const std::string& args, const std::string& env = "") {
+  return "env " + env + " FIRE_VK_VALIDATION=1 LSAN_OPTIONS=suppressions=" + FIRE_LSAN_SUPPRESSIONS +
+         ":print_suppressions=0 xvfb-run -a -n " + std::to_string(display) +
+         " -s '-screen 0 1280x800x24' timeout 240 " + quote(FIRE_BINARY) + " app " + args;
+}
+
+fs::path scratch(const std::string& name) {
+  fs::path dir = fs::temp_directory_path() / ("fire_app_window_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+bool near(const uint8_t* p, const uint8_t (&c)[3], int tolerance) {
+  for (int k = 0; k < 3; ++k)
+    if (std::abs(int(p[k]) - int(c[k])) > tolerance) return false;
+  return true;
+}
+
+// The lit surface: a neutral grey brighter than any background row.
+bool surface_like(const uint8_t* p) {
+  const int lo = std::min({p[0], p[1], p[2]}), hi = std::max({p[0], p[1], p[2]});
+  return hi - lo < 40 && (p[0] + p[1] + p[2]) / 3 > 100;
+}
+
+// Pixels of [x0, x1) x [y0, y1) well darker than the background's top rows there (the HUD's translucent panels).
+double dark_fraction(const Image& im, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1) {
+  size_t dark = 0;
+  for (uint32_t y = y0; y < y1; ++y)
+    for (uint32_t x = x0; x < x1; ++x) dark += std::max({im.pixel(x, y)[0], im.pixel(x, y)[1], im.pixel(x, y)[2]}) < 50;
+  return double(dark) / double((x1 - x0) * (y1 - y0));
+}
+
+size_t curve_pixels(const Image& im) {
+  size_t n = 0;
+  for (uint32_t y = 0; y < im.height; ++y)
+    for (uint32_t x = 0; x < im.width; ++x) n += near(im.pixel(x, y), Palette::curve, 40);
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("fire app: a scripted session in a window, its screenshot and its replay", "[app][window]") {
+  INFO("the window test needs xvfb-run: apt-get install xvfb (tools/run test installs it)");
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("session");
+  const std::string shot = (dir / "shot.png").string(), record = (dir / "session.log").string(),
+                    saved = (dir / "saved.fnet").string();
+  const Run app = run(app_command(120, quote(FIRE_DEMO_LOG) + " --size 960x600 --script " +
+                                  quote(FIRE_WINDOW_TEST_DIR "/session.script") + " --screenshot " + quote(shot) +
+                                  " --record " + quote(record) + " -o " + quote(saved)),
+                      dir);
+  INFO("stdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  CHECK(app.err.find("validation") == std::string::npos);
+  const auto json = nlohmann::json::parse(app.out);
+  CHECK(json["validation"] == true);
+  CHECK(json["display_frames"] == 41);  // the close at frame 40 ends the loop after that frame
+  CHECK(json["system_frames"].get<uint64_t>() > 0);
+  {  // Ctrl+S saved the network as it was after the undo
+    auto network = fire::load_network(saved);
+    REQUIRE(network);
+    CHECK(network->edge_count() == json["edges"].get<size_t>());
+    CHECK(app.err.find("saved " + std::to_string(network->edge_count()) + " curves to " + saved) != std::string::npos);
+  }
+
+  {  // the recorded log ends with the undo and replays to the app's hash
+    const auto log = fire::read_text_file(record);
+    REQUIRE(log);
+    CHECK(log->rfind(" cmd undo\n") == log->size() - std::string(" cmd undo\n").size());
+    const Run replay = run(quote(FIRE_BINARY) + " replay " + quote(record) + " --hash", dir);
+    REQUIRE(replay.exit_code == 0);
+    CHECK(replay.out == json["hash"].get<std::string>() + "\n");
+    const Run original = run(quote(FIRE_BINARY) + " replay " + quote(FIRE_DEMO_LOG) + " --hash", dir);
+    CHECK(original.out != replay.out);  // the undo changed the network
+  }
+
+  {  // the screenshot shows the resized window: background, surface, curves and the HUD
+    auto image = fire::render::read_png(shot);
+    REQUIRE(image);
+    const Image& im = *image;
+    REQUIRE(im.width == 800);
+    REQUIRE(im.height == 520);
+    // The background's bottom row at both corners; the surface never reaches them.
+    CHECK(near(im.pixel(2, im.height - 2), Palette::background_bottom, 8));
+    CHECK(near(im.pixel(im.width - 3, im.height - 2), Palette::background_bottom, 8));
+    // The surface covers a large central region.
+    size_t surface = 0;
+    double cx = 0, cy = 0;
+    for (uint32_t y = 0; y < im.height; ++y)
+      for (uint32_t x = 0; x < im.width; ++x)
+        if (surface_like(im.pixel(x, y))) {
+          ++surface;
+          cx += x;
+          cy += y;
+        }
+    const double coverage = double(surface) / double(im.width * im.height);
+    INFO("surface coverage " << coverage);
+    CHECK(coverage > 0.12);
+    CHECK(coverage < 0.75);
+    CHECK(std::abs(cx / double(surface) - im.width / 2.0) < im.width * 0.2);
+    CHECK(std::abs(cy / double(surface) - im.height / 2.0) < im.height * 0.2);
+    // Curves on top of it.
+    const size_t curves = curve_pixels(im);
+    INFO("curve pixels " << curves);
+    CHECK(curves > 1500);
+    CHECK(curves < surface);
+    // The HUD's panel at the top left and the help overlay at the top right, both darker than the background.
+    INFO("dark HUD pixels: " << dark_fraction(im, 14, 14, 200, 120) << " left, "
+                               << dark_fraction(im, im.width - 150, 14, im.width - 14, 60) << " right");
+    CHECK(dark_fraction(im, 14, 14, 200, 120) > 0.5);
+    CHECK(dark_fraction(im, im.width - 150, 14, im.width - 14, 60) > 0.5);
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("fire app: curves toggled off are not drawn", "[app][window]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("curves_off");
+  const std::string shot = (dir / "shot.png").string();
+  const Run app = run(app_command(140, quote(FIRE_DEMO_LOG) + " --size 640x400 --script " +
+                                  quote(FIRE_WINDOW_TEST_DIR "/curves_off.script") + " --screenshot " + quote(shot)),
+                      dir);
+  INFO("stdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  auto image = fire::render::read_png(shot);
+  REQUIRE(image);
+  CHECK(curve_pixels(*image) < 20);
+  size_t surface = 0;
+  for (uint32_t y = 0; y < image->height; ++y)
+    for (uint32_t x = 0; x < image->width; ++x) surface += surface_like(image->pixel(x, y));
+  CHECK(surface > image->width * image->height / 10);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("fire app: strokes drawn with the mouse on a reference mesh replay bit for bit", "[app][window][sketch]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("draw");
+  const std::string shot = (dir / "shot.png").string(), record = (dir / "draw.log").string();
+  const Run app = run(app_command(160, "--reference " + quote(FIRE_PAWN) + " --size 960x720 --script " +
+                                  quote(FIRE_WINDOW_TEST_DIR "/draw_on_pawn.script") + " --screenshot " + quote(shot) +
+                                  " --record " + quote(record)),
+                      dir);
+  INFO("stdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  const auto json = nlohmann::json::parse(app.out);
+  // A closed border of 4 curves, split once (its curve and the halves of the two edges it ends on).
+  CHECK(json["faces"] == 2);
+  CHECK(json["edges"] == 7);
+  CHECK(json["surface_quads"].get<int>() > 0);
+
+  const auto log = fire::read_text_file(record);
+  REQUIRE(log);
+  auto parsed = fire::parse_input_log(*log, record);
+  REQUIRE(parsed);
+  size_t pens = 0, downs = 0, ups = 0;
+  for (const fire::InputEvent& e : parsed->events) {
+    pens += e.kind == fire::EventKind::Pen;
+    downs += e.kind == fire::EventKind::Down;
+    ups += e.kind == fire::EventKind::Up;
+    // Every sample carries the 12 pixels of snap radius in model units: a hundredth or so on the pawn.
+    if (e.kind == fire::EventKind::Pen) CHECK((e.snap > 0.001 && e.snap < 0.1));
+  }
+  CHECK(downs == 6);
+  CHECK(ups == 6);
+  CHECK(pens > 6 * 10);
+  CHECK(log->rfind(" cmd undo\n") == log->size() - std::string(" cmd undo\n").size());
+  for (int run_index = 0; run_index < 2; ++run_index) {  // the same hash on every replay
+    const Run replay = run(quote(FIRE_BINARY) + " replay " + quote(record) + " --hash", dir);
+    REQUIRE(replay.exit_code == 0);
+    CHECK(replay.out == json["hash"].get<std::string>() + "\n");
+  }
+
+  auto image = fire::render::read_png(shot);
+  REQUIRE(image);
+  // The curves are where the strokes were drawn (the square 430..530 x 180..260), and nowhere else.
+  size_t inside = 0, outside = 0;
+  for (uint32_t y = 0; y < image->height; ++y)
+    for (uint32_t x = 0; x < image->width; ++x)
+      if (near(image->pixel(x, y), Palette::curve, 40)) (x >= 420 && x <= 540 && y >= 170 && y <= 270 ? inside : outside)++;
+  INFO("curve pixels inside " << inside << ", outside " << outside);
+  CHECK(inside > 400);
+  CHECK(outside < 20);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("fire app: the stroke in progress is drawn before it becomes a curve", "[app][window][sketch]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("stroke");
+  const std::string shot = (dir / "shot.png").string();
+  const Run app = run(app_command(220, "--reference " + quote(FIRE_PAWN) + " --size 960x720 --script " +
+                                           quote(FIRE_WINDOW_TEST_DIR "/stroke_in_progress.script") +
+                                           " --screenshot " + quote(shot)),
+                      dir);
+  INFO("stdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  CHECK(nlohmann::json::parse(app.out)["edges"] == 0);  // the pen never went up
+  auto image = fire::render::read_png(shot);
+  REQUIRE(image);
+  // Along the drag from (430, 180) to (530, 210), and nowhere else.
+  size_t inside = 0, outside = 0;
+  for (uint32_t y = 0; y < image->height; ++y)
+    for (uint32_t x = 0; x < image->width; ++x)
+      if (near(image->pixel(x, y), Palette::stroke, 40)) (x >= 420 && x <= 540 && y >= 170 && y <= 220 ? inside : outside)++;
+  INFO("stroke pixels inside " << inside << ", outside " << outside);
+  CHECK(inside > 150);
+  CHECK(outside < 10);
+  CHECK(curve_pixels(*image) < 20);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("fire app without a display: a clear message, exit 1, no crash", "[app][window]") {
+  const fs::path dir = scratch("no_display");
+  const Run app = run("env -u DISPLAY -u WAYLAND_DISPLAY " + quote(FIRE_BINARY) + " app " + quote(FIRE_DEMO_LOG), dir);
+  INFO("stderr: " << app.err);
+  CHECK(app.exit_code == 1);
+  CHECK(app.err.find("no display") != std::string::npos);
+  CHECK(app.err.find("fire render") != std::string::npos);
+  CHECK(app.out.empty());
+  fs::remove_all(dir);
+}
+
+TEST_CASE("fire app: no Vulkan device, a reference that does not load: a clear message, exit 1", "[app][window]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("bad_input");
+  const Run no_device =
+      run(app_command(180, "--size 320x200 " + quote(FIRE_DEMO_LOG),
+                      "VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json"),
+          dir);
+  INFO("stderr: " << no_device.err);
+  CHECK(no_device.exit_code == 1);
+  CHECK(no_device.err.find("mesa-vulkan-drivers") != std::string::npos);
+  const Run bad_reference = run(app_command(200, "--reference " + quote((dir / "missing.obj").string())), dir);
+  INFO("stderr: " << bad_reference.err);
+  CHECK(bad_reference.exit_code == 1);
+  CHECK(bad_reference.err.find("--reference: " + (dir / "missing.obj").string()) != std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("fire app: a script that does not parse is refused before a window opens", "[app][window]") {
+  const fs::path dir = scratch("bad_script");
+  const std::string script = (dir / "bad.script").string();
+  REQUIRE(fire::write_file_atomic(script, "1 move 10 10\n0 close\n"));
+  const Run app = run("env -u DISPLAY -u WAYLAND_DISPLAY " + quote(FIRE_BINARY) + " app --script " + quote(script), dir);
+  CHECK(app.exit_code == 1);
+  CHECK(app.err.find("bad.script:2: frames must not decrease") != std::string::npos);
+  fs::remove_all(dir);
+}

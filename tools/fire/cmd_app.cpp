@@ -1,0 +1,524 @@
+// fire app: the interactive window. The session's systems run at the scheduler's fixed step on the input
+// log's clock; the display is paced by vsync. Edits made with keys become commands in the session's input
+// log, so `fire replay` of the recorded log (--record) gives the same pools and surface, bit for bit.
+#include <algorithm>
+#include <chrono>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+
+#include "engine/input_log.hpp"
+#include "platform/clock.hpp"
+#include "platform/files.hpp"
+#include "platform/network_file.hpp"
+#include "platform/obj.hpp"
+#include "platform/render/present.hpp"
+#include "platform/window/hud.hpp"
+#include "platform/window/window.hpp"
+#include "systems/evaluate/evaluate.hpp"
+#include "tools/fire/commands.hpp"
+#include "tools/fire/session.hpp"
+
+namespace fire::cli {
+
+namespace {
+
+struct AppArgs {
+  std::string input_path, reference_path, out_path, record_path, script_path, screenshot_path, size = "1280x720";
+  uint32_t levels = 3;
+  int reference_levels = 3;
+  double snap_pixels = 12;
+};
+
+int fail(const std::string& message) {
+  std::cerr << "fire app: " << message << "\n";
+  return 1;
+}
+
+bool ends_with(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+// The help overlay and `fire app --help` list the same keys.
+const std::vector<std::string> kKeys = {
+    "left drag       orbit; with --reference: draw a stroke on it (logged)",
+    "right drag      pan; with --reference: orbit",
+    "Shift + drag    pan",
+    "scroll          zoom",
+    "Ctrl+Z          undo (logged)",
+    "Ctrl+Shift+Z    redo (logged; also Ctrl+Y)",
+    "C               close the border to its first vertex (logged)",
+    "Delete          delete the curve under the cursor (logged)",
+    "1 / 2 / 3       surface / curves / wireframe on or off",
+    "F               frame everything",
+    "Ctrl+S          save the network (-o, or the default path)",
+    "H or F1         this help",
+    "Esc             quit",
+};
+
+// A scripted event of --script: at display frame `frame`, `event` goes through the window's callbacks, or,
+// with a resize size, the window asks the window system for that size (as a person dragging its border).
+struct ScriptEvent {
+  uint64_t frame = 0;
+  window::WindowEvent event;
+  uint32_t resize_width = 0, resize_height = 0;
+};
+
+Result<int> parse_key(const std::string& name) {
+  if (name.size() == 1 && name[0] >= 'a' && name[0] <= 'z') return GLFW_KEY_A + (name[0] - 'a');
+  if (name.size() == 1 && name[0] >= '0' && name[0] <= '9') return GLFW_KEY_0 + (name[0] - '0');
+  if (name == "delete") return GLFW_KEY_DELETE;
+  if (name == "escape") return GLFW_KEY_ESCAPE;
+  if (name == "f1") return GLFW_KEY_F1;
+  return Result<int>::failure("unknown key '" + name + "' (a-z, 0-9, delete, escape, f1)");
+}
+
+// The --script format, one event a line ('#' starts a comment):
+//   FRAME move X Y | press left|right|middle | release left|right|middle | scroll DY | key [ctrl+][shift+]KEY |
+//   resize WIDTH HEIGHT | close
+// FRAME is the display frame (from 0) before which the event is delivered; frames never decrease.
+Result<std::vector<ScriptEvent>> read_script(const std::string& path) {
+  using R = Result<std::vector<ScriptEvent>>;
+  auto text = read_text_file(path);
+  if (!text) return R::failure(text.error());
+  std::vector<ScriptEvent> events;
+  std::istringstream lines(*text);
+  std::string line;
+  for (uint32_t number = 1; std::getline(lines, line); ++number) {
+    if (const size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+    std::istringstream in(line);
+    ScriptEvent s;
+    std::string kind;
+    if (!(in >> s.frame)) {
+      if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+      return R::failure(path + ":" + std::to_string(number) + ": expected a frame number");
+    }
+    auto bad = [&](const std::string& why) { return R::failure(path + ":" + std::to_string(number) + ": " + why); };
+    if (!events.empty() && s.frame < events.back().frame) return bad("frames must not decrease");
+    if (!(in >> kind)) return bad("expected an event after the frame");
+    window::WindowEvent& e = s.event;
+    if (kind == "move") {
+      e.kind = window::EventKind::CursorMove;
+      if (!(in >> e.x >> e.y)) return bad("move needs X Y");
+    } else if (kind == "press" || kind == "release") {
+      e.kind = kind == "press" ? window::EventKind::ButtonPress : window::EventKind::ButtonRelease;
+      std::string b;
+      in >> b;
+      if (b == "left") e.button = window::Button::Left;
+      else if (b == "right") e.button = window::Button::Right;
+      else if (b == "middle") e.button = window::Button::Middle;
+      else return bad(kind + " needs left, right or middle");
+    } else if (kind == "scroll") {
+      e.kind = window::EventKind::Scroll;
+      if (!(in >> e.y)) return bad("scroll needs DY");
+    } else if (kind == "key") {
+      e.kind = window::EventKind::KeyPress;
+      std::string name;
+      in >> name;
+      for (const auto& [prefix, flag] : {std::pair{"ctrl+", window::kCtrl}, std::pair{"shift+", window::kShift}})
+        while (name.rfind(prefix, 0) == 0) {
+          e.mods |= flag;
+          name = name.substr(std::string(prefix).size());
+        }
+      auto key = parse_key(name);
+      if (!key) return bad(key.error());
+      e.key = *key;
+    } else if (kind == "resize") {
+      if (!(in >> s.resize_width >> s.resize_height) || s.resize_width < 64 || s.resize_height < 64)
+        return bad("resize needs WIDTH HEIGHT, at least 64 each");
+    } else if (kind == "close") {
+      e.kind = window::EventKind::Close;
+    } else {
+      return bad("unknown event '" + kind + "' (move, press, release, scroll, key, resize, close)");
+    }
+    std::string extra;
+    if (in >> extra) return bad("unexpected '" + extra + "'");
+    events.push_back(s);
+  }
+  return events;
+}
+
+render::Box scene_box(const Mesh& mesh, const SurfaceLevels& surface, const std::vector<Vec3>& reference) {
+  render::Box box;
+  for (uint32_t e = 0; e < mesh.edge_slots(); ++e)
+    if (mesh.edge_alive(e))
+      for (const Vec3& p : mesh.polyline(e)) box.add(p);
+  for (const Vec3& p : surface.positions) box.add(p);
+  for (const Vec3& p : reference) box.add(p);
+  return box;
+}
+
+// The polyline point nearest to the cursor on screen, within `radius` pixels: what Delete picks.
+bool curve_point_under(const Mesh& mesh, const render::Camera& camera, uint32_t width, uint32_t height, glm::vec2 cursor,
+                       float radius, Vec3& out) {
+  float best = radius * radius;
+  bool found = false;
+  for (uint32_t e = 0; e < mesh.edge_slots(); ++e) {
+    if (!mesh.edge_alive(e)) continue;
+    for (const Vec3& p : mesh.polyline(e)) {
+      const glm::vec4 clip = camera.view_projection() * glm::vec4(float(p.x()), float(p.y()), float(p.z()), 1.0f);
+      if (clip.w <= 0.0f) continue;  // behind the eye
+      const glm::vec2 d = render::project_to_pixels(camera, p, width, height) - cursor;
+      if (glm::dot(d, d) < best) {
+        best = glm::dot(d, d);
+        out = p;
+        found = true;
+      }
+    }
+  }
+  return found;
+}
+
+std::string default_output(const std::string& input) {
+  if (input.empty()) return "fire-app.fnet";
+  std::filesystem::path p(input);
+  return (p.parent_path() / (p.stem().string() + "-app.fnet")).string();
+}
+
+int run_app(const AppArgs& a) {
+  uint32_t width = 0, height = 0;
+  char tail = 0;
+  if (std::sscanf(a.size.c_str(), "%ux%u%c", &width, &height, &tail) != 2 || width < 64 || height < 64 ||
+      width > 8192 || height > 8192)
+    return fail("--size must be WIDTHxHEIGHT, 64 to 8192 pixels a side, not '" + a.size + "'");
+  if (a.levels < 1 || a.levels > reconstruct::kMaxSurfaceLevels)
+    return fail("--levels must be 1 to " + std::to_string(reconstruct::kMaxSurfaceLevels));
+  if (!a.screenshot_path.empty() && !ends_with(a.screenshot_path, ".png"))
+    return fail(a.screenshot_path + ": --screenshot must be a .png file");
+  const bool from_network = ends_with(a.input_path, ".fnet");
+  if (from_network && !a.record_path.empty())
+    return fail("--record: a session that starts from a network file cannot be replayed from its log alone; "
+                "start from an input log or from nothing");
+  std::vector<ScriptEvent> script;
+  if (!a.script_path.empty()) {
+    auto s = read_script(a.script_path);
+    if (!s) return fail("--script: " + s.error());
+    script = std::move(*s);
+  }
+  if (a.reference_levels < 0 || a.reference_levels > 5) return fail("--reference-levels must be 0 to 5");
+  if (!(a.snap_pixels > 0) || a.snap_pixels > 200) return fail("--snap-pixels must be above 0 and at most 200");
+  // The reference as drawn on: its Catmull-Clark limit surface (a control mesh), or its faces as fans (level 0).
+  evaluate::TriangleMesh reference;
+  if (!a.reference_path.empty()) {
+    auto mesh = read_obj(a.reference_path);
+    if (!mesh) return fail("--reference: " + mesh.error());
+    auto triangles = a.reference_levels > 0
+                         ? evaluate::reference_limit_surface(mesh->positions, mesh->face_offsets, mesh->face_vertices,
+                                                             a.reference_levels)
+                         : evaluate::triangulate(mesh->positions, mesh->face_offsets, mesh->face_vertices);
+    if (!triangles) return fail("--reference: " + a.reference_path + ": " + triangles.error());
+    reference = std::move(*triangles);
+  }
+  const evaluate::TriangleBvh reference_bvh(reference);
+  const std::vector<Vec3>& reference_positions = reference.positions;
+
+  // The session: a network to continue from, or an input log replayed first, or nothing.
+  auto world = std::make_unique<World>();
+  World& w = *world;
+  w.surface_options.levels = a.levels;
+  if (from_network) {
+    auto network = load_network(a.input_path);
+    if (!network) return fail(network.error());
+    w.mesh = std::move(*network);
+  } else if (!a.input_path.empty()) {
+    auto log = read_input_log(a.input_path);
+    if (!log) return fail(log.error());
+    w.log = std::move(*log);
+  }
+  if (w.log.events.empty()) {
+    // Frame 0 starts at the first event, in a replay as here: a first event at 0 fixes the clock's origin.
+    InputEvent start;
+    start.kind = EventKind::Meta;
+    start.name = "session";
+    start.text = "fire app";
+    w.log.events.push_back(start);
+  }
+  Scheduler scheduler = make_scheduler(w, monotonic_ns);
+  replay_headless(w, scheduler);
+
+  auto win = window::Window::create("FIRE", width, height);
+  if (!win) return fail(win.error());
+  window::Window& window = **win;
+  auto context = render::Context::create(window.context_options());
+  if (!context) return fail(context.error());
+  auto surface = window.create_surface((*context)->instance());
+  if (!surface) return fail(surface.error());
+  window.framebuffer_size(width, height);
+  auto presenter = render::Presenter::create(**context, *surface, width, height);
+  if (!presenter) return fail(presenter.error());
+  auto renderer = render::Renderer::create(**context, {std::max(width, 1u), std::max(height, 1u)});
+  if (!renderer) return fail(renderer.error());
+  if (Status s = (*renderer)->set_reference(reference.positions, reference.triangles); !s) return fail(s.error);
+  auto hud = window::Hud::create(**context, **presenter, window);
+  if (!hud) return fail(hud.error());
+
+  render::Orbit orbit = frame_orbit(scene_box(w.mesh, w.surface, reference_positions), width, height);
+  window::HudData hud_data;
+  hud_data.keys = kKeys;
+  hud_data.wireframe_supported = (*context)->wireframe_supported();
+  const std::string out_path = a.out_path.empty() ? default_output(a.input_path) : a.out_path;
+  size_t rejections_seen = w.rejections.size();
+  if (!w.rejections.empty()) hud_data.last_rejection = w.rejections.back().reason;
+
+  // The log's clock continues from the next frame; the wall clock says how far it has advanced.
+  using WallClock = std::chrono::steady_clock;
+  const auto wall_start = WallClock::now();
+  const int64_t session_origin_us = w.frame.begin_us;
+  auto session_us = [&] {
+    return session_origin_us +
+           std::chrono::duration_cast<std::chrono::microseconds>(WallClock::now() - wall_start).count();
+  };
+  render::Camera camera;  // the view of the last displayed frame: what the cursor points at
+  auto log_event = [&](InputEvent e) {
+    // Never before the frame about to run, nor before the last event: the log stays in time order.
+    e.t_us = std::max({session_us(), w.frame.begin_us, w.log.events.back().t_us});
+    e.line = uint32_t(w.log.events.size() + 2);  // its line in the recorded log (after the header)
+    w.log.events.push_back(std::move(e));
+  };
+  auto log_command = [&](CommandKind command, const Vec3& p) {
+    InputEvent e;
+    e.kind = EventKind::Command;
+    e.command = command;
+    e.p = p;
+    log_event(std::move(e));
+  };
+  auto log_pen = [&](EventKind kind) {
+    InputEvent e;
+    e.kind = kind;
+    log_event(std::move(e));
+  };
+  // The mouse pen: the ray from the cursor onto the reference; a hit is a pen sample with the snap radius
+  // of --snap-pixels at its depth, both logged, so the drawing replays without the view.
+  auto pen_sample = [&](glm::vec2 pixel) {
+    const glm::vec3 direction = render::ray_through_pixel(camera, pixel, width, height);
+    const evaluate::TriangleBvh::Hit hit = reference_bvh.ray_cast(
+        Vec3(camera.eye.x, camera.eye.y, camera.eye.z), Vec3(direction.x, direction.y, direction.z));
+    if (hit.triangle == evaluate::kNoTriangle) return false;
+    InputEvent e;
+    e.kind = EventKind::Pen;
+    e.p = hit.point;
+    const glm::vec3 p(float(hit.point.x()), float(hit.point.y()), float(hit.point.z()));
+    e.snap = a.snap_pixels * double(render::pixel_size_at(camera, p, height));
+    log_event(std::move(e));
+    return true;
+  };
+  auto run_frame = [&] {
+    scheduler.run_frame();
+    begin_frame(w, w.frame.index + 1, w.frame.end_us);
+  };
+
+  bool dragging = false, panning = false, drawing = false;
+  const bool can_draw = !reference.triangles.empty();
+  glm::vec2 cursor(0.0f);
+  uint64_t display_frame = 0;
+  size_t next_script = 0;
+  auto last_frame = WallClock::now();
+  Status status;
+
+  auto handle = [&](const window::WindowEvent& e) {
+    using window::EventKind;
+    const bool ctrl = e.mods & window::kCtrl, shift = e.mods & window::kShift;
+    switch (e.kind) {
+      case EventKind::CursorMove: {
+        const glm::vec2 now(float(e.x), float(e.y)), d = now - cursor;
+        if (dragging) orbit.rotate(d.x, d.y);
+        if (panning) orbit.pan(d.x, d.y, std::max(height, 1u));
+        if (drawing) {  // samples every 2 pixels along the move, so a fast drag still makes a dense stroke
+          const int steps = std::max(1, int(std::ceil(glm::length(d) / 2.0f)));
+          for (int k = 1; k <= steps; ++k) pen_sample(cursor + d * (float(k) / float(steps)));
+        }
+        cursor = now;
+        break;
+      }
+      case EventKind::ButtonPress:
+        cursor = glm::vec2(float(e.x), float(e.y));
+        if ((*hud)->wants_mouse() || dragging || panning || drawing) break;
+        if (shift || e.button == window::Button::Middle) panning = true;
+        else if (e.button == window::Button::Left && can_draw) {
+          // A stroke starts only on the reference: the pen goes down with its first sample.
+          log_pen(fire::EventKind::Down);
+          drawing = pen_sample(cursor);
+          if (!drawing) {
+            w.log.events.pop_back();  // the down: not yet delivered, since events wait for the next frame
+            hud_data.status = "press on the reference mesh to draw";
+          }
+        } else if (e.button == window::Button::Left || (e.button == window::Button::Right && can_draw)) dragging = true;
+        else panning = true;
+        break;
+      case EventKind::ButtonRelease:
+        if (drawing) log_pen(fire::EventKind::Up);
+        dragging = panning = drawing = false;
+        break;
+      case EventKind::Scroll:
+        if (!(*hud)->wants_mouse()) orbit.zoom(float(e.y));
+        break;
+      case EventKind::KeyPress:
+        if (ctrl && e.key == GLFW_KEY_Z) log_command(shift ? CommandKind::Redo : CommandKind::Undo, Vec3::Zero());
+        else if (ctrl && e.key == GLFW_KEY_Y) log_command(CommandKind::Redo, Vec3::Zero());
+        else if (ctrl && e.key == GLFW_KEY_S) {
+          const Status saved = save_network(w.mesh, out_path);
+          hud_data.status = saved ? "saved " + std::to_string(w.mesh.edge_count()) + " curves to " + out_path : saved.error;
+          std::cerr << "fire app: " << hud_data.status << "\n";
+        } else if (ctrl) break;
+        else if (e.key == GLFW_KEY_C) log_command(CommandKind::Close, Vec3::Zero());
+        else if (e.key == GLFW_KEY_DELETE) {
+          Vec3 p;
+          if (curve_point_under(w.mesh, camera, width, height, cursor, 12.0f, p)) log_command(CommandKind::Delete, p);
+          else hud_data.status = "no curve under the cursor to delete";
+        } else if (e.key == GLFW_KEY_1) hud_data.view.surface = !hud_data.view.surface;
+        else if (e.key == GLFW_KEY_2) hud_data.view.curves = !hud_data.view.curves;
+        else if (e.key == GLFW_KEY_3) hud_data.view.wireframe = !hud_data.view.wireframe;
+        else if (e.key == GLFW_KEY_F) orbit = frame_orbit(scene_box(w.mesh, w.surface, reference_positions), width, height);
+        else if (e.key == GLFW_KEY_H || e.key == GLFW_KEY_F1) hud_data.help = !hud_data.help;
+        else if (e.key == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(window.handle(), GLFW_TRUE);
+        break;
+      case EventKind::Close:
+        break;
+    }
+  };
+
+  // One displayed frame: systems due by the wall clock, the upload, the HUD, the present.
+  auto display = [&](render::Image* capture) -> bool {
+    const int64_t now_us = session_us();
+    while (w.frame.end_us <= now_us) run_frame();
+    if (w.rejections.size() > rejections_seen) {
+      hud_data.last_rejection = w.rejections.back().reason;
+      rejections_seen = w.rejections.size();
+    }
+    window.framebuffer_size(width, height);
+    if (width == 0 || height == 0) return false;  // minimised: systems go on, nothing to show
+    camera = render::orbit_camera(orbit, width, height);
+    if (status = (*presenter)->wait(); !status) return false;
+    if (status = (*renderer)->upload(w.mesh, w.surface); !status) return false;
+    const std::span<const Vec3> stroke = w.sketch.pen_down ? std::span<const Vec3>(w.sketch.stroke) : std::span<const Vec3>();
+    if (status = (*renderer)->set_stroke(stroke); !status) return false;
+    const auto wall_now = WallClock::now();
+    hud_data.frame_ms = std::chrono::duration<double, std::milli>(wall_now - last_frame).count();
+    last_frame = wall_now;
+    hud_data.frames = scheduler.frames();
+    hud_data.timings = &scheduler.timings();
+    hud_data.frame_timing = &scheduler.frame_timing();
+    hud_data.vertices = w.mesh.vertex_count();
+    hud_data.edges = w.mesh.edge_count();
+    hud_data.faces = w.mesh.face_count();
+    hud_data.points = w.mesh.live_point_count();
+    hud_data.surface_quads = w.surface.quad_count();
+    hud_data.border_mode = w.mesh.face_count() == 0;
+    (*hud)->build(hud_data);
+    auto shown = (*presenter)->frame(**renderer, camera, hud_data.view, [&](VkCommandBuffer cmd) { (*hud)->draw(cmd); },
+                                     capture);
+    if (!shown) {
+      status = Status::failure(shown.error());
+      return false;
+    }
+    if (status = (*hud)->status(); !status) return false;
+    if (!*shown) status = (*presenter)->resize(width, height);
+    return *shown;
+  };
+
+  while (status && !window.should_close()) {
+    for (; next_script < script.size() && script[next_script].frame <= display_frame; ++next_script) {
+      const ScriptEvent& s = script[next_script];
+      if (s.resize_width) window.request_size(s.resize_width, s.resize_height);
+      else window.inject(s.event);
+    }
+    window.poll();
+    for (const window::WindowEvent& e : window.events()) handle(e);
+    window.events().clear();
+    if (!display(nullptr) && status && width == 0) std::this_thread::sleep_for(std::chrono::milliseconds(16));
+    ++display_frame;
+  }
+  if (!status) return fail("Vulkan: " + status.error);
+
+  // Every logged event handled, as `fire replay` ends; then the last picture, which --screenshot keeps.
+  while (w.cursor.next < w.log.events.size() || !w.sketch.pending.empty()) run_frame();
+  render::Image shot;
+  if (!a.screenshot_path.empty()) {
+    bool shown = false;
+    for (int attempt = 0; attempt < 3 && status && !shown; ++attempt) shown = display(&shot);
+    if (!status) return fail("Vulkan: " + status.error);
+    if (!shown) return fail("--screenshot: the window could not be drawn (minimised?)");
+  }
+  const uint64_t hash = world_hash(w);
+  const std::string device = (*context)->device_name();
+  const bool validation = (*context)->validation();
+  hud->reset();
+  presenter->reset();
+  renderer->reset();
+  const size_t messages = (*context)->validation_message_count();
+  context->reset();
+  win->reset();
+  if (messages) return fail(std::to_string(messages) + " Vulkan validation message(s), see above");
+  if (!a.screenshot_path.empty())
+    if (Status s = render::write_png(shot, a.screenshot_path); !s) return fail(s.error);
+  if (!a.record_path.empty())
+    if (Status s = write_file_atomic(a.record_path, format_input_log(w.log.events)); !s) return fail(s.error);
+
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016" PRIx64, hash);
+  nlohmann::ordered_json out;
+  out["display_frames"] = display_frame;
+  out["system_frames"] = scheduler.frames();
+  out["events"] = w.log.events.size();
+  out["edges"] = w.mesh.edge_count();
+  out["faces"] = w.mesh.face_count();
+  out["surface_quads"] = w.surface.quad_count();
+  out["hash"] = hex;
+  out["device"] = device;
+  out["validation"] = validation;
+  std::cout << out.dump() << "\n";
+  return 0;
+}
+
+}  // namespace
+
+void add_app_commands(CLI::App& app, Registry& registry) {
+  auto a = std::make_shared<AppArgs>();
+  CLI::App* cmd = app.add_subcommand("app", "The interactive window: the sketch, its surface and a HUD");
+  std::string keys;
+  for (const std::string& k : kKeys) keys += "  " + k + "\n";
+  cmd->footer(
+      "Opens a window (GLFW) drawn with Vulkan (lavapipe without a GPU) and a HUD: frame time, per-system "
+      "timings, counts, the sketch mode, the last rejected edit. NET (.fnet) is a network to continue from; "
+      "any other file is an input log, replayed first. The systems run at the scheduler's fixed step "
+      "(10 ms of log time) as the wall clock advances; vsync paces the display. Edits made with keys are "
+      "commands appended to the session's input log, so `fire replay` of the --record log reproduces the "
+      "session bit for bit. Needs a display (DISPLAY or WAYLAND_DISPLAY); without one it exits 1 and points "
+      "to `fire render`. On exit prints one JSON line: display_frames, system_frames, events, edges, faces, "
+      "surface_quads, hash (as `fire replay --hash`), device, validation. FIRE_VK_VALIDATION=1 turns the "
+      "validation layer on; any message then fails the command.\n\nKeys:\n" + keys);
+  cmd->add_option("NET", a->input_path, "curve network (.fnet) or input log to start from");
+  cmd->add_option("--reference", a->reference_path,
+                  "OBJ mesh drawn see-through; a left drag draws on it (ray casts through a BVH): a pen sample at "
+                  "every hit, logged with its snap radius");
+  cmd->add_option("--reference-levels", a->reference_levels,
+                  "the reference as its Catmull-Clark limit surface at this level (so strokes lie on the surface "
+                  "fire eval measures against); 0: its faces as they are")
+      ->capture_default_str();
+  cmd->add_option("--snap-pixels", a->snap_pixels,
+                  "snap radius of the mouse pen in screen pixels, converted to model units at each sample")
+      ->capture_default_str();
+  cmd->add_option("-o,--output", a->out_path, "where Ctrl+S saves the network (default: INPUT-app.fnet beside the "
+                                              "input, or fire-app.fnet)");
+  cmd->add_option("--record", a->record_path, "write the session's input log here on exit (not with a .fnet input)");
+  cmd->add_option("--size", a->size, "window size WIDTHxHEIGHT in pixels")->capture_default_str();
+  cmd->add_option("--levels", a->levels, "Catmull-Clark levels of the surface (1 to 6)")->capture_default_str();
+  cmd->add_option("--script", a->script_path,
+                  "test hook: input events delivered through the window's GLFW callbacks, one a line: "
+                  "'FRAME move X Y', 'FRAME press|release left|right|middle', 'FRAME scroll DY', "
+                  "'FRAME key [ctrl+][shift+]KEY', 'FRAME resize W H' (asks the window system), 'FRAME close'; FRAME is "
+                  "the display frame");
+  cmd->add_option("--screenshot", a->screenshot_path, "on exit, write the last presented frame (HUD included) as PNG");
+  cmd->callback([a, &registry] { registry.exit_code = run_app(*a); });
+}
+
+}  // namespace fire::cli
