@@ -182,6 +182,22 @@ bool has_device_extension(VkPhysicalDevice device, const char* name) {
 }
 }  // namespace
 
+Status Context::create_commands(VkCommandPool& pool, VkCommandBuffer& buffer, VkFence& fence, bool signaled) const {
+  VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pool_info.queueFamilyIndex = queue_family_;
+  FIRE_VK_TRY(vkCreateCommandPool(device_, &pool_info, nullptr, &pool));
+  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  alloc.commandPool = pool;
+  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  alloc.commandBufferCount = 1;
+  FIRE_VK_TRY(vkAllocateCommandBuffers(device_, &alloc, &buffer));
+  VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  if (signaled) fence_info.flags = VK_FENCE_CREATE_SIGNALED_BIT;
+  FIRE_VK_TRY(vkCreateFence(device_, &fence_info, nullptr, &fence));
+  return Status::success();
+}
+
 Status Context::pick_device(const ContextOptions& options) {
   uint32_t count = 0;
   const VkResult listed = vkEnumeratePhysicalDevices(instance_, &count, nullptr);

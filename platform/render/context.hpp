@@ -68,6 +68,9 @@ class Context {
   std::string device_name() const { return properties_.deviceName; }
   bool is_cpu_device() const { return properties_.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU; }
   bool validation() const { return messenger_ != VK_NULL_HANDLE; }
+  // A pool whose buffers can be reset, one primary command buffer from it, and a fence (already signalled
+  // when `signaled`, for a first wait with no frame in flight): what the offscreen and present paths record with.
+  Status create_commands(VkCommandPool& pool, VkCommandBuffer& buffer, VkFence& fence, bool signaled) const;
   // Whether polygons can be drawn as lines (the renderer's wireframe).
   bool wireframe_supported() const { return wireframe_; }
 

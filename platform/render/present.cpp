@@ -96,18 +96,7 @@ Status Presenter::init(uint32_t width, uint32_t height) {
   pass.pDependencies = &after_blit;
   FIRE_VK_TRY(vkCreateRenderPass(device, &pass, nullptr, &overlay_pass_));
 
-  VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-  pool.queueFamilyIndex = context_.queue_family();
-  FIRE_VK_TRY(vkCreateCommandPool(device, &pool, nullptr, &pool_));
-  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  alloc.commandPool = pool_;
-  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  alloc.commandBufferCount = 1;
-  FIRE_VK_TRY(vkAllocateCommandBuffers(device, &alloc, &commands_));
-  VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  fence.flags = VK_FENCE_CREATE_SIGNALED_BIT;  // no frame in flight yet
-  FIRE_VK_TRY(vkCreateFence(device, &fence, nullptr, &fence_));
+  FIRE_TRY(context_.create_commands(pool_, commands_, fence_, true));
   VkSemaphoreCreateInfo semaphore{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
   FIRE_VK_TRY(vkCreateSemaphore(device, &semaphore, nullptr, &acquired_));
   return create_swapchain(width, height);

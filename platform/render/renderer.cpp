@@ -62,7 +62,6 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Rende
 }
 
 Status Renderer::init() {
-  VkDevice device = context_.device();
   const VkPhysicalDeviceLimits& limits = context_.properties().limits;
   if (limits.framebufferColorSampleCounts & limits.framebufferDepthSampleCounts & VK_SAMPLE_COUNT_4_BIT)
     samples_ = VK_SAMPLE_COUNT_4_BIT;
@@ -73,17 +72,7 @@ Status Renderer::init() {
 
   FIRE_TRY(create_targets());
 
-  VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-  pool.queueFamilyIndex = context_.queue_family();
-  FIRE_VK_TRY(vkCreateCommandPool(device, &pool, nullptr, &pool_));
-  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  alloc.commandPool = pool_;
-  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  alloc.commandBufferCount = 1;
-  FIRE_VK_TRY(vkAllocateCommandBuffers(device, &alloc, &commands_));
-  VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  FIRE_VK_TRY(vkCreateFence(device, &fence, nullptr, &fence_));
+  FIRE_TRY(context_.create_commands(pool_, commands_, fence_, false));
   return create_pipelines();
 }
 
