@@ -101,4 +101,9 @@ class Context {
   std::vector<std::string> messages_;
 };
 
+// A layout transition of one image's first mip and layer, on one queue family.
+VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageAspectFlags aspect, VkImageLayout from, VkImageLayout to,
+                                    VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
+                                    VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access);
+
 }  // namespace fire::render

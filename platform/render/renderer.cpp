@@ -470,17 +470,9 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
   // Every target starts undefined: the frame clears or overwrites all of it.
   auto to_attachment = [](VkImage image, VkImageLayout layout, VkImageAspectFlags aspect, VkPipelineStageFlags2 stage,
                           VkAccessFlags2 access) {
-    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-    b.srcStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;  // the previous frame's copy or depth use
-    b.srcAccessMask = 0;
-    b.dstStageMask = stage;
-    b.dstAccessMask = access;
-    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    b.newLayout = layout;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = image;
-    b.subresourceRange = {aspect, 0, 1, 0, 1};
-    return b;
+    // The source is the previous frame's copy or depth use.
+    return image_barrier(image, aspect, VK_IMAGE_LAYOUT_UNDEFINED, layout, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0, stage,
+                         access);
   };
   std::vector<VkImageMemoryBarrier2> barriers;
   const VkPipelineStageFlags2 color_stage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
