@@ -18,8 +18,8 @@ using Sparse = Eigen::SparseMatrix<double>;
 
 
 // The umbrella operator of the base mesh: each vertex minus the mean of its neighbours. On the border
-// only the neighbours along the border count and corners (border vertices of one face) are left out,
-// as Catmull-Clark treats them, so that a flat grid costs nothing up to its border.
+// only the neighbours along the border count and the border's corners are left out, as Catmull-Clark
+// treats them, so that a flat grid costs nothing up to its border.
 Sparse umbrella(const BaseMesh& base) {
   const uint32_t n = base.vertex_count();
   std::unordered_map<uint64_t, uint32_t> sides;  // faces per undirected edge
@@ -44,7 +44,8 @@ Sparse umbrella(const BaseMesh& base) {
   std::vector<Eigen::Triplet<double>> entries;
   for (uint32_t v = 0; v < n; ++v) {
     const std::vector<uint32_t>& ring = border[v].empty() ? all[v] : border[v];
-    if (!border[v].empty() && faces[v] < 2) continue;
+    const bool corner = base.border_corners.empty() ? faces[v] < 2 : base.border_corners[v] != 0;
+    if (!border[v].empty() && corner) continue;
     entries.emplace_back(int(v), int(v), 1.0);
     for (uint32_t u : ring) entries.emplace_back(int(v), int(u), -1.0 / double(ring.size()));
   }

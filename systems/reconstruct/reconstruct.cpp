@@ -1,6 +1,8 @@
 #include "systems/reconstruct/reconstruct.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <string>
 
 #include "systems/reconstruct/fit.hpp"
@@ -27,7 +29,7 @@ struct ReconstructionCache {
   // What depends on the base mesh's topology alone.
   bool have_topology = false;
   std::vector<uint32_t> key_face_offsets, key_face_vertices, key_sharp, key_curve_ends;
-  std::vector<uint8_t> key_curve_drawn, key_vertex_drawn;
+  std::vector<uint8_t> key_curve_drawn, key_vertex_drawn, key_border_corners;
   uint32_t key_vertex_count = 0;
   subdivide::Refinement refinement;
   subdivide::LimitStencils limit;
@@ -47,6 +49,32 @@ namespace {
 
 bool used_by_face(const Mesh& net, uint32_t e) {
   return net.edges.face[e][0] != kNone || net.edges.face[e][1] != kNone;
+}
+
+// The unit direction in which edge e leaves its end v, from v to the polyline's point a fraction
+// kTangentReach of its length along: far enough that a hand's jitter does not turn it, near enough to
+// be the curve's own direction.
+Vec3 leaving_direction(const Mesh& net, uint32_t e, uint32_t v) {
+  std::vector<Vec3> line(net.polyline(e).begin(), net.polyline(e).end());
+  if (net.edges.vertex[e][0] != v) std::reverse(line.begin(), line.end());
+  const std::vector<double> params = arc_parameters(line);
+  const Vec3 d = sample_polyline(line, params, kTangentReach, Sampling::linear) - line.front();
+  return d.normalized();
+}
+
+// A border network vertex is a corner of the surface where the border turns by more than
+// kBorderCornerTurnDegrees; where it goes straight on it is a smooth point of the border.
+bool border_corner(const Mesh& net, uint32_t v) {
+  uint32_t border[2], count = 0;
+  for (uint32_t e : net.vertex_edges(v))
+    if (used_by_face(net, e) && net.is_border_edge(e)) {
+      if (count == 2) return true;  // the border touches itself here
+      border[count++] = e;
+    }
+  if (count != 2) return true;
+  const double cosine = leaving_direction(net, border[0], v).dot(leaving_direction(net, border[1], v));
+  const double turn = 180.0 - std::acos(std::clamp(cosine, -1.0, 1.0)) * 180.0 / std::numbers::pi;
+  return !(turn <= kBorderCornerTurnDegrees);
 }
 
 
@@ -146,6 +174,7 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
       vertex_id[v] = base.vertex_count();
       base.positions.push_back(net.vertices.position[v]);
       base.vertex_drawn.push_back(1);
+      if (options.method == Method::fire) base.border_corners.push_back(border_corner(net, v) ? 1 : 0);
     }
   for (uint32_t e = 0; e < net.edge_slots(); ++e) {
     if (!c.edge_valid[e]) continue;
@@ -207,19 +236,20 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
       base.curve_drawn.push_back(0);
     }
   }
+  if (options.method == Method::fire) base.border_corners.resize(base.vertex_count(), 0);
   return base;
 }
 
 bool same_topology(const ReconstructionCache& c, const BaseMesh& b) {
   return c.have_topology && c.key_vertex_count == b.vertex_count() && c.key_face_offsets == b.face_offsets &&
-         c.key_face_vertices == b.face_vertices && c.key_sharp == b.sharp_edges && c.key_curve_ends == b.curve_ends &&
+         c.key_face_vertices == b.face_vertices && c.key_sharp == b.sharp_edges && c.key_border_corners == b.border_corners && c.key_curve_ends == b.curve_ends &&
          c.key_curve_drawn == b.curve_drawn && c.key_vertex_drawn == b.vertex_drawn;
 }
 
 Status rebuild_topology(const Options& options, ReconstructionCache& c) {
   const BaseMesh& b = c.base;
   c.have_topology = false;
-  subdivide::BaseTopology topology{b.vertex_count(), b.face_offsets, b.face_vertices, b.sharp_edges};
+  subdivide::BaseTopology topology{b.vertex_count(), b.face_offsets, b.face_vertices, b.sharp_edges, b.border_corners};
   auto refinement = subdivide::build_refinement(topology, {static_cast<int>(options.levels), true});
   if (!refinement) return Status::failure("the base mesh cannot be subdivided: " + refinement.error());
   auto limit = subdivide::build_limit_stencils(*refinement);
@@ -237,6 +267,7 @@ Status rebuild_topology(const Options& options, ReconstructionCache& c) {
   c.key_face_offsets = b.face_offsets;
   c.key_face_vertices = b.face_vertices;
   c.key_sharp = b.sharp_edges;
+  c.key_border_corners = b.border_corners;
   c.key_curve_ends = b.curve_ends;
   c.key_curve_drawn = b.curve_drawn;
   c.key_vertex_drawn = b.vertex_drawn;

@@ -30,6 +30,12 @@
 namespace fire::reconstruct {
 
 inline constexpr uint32_t kMaxCoonsSteps = 5;
+// fire: a border vertex of the network is a corner of the surface only where the border turns by more
+// than this many degrees, the turn measured between the directions in which its two border curves leave
+// it, each towards its point kTangentReach of the curve's length away. Elsewhere the border runs
+// smoothly through it (thesis: a vertex where a curve merely goes on is no corner).
+inline constexpr double kBorderCornerTurnDegrees = 30.0;
+inline constexpr double kTangentReach = 0.15;
 // Surface levels the options allow (the Catmull-Clark library itself refines further).
 inline constexpr uint32_t kMaxSurfaceLevels = 6;
 
@@ -51,6 +57,9 @@ struct BaseMesh {
   std::vector<uint32_t> face_offsets{0};
   std::vector<uint32_t> face_vertices;
   std::vector<uint32_t> sharp_edges;  // vertex pairs along network edges marked sharp
+  // fire: per vertex, 1 where the border is a corner of the surface (subdivide::BaseTopology::
+  // border_corners); empty for thesis, whose border keeps Catmull-Clark's EdgeAndCorner rule.
+  std::vector<uint8_t> border_corners;
   // One curve per base edge, from curve_ends[2c] to curve_ends[2c+1]: a piece of a network polyline
   // (drawn) or a polyline made inside a face (a triquadrification cut or a spoke).
   std::vector<uint32_t> curve_ends;

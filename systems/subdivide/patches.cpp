@@ -330,7 +330,12 @@ void plan_regular_patches(const BaseTopology& topology, Refinement& refinement) 
         break;
       }
     }
-    const BaseTopology rest_topology{static_cast<uint32_t>(plan.rest_controls.size()), offsets, vertices, sharp};
+    // A vertex on the rest's border that is inside the whole mesh moves no point the rest is used for, so
+    // its flag does not matter.
+    std::vector<uint8_t> corners;
+    if (!topology.border_corners.empty())
+      for (uint32_t v : plan.rest_controls) corners.push_back(topology.border_corners[v]);
+    const BaseTopology rest_topology{static_cast<uint32_t>(plan.rest_controls.size()), offsets, vertices, sharp, corners};
     Result<Refinement> rest = build_levels(rest_topology, {static_cast<int>(depth), false});
     if (!rest) return;
     plan.rest = std::move(rest->levels);

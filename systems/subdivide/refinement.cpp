@@ -39,6 +39,9 @@ Status validate_base(const BaseTopology& base) {
           return Status::failure("face " + std::to_string(f) + " uses vertex " + std::to_string(verts[c]) + " twice");
     }
   }
+  if (!base.border_corners.empty() && base.border_corners.size() != base.vertex_count)
+    return Status::failure("border corner flags must be one per vertex: " + std::to_string(base.border_corners.size()) +
+                           " flags for " + std::to_string(base.vertex_count) + " vertices");
   if (base.sharp_edges.size() % 2 != 0)
     return Status::failure("sharp edges must be vertex pairs, got an odd count of " +
                            std::to_string(base.sharp_edges.size()) + " indices");
@@ -220,7 +223,10 @@ Result<Level> build_base_level(const BaseTopology& base) {
     if (visited != face_total)
       return Result<Level>::failure("vertex " + std::to_string(v) + " is not manifold: its " +
                                     std::to_string(face_total) + " faces do not form a single fan");
-    if (boundary && visited == 1) {
+    const bool given = !base.border_corners.empty();
+    if (boundary && given) {
+      level.vertex_rules[v] = base.border_corners[v] || sharp_count > 2 ? VertexRule::corner : VertexRule::crease;
+    } else if (boundary && visited == 1) {
       level.vertex_rules[v] = VertexRule::corner;
     } else {
       level.vertex_rules[v] = sharp_count == 0   ? VertexRule::smooth

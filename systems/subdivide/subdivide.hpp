@@ -1,6 +1,7 @@
 #pragma once
 // Catmull-Clark subdivision equal to OpenSubdiv's Catmark scheme with boundary interpolation
-// EdgeAndCorner (boundary edges are infinitely sharp, boundary vertices with one face are corners),
+// EdgeAndCorner (boundary edges are infinitely sharp, boundary vertices with one face are corners; or
+// the border's corners given per vertex, BaseTopology::border_corners),
 // infinitely sharp creases, faces of any size and vertices of any valence.
 //
 // Topology lives in flat index arrays per level. Refinement from level l to l+1 is given by
@@ -38,12 +39,16 @@ enum class VertexRule : uint8_t { smooth, dart, crease, corner };
 
 // The base mesh as plain arrays: face f uses face_vertices[face_offsets[f] .. face_offsets[f+1]),
 // counter-clockwise seen from outside; sharp_edges holds vertex index pairs (a0, b0, a1, b1, ...) of
-// edges that are infinitely sharp creases.
+// edges that are infinitely sharp creases. border_corners, when given (one flag per vertex), says which
+// boundary vertices are corners instead of EdgeAndCorner's rule: a flagged boundary vertex is a corner,
+// an unflagged one with a single face is a smooth point of its border (the crease rule along it); flags
+// of interior vertices are ignored.
 struct BaseTopology {
   uint32_t vertex_count = 0;
   std::span<const uint32_t> face_offsets;
   std::span<const uint32_t> face_vertices;
   std::span<const uint32_t> sharp_edges;
+  std::span<const uint8_t> border_corners = {};
 };
 
 // One level's topology. A "corner" is one entry of face_vertices; corner c of face f lies in

@@ -110,6 +110,30 @@ TEST_CASE("FIRE: an n-sided face becomes n quads around its centre", "[reconstru
   }
 }
 
+TEST_CASE("FIRE: a border vertex is a corner only where the border turns", "[reconstruct][fire]") {
+  // Two unit squares side by side: the four outer corners turn by 90 degrees, the middle vertices of
+  // the long sides go straight on.
+  const Mesh grid = grid_network(2, 1, 9, [](double x, double y) { return 0.1 * x * y; });
+  const BaseMesh b = base_of(grid, {Method::fire, 1, 2, Planarity::least_squares});
+  REQUIRE(b.border_corners.size() == b.vertex_count());
+  uint32_t corners = 0;
+  for (uint32_t v = 0; v < b.vertex_count(); ++v) {
+    const Vec3& p = b.positions[v];
+    const bool outer = (p.x() == 0 || p.x() == 2) && (p.y() == 0 || p.y() == 1);
+    INFO("base vertex " << v << " at " << p.transpose());
+    CHECK(b.border_corners[v] == (outer ? 1 : 0));
+    corners += b.border_corners[v];
+  }
+  CHECK(corners == 4);
+  // A face bounded by arcs of one circle has a smooth border: no corners at all, where EdgeAndCorner
+  // made each meeting point of two arcs a corner.
+  const Mesh disk = polygon_network(4);
+  const BaseMesh d = base_of(disk, {Method::fire, 1, 2, Planarity::least_squares});
+  for (uint8_t flag : d.border_corners) CHECK(flag == 0);
+  // The thesis pipeline keeps Catmull-Clark's own rule.
+  CHECK(base_of(disk, {Method::thesis, 1, 2, Planarity::least_squares}).border_corners.empty());
+}
+
 TEST_CASE("FIRE: the fitted limit surface passes through the drawn samples", "[reconstruct][fire][fit]") {
   // Curves sampled on the limit surface of a 4 x 4 control grid at its level-3 vertices: the FIRE base
   // mesh has the grid's topology, so a surface through every sample exists.

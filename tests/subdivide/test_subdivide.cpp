@@ -89,6 +89,32 @@ TEST_CASE("boundary edges are creases and single-face boundary vertices are corn
   CHECK(result->quads.size() == 4 * 16);
 }
 
+TEST_CASE("given border corners: unflagged single-face boundary vertices move along their border", "[subdivide]") {
+  // A 2 x 1 strip of unit quads: vertices 0 1 2 along y = 0, 3 4 5 along y = 1.
+  const std::vector<Vec3> strip = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0}};
+  const std::vector<uint32_t> offsets = {0, 4, 8}, faces = {0, 1, 4, 3, 1, 2, 5, 4};
+  const std::vector<uint8_t> only_0 = {1, 0, 0, 0, 1, 0};
+  auto refinement = sd::build_refinement({6, offsets, faces, {}, only_0}, {1, true});
+  REQUIRE(refinement.ok());
+  const auto& rules = refinement->levels[0].vertex_rules;
+  CHECK(rules[0] == sd::VertexRule::corner);  // flagged, one face
+  CHECK(rules[2] == sd::VertexRule::crease);  // unflagged, one face: EdgeAndCorner would make it a corner
+  CHECK(rules[1] == sd::VertexRule::crease);  // unflagged, two faces: as EdgeAndCorner
+  CHECK(rules[4] == sd::VertexRule::corner);  // flagged, two faces: a corner EdgeAndCorner would not make
+  // The crease rule along the border: vertex 2 moves to 3/4 of itself plus 1/8 of its border neighbours
+  // (1 and 5), off its own position, where a corner would stay.
+  std::vector<Vec3> points, scratch;
+  sd::evaluate(*refinement, strip, points, scratch);
+  CHECK((points[2] - (0.75 * strip[2] + 0.125 * (strip[1] + strip[5]))).norm() < 1e-15);
+  CHECK((points[0] - strip[0]).norm() == 0.0);
+  auto limit = sd::build_limit_stencils(*refinement);
+  REQUIRE(limit.ok());
+  // Flags for a different vertex count are refused with both counts named.
+  const std::vector<uint8_t> short_flags = {1, 0};
+  const std::string error = error_of({6, offsets, faces, {}, short_flags});
+  CHECK(contains(error, "2 flags for 6 vertices"));
+}
+
 TEST_CASE("n-gons become n quads and the face point is their centroid", "[subdivide]") {
   // A pentagon (boundary) split into 5 quads around its centroid.
   std::vector<Vec3> pentagon;
