@@ -59,6 +59,29 @@ class Gaussian {
   bool has_spare_ = false;
 };
 
+// White noise (one unit-variance sample per inner polyline point; zero at the ends) made correlated along
+// the line: each point's offset is a Gaussian-weighted mean over arc length (standard deviation
+// `length`, cut at 3 of them) of its neighbours' samples, scaled back to unit variance. A tracked,
+// filtered pen errs like this: smoothly along the stroke, not independently per sample.
+std::vector<Vec3> correlate_along(std::span<const Vec3> line, std::span<const Vec3> white, double length) {
+  std::vector<double> arc(line.size(), 0.0);
+  for (size_t i = 1; i < line.size(); ++i) arc[i] = arc[i - 1] + (line[i] - line[i - 1]).norm();
+  std::vector<Vec3> out(line.size(), Vec3::Zero());
+  for (size_t i = 1; i + 1 < line.size(); ++i) {
+    Vec3 sum = Vec3::Zero();
+    double squares = 0;
+    for (size_t j = 1; j + 1 < line.size(); ++j) {
+      const double d = (arc[j] - arc[i]) / length;
+      if (std::abs(d) > 3) continue;
+      const double w = std::exp(-0.5 * d * d);
+      sum += w * white[j];
+      squares += w * w;
+    }
+    out[i] = sum / std::sqrt(squares);
+  }
+  return out;
+}
+
 std::string obj_vertex(uint32_t v) { return std::to_string(v + 1); }
 
 // Half-edge h is the side of face half_face[h] from corner h to the next corner (h indexes face_vertices).
@@ -91,6 +114,8 @@ Status check_input(const PolygonMeshView& in, const UnrefineOptions& o, const st
     return Status::failure(src + ": samples per edge must be between 8 and 65536, not " + std::to_string(o.samples_per_edge));
   if (!std::isfinite(o.noise_percent) || o.noise_percent < 0)
     return Status::failure(src + ": noise percent must be a finite number >= 0");
+  if (!std::isfinite(o.noise_correlation_percent) || o.noise_correlation_percent < 0)
+    return Status::failure(src + ": noise correlation length must be a finite number >= 0");
   const auto& off = in.face_offsets;
   if (off.size() < 2 || off[0] != 0 || off.back() != in.face_vertices.size())
     return Status::failure(src + ": no faces, or face offsets that do not cover the face vertex list");
@@ -498,6 +523,7 @@ Result<Mesh> network_from_mesh(const PolygonMeshView& control, const UnrefineOpt
   double total_length = 0;
   for (uint32_t e = 0; e < ne; ++e) total_length += (c.positions[c.edge_head(e)] - c.positions[c.edge_tail(e)]).norm();
   const double sigma = o.noise_percent / 100.0 * (total_length / double(ne));
+  const double correlation = o.noise_correlation_percent / 100.0 * (total_length / double(ne));
   Gaussian noise(o.seed);
   std::vector<uint32_t> chain_edge(chains.size());
   std::vector<Vec3> line;
@@ -506,15 +532,21 @@ Result<Mesh> network_from_mesh(const PolygonMeshView& control, const UnrefineOpt
     line.clear();
     if (!limit) sample_chain_linear(c.positions, cv, o.samples_per_edge, line);
     else if (!limit->sample_chain(cv, line)) return fail(src + ": internal error: a chain leaves the control edges");
-    if (sigma > 0)
+    if (sigma > 0) {
+      std::vector<Vec3> white(line.size(), Vec3::Zero());
       for (size_t i = 1; i + 1 < line.size(); ++i) {
         // Drawn one by one: the order of evaluation of constructor arguments is unspecified.
         const double dx = noise.next();
         const double dy = noise.next();
         const double dz = noise.next();
-        line[i] += sigma * Vec3(dx, dy, dz);
+        white[i] = Vec3(dx, dy, dz);
+      }
+      const std::vector<Vec3> offsets = correlation > 0 ? correlate_along(line, white, correlation) : white;
+      for (size_t i = 1; i + 1 < line.size(); ++i) {
+        line[i] += sigma * offsets[i];
         if (!is_finite(line[i])) return fail(src + ": noise of " + std::to_string(o.noise_percent) + " percent overflows the coordinates");
       }
+    }
     chain_edge[k] = mesh.add_edge(net_vertex[cv.front()], net_vertex[cv.back()], line);
   }
 

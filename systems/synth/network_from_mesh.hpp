@@ -24,6 +24,9 @@ struct PolygonMeshView {
 struct UnrefineOptions {
   uint32_t unrefine = 1;          // keep every K-th edge loop; 1 keeps every edge
   double noise_percent = 0;       // Gaussian sigma, in percent of the mean control edge length
+  // Correlation length of the noise along each polyline, in percent of the mean control edge length; 0
+  // draws every point's noise independently.
+  double noise_correlation_percent = 0;
   uint64_t seed = 0;              // seeds the noise
   uint32_t samples_per_edge = 8;  // polyline points each control edge contributes (at least 8)
   // Sample the control mesh's Catmull-Clark limit surface instead of its straight edges: vertices sit at

@@ -281,6 +281,55 @@ TEST_CASE("noise is seeded, reproducible, and moves only interior polyline point
   CHECK(measured == Approx(sigma).epsilon(0.1));
 }
 
+TEST_CASE("correlated noise keeps its deviation and varies smoothly along each polyline", "[synth]") {
+  PolygonMesh torus = load("torus.obj");
+  auto noisy = [&](double correlation) {
+    UnrefineOptions o;
+    o.unrefine = 2;
+    o.noise_percent = 5.0;
+    o.noise_correlation_percent = correlation;
+    o.seed = 42;
+    o.samples_per_edge = 32;
+    return network_from_mesh(view_of(torus, "torus.obj"), o);
+  };
+  auto clean = network(torus, 2, 0.0, 0, 32);
+  auto independent = noisy(0.0), correlated = noisy(50.0);
+  REQUIRE((clean.ok() && independent.ok() && correlated.ok()));
+  CHECK(correlated->validate().empty());
+  // No correlation is the independent model, point for point.
+  CHECK(independent->same_pools(*network(torus, 2, 5.0, 42, 32)));
+  // Both keep the standard deviation asked for; the correlated offsets of neighbouring points are
+  // nearly equal (lag-1 correlation near 1), the independent ones unrelated (near 0).
+  auto statistics = [&](const Mesh& m) {
+    double squares = 0, products = 0;
+    size_t count = 0, pairs = 0;
+    for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+      auto line = m.polyline(e), truth = clean->polyline(e);
+      for (size_t i = 1; i + 1 < line.size(); ++i) {
+        const Vec3 d = line[i] - truth[i];
+        squares += d.squaredNorm();
+        ++count;
+        if (i + 2 < line.size()) {
+          products += d.dot(line[i + 1] - truth[i + 1]);
+          ++pairs;
+        }
+      }
+    }
+    const double variance = squares / double(count);
+    return std::pair{std::sqrt(variance / 3.0), products / double(pairs) / variance};
+  };
+  const double sigma = 0.05 * mean_control_edge_length(torus);
+  const auto [independent_sigma, independent_lag1] = statistics(*independent);
+  const auto [correlated_sigma, correlated_lag1] = statistics(*correlated);
+  CHECK(independent_sigma == Approx(sigma).epsilon(0.1));
+  CHECK(correlated_sigma == Approx(sigma).epsilon(0.25));
+  CHECK(std::abs(independent_lag1) < 0.1);
+  CHECK(correlated_lag1 > 0.9);
+  UnrefineOptions bad;
+  bad.noise_correlation_percent = -1;
+  CHECK_THAT(network_from_mesh(view_of(torus, "torus.obj"), bad).error(), Catch::Contains("noise correlation length"));
+}
+
 TEST_CASE("fan.obj is non-manifold: the error names an edge shared by 3 faces", "[synth]") {
   PolygonMesh fan = load("fan.obj");
   auto net = network_from_mesh(view_of(fan, "fan.obj"), UnrefineOptions{});
