@@ -75,14 +75,16 @@ double squared_gap(const B& b, const Vec3& p) {
 using DoublePair = double __attribute__((vector_size(16)));
 using FloatPair = float __attribute__((vector_size(8)));
 
-// squared_gap() of both children's boxes at once, with the same arithmetic in the same order.
+// squared_gap() of a node's entries 2h and 2h+1 at once, with the same arithmetic in the same order; NaN
+// for an empty entry, which no bound admits. (Pairs, not one four-wide vector: without AVX, GCC spills
+// four-wide doubles through memory.)
 template <class Node>
-DoublePair children_gaps(const Node& n, const Vec3& p) {
+DoublePair entry_gaps(const Node& n, int h, const Vec3& p) {
   DoublePair s = {0, 0};
   for (int a = 0; a < 3; ++a) {
     FloatPair lo, hi;
-    std::memcpy(&lo, n.lo[a], sizeof lo);
-    std::memcpy(&hi, n.hi[a], sizeof hi);
+    std::memcpy(&lo, n.lo[a] + 2 * h, sizeof lo);
+    std::memcpy(&hi, n.hi[a] + 2 * h, sizeof hi);
     const DoublePair below = __builtin_convertvector(lo, DoublePair) - p[a];
     const DoublePair above = p[a] - __builtin_convertvector(hi, DoublePair);
     DoublePair g = below < above ? above : below;
@@ -92,10 +94,18 @@ DoublePair children_gaps(const Node& n, const Vec3& p) {
   return s;
 }
 
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
 // The depth a subtree with this many leaves may reach before it is rebuilt.
 int32_t depth_limit(uint32_t leaves) { return 2 * int32_t(std::bit_width(leaves)) + 2; }
 
 }  // namespace
+
+inline SnapIndex::Box SnapIndex::Node::box(int s) const {
+  Box b = entry_box(2 * s);
+  if (entry[2 * s + 1] != kNone) merge_into(b, entry_box(2 * s + 1));
+  return b;
+}
 
 // ---- updates
 
@@ -257,6 +267,7 @@ uint32_t SnapIndex::new_node() {
   return static_cast<uint32_t>(nodes_.size() - 1);
 }
 
+
 SnapIndex::Box SnapIndex::box_of(uint32_t ref) const {
   if (ref & kLeafRef) return leaves_[ref & ~kLeafRef].box;
   Box b = nodes_[ref].box(0);
@@ -264,7 +275,20 @@ SnapIndex::Box SnapIndex::box_of(uint32_t ref) const {
   return b;
 }
 
-void SnapIndex::replace_child(uint32_t parent, uint32_t old_ref, uint32_t new_ref, const Box& box) {
+// Copies child s's boxes and references into node i's entries; the child must be up to date.
+void SnapIndex::fill(uint32_t i, int s) {
+  Node& n = nodes_[i];
+  const uint32_t c = n.child[s];
+  if (c & kLeafRef) {
+    n.set_entry(2 * s, c, leaves_[c & ~kLeafRef].box);
+    n.set_entry(2 * s + 1, kNone, {{kNaN, kNaN, kNaN}, {kNaN, kNaN, kNaN}});
+    return;
+  }
+  const Node& cn = nodes_[c];
+  for (int k = 0; k < 2; ++k) n.set_entry(2 * s + k, cn.child[k], cn.box(k));
+}
+
+void SnapIndex::replace_child(uint32_t parent, uint32_t old_ref, uint32_t new_ref) {
   if (parent == kNone) {
     root_ = new_ref;
     return;
@@ -272,12 +296,12 @@ void SnapIndex::replace_child(uint32_t parent, uint32_t old_ref, uint32_t new_re
   Node& p = nodes_[parent];
   const int s = p.child[0] == old_ref ? 0 : 1;
   p.child[s] = new_ref;
-  p.set_box(s, box);
+  fill(parent, s);
 }
 
 // Picks the sibling that adds the least box area over the path (the surface area heuristic, greedily
-// down the tree), growing the boxes on the way, and pairs the leaf with it under a new node. Heights and
-// counts above wait for refit_touched().
+// down the tree) and pairs the leaf with it under a new node. Boxes, heights and counts above wait for
+// refit_touched().
 void SnapIndex::insert_leaf(uint32_t leaf) {
   parent_of(leaf) = kNone;
   if (root_ == kNone) {
@@ -302,27 +326,23 @@ void SnapIndex::insert_leaf(uint32_t leaf) {
     if (here < cost[0] && here < cost[1]) break;
     const int s = cost[0] <= cost[1] ? 0 : 1;
     ib = n.box(s);
-    Box grown = ib;
-    merge_into(grown, lb);
-    n.set_box(s, grown);
     i = n.child[s];
   }
   const uint32_t sibling = i, old_parent = parent_of(sibling);
   const uint32_t p = new_node();
-  nodes_[p].set_box(0, ib);
-  nodes_[p].set_box(1, lb);
   nodes_[p].child[0] = sibling;
   nodes_[p].child[1] = leaf;
+  fill(p, 0);
+  fill(p, 1);
   parent_[p] = old_parent;
   parent_of(sibling) = p;
   parent_of(leaf) = p;
-  Box pb = ib;
-  merge_into(pb, lb);
-  replace_child(old_parent, sibling, p, pb);
+  replace_child(old_parent, sibling, p);
   touched_.push_back(p);
 }
 
 // Puts the leaf's sibling in its parent's place; boxes, heights and counts above wait for refit_touched().
+// A subtree the sibling roots may itself be awaiting its refit, which refills the entries copied here.
 void SnapIndex::remove_leaf(uint32_t leaf) {
   if (leaf == root_) {
     root_ = kNone;
@@ -331,22 +351,21 @@ void SnapIndex::remove_leaf(uint32_t leaf) {
   const uint32_t p = parent_of(leaf), gp = parent_[p];
   const int s = nodes_[p].child[0] == leaf ? 1 : 0;
   const uint32_t sibling = nodes_[p].child[s];
-  const Box sb = nodes_[p].box(s);
   parent_of(sibling) = gp;
-  replace_child(gp, p, sibling, sb);
+  replace_child(gp, p, sibling);
   free_nodes_.push_back(p);
   parent_[p] = kFreed;
   if (gp != kNone) touched_.push_back(gp);
 }
 
-// Boxes, heights and leaf counts from node i to the root.
+// Entries, heights and leaf counts from node i to the root.
 void SnapIndex::refit_up(uint32_t i) {
   for (; i != kNone; i = parent_[i]) {
+    fill(i, 0);
+    fill(i, 1);
     const Node& n = nodes_[i];
     height_[i] = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
     leaves_under_[i] = leaves_of(n.child[0]) + leaves_of(n.child[1]);
-    const uint32_t p = parent_[i];
-    if (p != kNone) nodes_[p].set_box(nodes_[p].child[0] == i ? 0 : 1, box_of(i));
   }
 }
 
@@ -377,7 +396,7 @@ void SnapIndex::refit_marked(uint32_t i, std::vector<uint32_t>& unbalanced) {
     const uint32_t c = n.child[s];
     if (c & kLeafRef || !marked_[c]) continue;
     refit_marked(c, unbalanced);
-    n.set_box(s, box_of(c));
+    fill(i, s);
   }
   height_[i] = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
   leaves_under_[i] = leaves_of(n.child[0]) + leaves_of(n.child[1]);
@@ -417,7 +436,7 @@ void SnapIndex::rebuild_subtree(uint32_t top) {
     stack.pop_back();
     for (int s = 0; s < 2; ++s) {
       const uint32_t c = nodes_[i].child[s];
-      if (c & kLeafRef) items.push_back({c, nodes_[i].box(s)});
+      if (c & kLeafRef) items.push_back({c, box_of(c)});
       else stack.push_back(c);
     }
     if (i != top) free_nodes_.push_back(i);
@@ -450,18 +469,15 @@ void SnapIndex::build(std::span<Item> items, uint32_t node, uint32_t parent) {
   const std::span<Item> half[2] = {items.first(mid), items.subspan(mid)};
   for (int s = 0; s < 2; ++s) {
     uint32_t ref;
-    Box box;
     if (half[s].size() == 1) {
       ref = half[s][0].ref;
-      box = half[s][0].box;
       parent_of(ref) = node;
     } else {
       ref = new_node();
       build(half[s], ref, node);
-      box = box_of(ref);
     }
     nodes_[node].child[s] = ref;
-    nodes_[node].set_box(s, box);
+    fill(node, s);
   }
   const Node& n = nodes_[node];
   height_[node] = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
@@ -472,61 +488,77 @@ void SnapIndex::build(std::span<Item> items, uint32_t node, uint32_t parent) {
 
 // Starts loading what a child reference points at while the current node is still being worked on.
 void SnapIndex::prefetch(uint32_t ref) const {
-  if (ref & kLeafRef) {
-    const char* l = reinterpret_cast<const char*>(&leaves_[ref & ~kLeafRef]);
-    for (size_t b = 0; b < sizeof(Leaf); b += 64) __builtin_prefetch(l + b);
-  } else {
-    __builtin_prefetch(&nodes_[ref]);
-  }
+  const char* at = ref & kLeafRef ? reinterpret_cast<const char*>(&leaves_[ref & ~kLeafRef])
+                                   : reinterpret_cast<const char*>(&nodes_[ref]);
+  const size_t bytes = ref & kLeafRef ? sizeof(Leaf) : sizeof(Node);
+  for (size_t b = 0; b < bytes; b += 64) __builtin_prefetch(at + b);
 }
+
+namespace {
+
+// A node's four entry gaps, and which entry is nearest (an empty entry's NaN counts as farthest).
+template <class Node>
+[[gnu::always_inline]] inline int nearest_entry(const Node& n, const Vec3& p, double (&g)[4]) {
+  const DoublePair g01 = entry_gaps(n, 0, p), g23 = entry_gaps(n, 1, p);
+  g[0] = g01[0], g[1] = g01[1], g[2] = g23[0], g[3] = g23[1];
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  const DoublePair k01 = g01 == g01 ? g01 : inf, k23 = g23 == g23 ? g23 : inf;
+  const int m01 = k01[1] < k01[0] ? 1 : 0, m23 = k23[1] < k23[0] ? 3 : 2;
+  return (m23 == 3 ? k23[1] : k23[0]) < (m01 == 1 ? k01[1] : k01[0]) ? m23 : m01;
+}
+
+}  // namespace
 
 SnapHit SnapIndex::nearest(const Vec3& p, double radius) const {
   SnapHit best;
   if (root_ == kNone) return best;
   double bound = bound_of(radius);
+  auto visit = [&](const Leaf& l) {
+    for (uint32_t k = 0; k < kLeafPoints; k += 2) {
+      DoublePair x, y, z;
+      std::memcpy(&x, l.x + k, sizeof x);
+      std::memcpy(&y, l.y + k, sizeof y);
+      std::memcpy(&z, l.z + k, sizeof z);
+      const DoublePair dx = x - p.x(), dy = y - p.y(), dz = z - p.z();
+      const auto near = dx * dx + dy * dy + dz * dz <= bound;
+      for (uint32_t j = 0; j < 2; ++j) {
+        if (!near[j]) continue;
+        const double d = (Vec3(l.x[k + j], l.y[k + j], l.z[k + j]) - p).norm();
+        if (d <= radius && before(d, l.edge, l.first + k + j, best)) {
+          best = {l.edge, l.first + k + j, d};
+          bound = bound_of(d);
+        }
+      }
+    }
+  };
   struct Pending {
     uint32_t ref;
     double gap;
   };
   Pending stack[kStack];  // left uninitialised: a query must not pay for clearing it
   size_t top = 0;
-  stack[top++] = {root_, squared_gap(box_of(root_), p)};
+  stack[top++] = {root_, 0.0};  // the root's entries or points are tested when it is popped
   while (top > 0) {
     const auto [ref, gap] = stack[--top];
     if (gap > bound) continue;
     if (ref & kLeafRef) {
-      const Leaf& l = leaves_[ref & ~kLeafRef];
-      for (uint32_t k = 0; k < kLeafPoints; k += 2) {
-        DoublePair x, y, z;
-        std::memcpy(&x, l.x + k, sizeof x);
-        std::memcpy(&y, l.y + k, sizeof y);
-        std::memcpy(&z, l.z + k, sizeof z);
-        const DoublePair dx = x - p.x(), dy = y - p.y(), dz = z - p.z();
-        const auto near = dx * dx + dy * dy + dz * dz <= bound;
-        for (uint32_t j = 0; j < 2; ++j) {
-          if (!near[j]) continue;
-          const double d = (Vec3(l.x[k + j], l.y[k + j], l.z[k + j]) - p).norm();
-          if (d <= radius && before(d, l.edge, l.first + k + j, best)) {
-            best = {l.edge, l.first + k + j, d};
-            bound = bound_of(d);
-          }
-        }
-      }
+      visit(leaves_[ref & ~kLeafRef]);
       continue;
     }
     const Node& n = nodes_[ref];
-    const DoublePair g = children_gaps(n, p);
-    // The nearer child goes on top, so it is searched first and tightens the bound for the other. Pushes
-    // are unconditional writes with a conditional count: which child is nearer is a coin toss that a
-    // branch would mispredict.
-    const int nearer = g[1] < g[0] ? 1 : 0;
-    const double gn = g[nearer], gf = g[1 - nearer];
-    stack[top] = {n.child[1 - nearer], gf};
-    top += gf <= bound;
-    stack[top] = {n.child[nearer], gn};
-    top += gn <= bound;
-    prefetch(n.child[nearer]);
-    prefetch(n.child[1 - nearer]);
+    double g[4];
+    const int m = nearest_entry(n, p, g);
+    // The nearest entry goes on top, so it is searched first and tightens the bound for the others.
+    // Pushes are unconditional writes with a conditional count: which entry is nearest is a coin toss
+    // that branches would mispredict.
+    const size_t first = top;
+    for (int k = 0; k < 4; ++k) {
+      stack[top] = {n.entry[k], g[k]};
+      top += k != m && g[k] <= bound;
+    }
+    stack[top] = {n.entry[m], g[m]};
+    top += g[m] <= bound;
+    for (size_t k = first; k < top; ++k) prefetch(stack[k].ref);
   }
   return best;
 }
@@ -566,8 +598,9 @@ void SnapIndex::nearest_per_edge(const Vec3& p, double radius, std::vector<SnapH
     const uint32_t ref = stack[--top];
     if (!(ref & kLeafRef)) {
       const Node& n = nodes_[ref];
-      for (int s = 0; s < 2; ++s)
-        if (squared_gap(n.box(s), p) <= bound) stack[top++] = n.child[s];
+      const DoublePair g[2] = {entry_gaps(n, 0, p), entry_gaps(n, 1, p)};
+      for (int k = 0; k < 4; ++k)
+        if (g[k / 2][k % 2] <= bound) stack[top++] = n.entry[k];
       continue;
     }
     const Leaf& l = leaves_[ref & ~kLeafRef];
@@ -609,8 +642,24 @@ std::string SnapIndex::validate_ref(uint32_t ref, uint32_t parent, const Box& bo
   }
   if (parent_[ref] != parent) return "node " + std::to_string(ref) + " has a wrong parent";
   const Node& n = nodes_[ref];
-  for (int s = 0; s < 2; ++s)
-    if (auto why = validate_ref(n.child[s], ref, n.box(s), leaves); !why.empty()) return why;
+  for (int s = 0; s < 2; ++s) {
+    const uint32_t c = n.child[s];
+    for (int k = 0; k < 2; ++k) {
+      const bool leaf = c & kLeafRef;
+      const uint32_t want = leaf ? (k == 0 ? c : kNone) : nodes_[c].child[k];
+      if (n.entry[2 * s + k] != want) return "node " + std::to_string(ref) + " holds a wrong grandchild";
+      const Box b = n.entry_box(2 * s + k);
+      if (want == kNone) {
+        // Queries rely on an empty entry's gap being NaN.
+        for (int a = 0; a < 3; ++a)
+          if (!std::isnan(b.lo[a]) || !std::isnan(b.hi[a])) return "node " + std::to_string(ref) + " has an empty entry with a box";
+        continue;
+      }
+      const Box own = leaf ? box_of(c) : nodes_[c].box(k);
+      if (!same_box(b.lo, b.hi, own.lo, own.hi)) return "node " + std::to_string(ref) + " holds a wrong grandchild's box";
+    }
+    if (auto why = validate_ref(c, ref, n.box(s), leaves); !why.empty()) return why;
+  }
   if (height_[ref] != 1 + std::max(height_of(n.child[0]), height_of(n.child[1])))
     return "node " + std::to_string(ref) + " has a wrong height";
   if (leaves_under_[ref] != leaves_of(n.child[0]) + leaves_of(n.child[1]))

@@ -73,23 +73,31 @@ class SnapIndex {
   struct Box {
     float lo[3], hi[3];
   };
-  // An inner node holds its children's boxes, so a query decides on both children from the one node it
-  // has loaded, as a k-d tree decides from its split plane; axis by axis ([axis][child]), so it computes
-  // both children's distances at once. A child is an inner node or a leaf record (kLeafRef set).
-  struct alignas(64) Node {  // one cache line
-    float lo[3][2], hi[3][2];
+  // An inner node is a binary node (child[]) that holds its grandchildren's boxes and references, so a
+  // query decides on four subtrees from the one node it has loaded and skips a level of dependent loads.
+  // Entries 2s and 2s+1 are child s's two children, or child s itself and an empty entry (kNone, NaN box)
+  // when it is a leaf record; child s's box is the union of its two entries. Boxes axis by axis
+  // ([axis][entry]), so a query computes the four distances at once. A reference is an inner node or a
+  // leaf record (kLeafRef set).
+  struct alignas(64) Node {  // two cache lines
+    float lo[3][4], hi[3][4];
+    uint32_t entry[4];
     uint32_t child[2];
-    Box box(int s) const { return {{lo[0][s], lo[1][s], lo[2][s]}, {hi[0][s], hi[1][s], hi[2][s]}}; }
-    void set_box(int s, const Box& b) {
+    Box entry_box(int k) const {
+      return {{lo[0][k], lo[1][k], lo[2][k]}, {hi[0][k], hi[1][k], hi[2][k]}};
+    }
+    Box box(int s) const;
+    void set_entry(int k, uint32_t ref, const Box& b) {
+      entry[k] = ref;
       for (int a = 0; a < 3; ++a) {
-        lo[a][s] = b.lo[a];
-        hi[a][s] = b.hi[a];
+        lo[a][k] = b.lo[a];
+        hi[a][k] = b.hi[a];
       }
     }
   };
   static constexpr uint32_t kLeafRef = 0x80000000u;
   static constexpr uint32_t kFreed = kNone - 1;  // parent_ of a node on the free list
-  struct Leaf {
+  struct alignas(64) Leaf {  // four cache lines
     Box box;
     uint32_t edge, first, count, parent;  // parent: inner node, or kNone at the root
     double x[kLeafPoints], y[kLeafPoints], z[kLeafPoints];
@@ -107,7 +115,8 @@ class SnapIndex {
   int32_t height_of(uint32_t ref) const { return ref & kLeafRef ? 0 : height_[ref]; }
   uint32_t leaves_of(uint32_t ref) const { return ref & kLeafRef ? 1 : leaves_under_[ref]; }
   Box box_of(uint32_t ref) const;
-  void replace_child(uint32_t parent, uint32_t old_ref, uint32_t new_ref, const Box& box);
+  void fill(uint32_t node, int s);
+  void replace_child(uint32_t parent, uint32_t old_ref, uint32_t new_ref);
   void insert_leaf(uint32_t ref);
   void remove_leaf(uint32_t ref);
   void refit_up(uint32_t node);
