@@ -74,6 +74,8 @@ double squared_gap(const B& b, const Vec3& p) {
 
 using DoublePair = double __attribute__((vector_size(16)));
 using FloatPair = float __attribute__((vector_size(8)));
+using FloatQuad = float __attribute__((vector_size(16)));
+using IntQuad = int32_t __attribute__((vector_size(16)));
 
 // squared_gap() of a node's entries 2h and 2h+1 at once, with the same arithmetic in the same order; NaN
 // for an empty entry, which no bound admits. (Pairs, not one four-wide vector: without AVX, GCC spills
@@ -101,9 +103,14 @@ int32_t depth_limit(uint32_t leaves) { return 2 * int32_t(std::bit_width(leaves)
 
 }  // namespace
 
+// Entry 4s is never empty, and an empty entry's NaN loses every comparison, so it drops out of the union.
 inline SnapIndex::Box SnapIndex::Node::box(int s) const {
-  Box b = entry_box(2 * s);
-  if (entry[2 * s + 1] != kNone) merge_into(b, entry_box(2 * s + 1));
+  Box b = entry_box(4 * s);
+  for (int k = 4 * s + 1; k < 4 * s + 4; ++k)
+    for (int a = 0; a < 3; ++a) {
+      b.lo[a] = lo[a][k] < b.lo[a] ? lo[a][k] : b.lo[a];
+      b.hi[a] = hi[a][k] > b.hi[a] ? hi[a][k] : b.hi[a];
+    }
   return b;
 }
 
@@ -202,10 +209,7 @@ void SnapIndex::update(const Mesh& mesh, std::span<const uint32_t> changed_edge_
   // Removals refit once for all; each insertion refits (and rebalances) before the next descends, or a
   // curve's leaves would pile up in one deep chain.
   refit_touched();
-  for (uint32_t r : fresh) {
-    insert_leaf(r | kLeafRef);
-    refit_touched();
-  }
+  for (uint32_t r : fresh) insert_leaf(r | kLeafRef);
 }
 
 void SnapIndex::sync(const Mesh& mesh) {
@@ -260,10 +264,7 @@ uint32_t SnapIndex::new_node() {
     return n;
   }
   nodes_.emplace_back();
-  marked_.push_back(0);
-  parent_.push_back(kNone);
-  height_.push_back(0);
-  leaves_under_.push_back(0);
+  info_.push_back({});
   return static_cast<uint32_t>(nodes_.size() - 1);
 }
 
@@ -275,17 +276,33 @@ SnapIndex::Box SnapIndex::box_of(uint32_t ref) const {
   return b;
 }
 
-// Copies child s's boxes and references into node i's entries; the child must be up to date.
-void SnapIndex::fill(uint32_t i, int s) {
-  Node& n = nodes_[i];
+// Copies child s's boxes and references into n's entries; the child must be up to date.
+void SnapIndex::fill_entries(Node& n, int s) const {
   const uint32_t c = n.child[s];
   if (c & kLeafRef) {
-    n.set_entry(2 * s, c, leaves_[c & ~kLeafRef].box);
-    n.set_entry(2 * s + 1, kNone, {{kNaN, kNaN, kNaN}, {kNaN, kNaN, kNaN}});
+    const Box empty = {{kNaN, kNaN, kNaN}, {kNaN, kNaN, kNaN}};
+    n.mid[2 * s] = c;
+    n.mid[2 * s + 1] = kNone;
+    n.set_entry(4 * s, c, leaves_[c & ~kLeafRef].box);
+    for (int k = 1; k < 4; ++k) n.set_entry(4 * s + k, kNone, empty);
     return;
   }
+  // Grandchild t's box is the union of the child's entries 2t and 2t+1, taken for all four at once: an
+  // empty odd entry (NaN) loses the comparison and keeps the even one; both empty stay NaN.
   const Node& cn = nodes_[c];
-  for (int k = 0; k < 2; ++k) n.set_entry(2 * s + k, cn.child[k], cn.box(k));
+  constexpr IntQuad even = {0, 2, 4, 6}, odd = {1, 3, 5, 7};
+  for (int a = 0; a < 3; ++a) {
+    FloatQuad l[2], h[2];
+    std::memcpy(l, cn.lo[a], sizeof l);
+    std::memcpy(h, cn.hi[a], sizeof h);
+    const FloatQuad le = __builtin_shuffle(l[0], l[1], even), lo = __builtin_shuffle(l[0], l[1], odd);
+    const FloatQuad he = __builtin_shuffle(h[0], h[1], even), ho = __builtin_shuffle(h[0], h[1], odd);
+    const FloatQuad lu = lo < le ? lo : le, hu = ho > he ? ho : he;
+    std::memcpy(n.lo[a] + 4 * s, &lu, sizeof lu);
+    std::memcpy(n.hi[a] + 4 * s, &hu, sizeof hu);
+  }
+  std::memcpy(n.entry + 4 * s, cn.mid, sizeof cn.mid);
+  for (int j = 0; j < 2; ++j) n.mid[2 * s + j] = cn.child[j];
 }
 
 void SnapIndex::replace_child(uint32_t parent, uint32_t old_ref, uint32_t new_ref) {
@@ -300,8 +317,7 @@ void SnapIndex::replace_child(uint32_t parent, uint32_t old_ref, uint32_t new_re
 }
 
 // Picks the sibling that adds the least box area over the path (the surface area heuristic, greedily
-// down the tree) and pairs the leaf with it under a new node. Boxes, heights and counts above wait for
-// refit_touched().
+// down the tree), pairs the leaf with it under a new node and refits the path above.
 void SnapIndex::insert_leaf(uint32_t leaf) {
   parent_of(leaf) = kNone;
   if (root_ == kNone) {
@@ -312,20 +328,21 @@ void SnapIndex::insert_leaf(uint32_t leaf) {
   uint32_t i = root_;
   Box ib = box_of(root_);
   while (!(i & kLeafRef)) {
-    Node& n = nodes_[i];
+    const Node& n = nodes_[i];
     Box merged = ib;
     merge_into(merged, lb);
     const double combined = half_area(merged);
     const double here = 2 * combined, inherited = 2 * (combined - half_area(ib));
+    const Box cb[2] = {n.box(0), n.box(1)};
     double cost[2];
     for (int s = 0; s < 2; ++s) {
-      Box b = n.box(s);
+      Box b = cb[s];
       merge_into(b, lb);
-      cost[s] = half_area(b) + inherited - (n.child[s] & kLeafRef ? 0.0 : half_area(n.box(s)));
+      cost[s] = half_area(b) + inherited - (n.child[s] & kLeafRef ? 0.0 : half_area(cb[s]));
     }
     if (here < cost[0] && here < cost[1]) break;
     const int s = cost[0] <= cost[1] ? 0 : 1;
-    ib = n.box(s);
+    ib = cb[s];
     i = n.child[s];
   }
   const uint32_t sibling = i, old_parent = parent_of(sibling);
@@ -334,11 +351,11 @@ void SnapIndex::insert_leaf(uint32_t leaf) {
   nodes_[p].child[1] = leaf;
   fill(p, 0);
   fill(p, 1);
-  parent_[p] = old_parent;
+  info_[p].parent = old_parent;
   parent_of(sibling) = p;
   parent_of(leaf) = p;
   replace_child(old_parent, sibling, p);
-  touched_.push_back(p);
+  refit_path(p);
 }
 
 // Puts the leaf's sibling in its parent's place; boxes, heights and counts above wait for refit_touched().
@@ -348,24 +365,40 @@ void SnapIndex::remove_leaf(uint32_t leaf) {
     root_ = kNone;
     return;
   }
-  const uint32_t p = parent_of(leaf), gp = parent_[p];
+  const uint32_t p = parent_of(leaf), gp = info_[p].parent;
   const int s = nodes_[p].child[0] == leaf ? 1 : 0;
   const uint32_t sibling = nodes_[p].child[s];
   parent_of(sibling) = gp;
   replace_child(gp, p, sibling);
   free_nodes_.push_back(p);
-  parent_[p] = kFreed;
+  info_[p].parent = kFreed;
   if (gp != kNone) touched_.push_back(gp);
+}
+
+// Entries, heights and leaf counts from node i, whose own entries are right, to the root; then the
+// highest subtree on the way grown too deep for its leaves is rebuilt. One insertion's refit: cheaper
+// than refit_touched()'s marking for a single path, with the same result.
+void SnapIndex::refit_path(uint32_t i) {
+  uint32_t unbalanced = kNone;
+  for (uint32_t below = kNone; i != kNone; below = i, i = info_[i].parent) {
+    const Node& n = nodes_[i];
+    if (below != kNone) fill(i, n.child[0] == below ? 0 : 1);
+    Info& f = info_[i];
+    f.height = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
+    f.leaves = leaves_of(n.child[0]) + leaves_of(n.child[1]);
+    if (f.height > depth_limit(f.leaves)) unbalanced = i;
+  }
+  if (unbalanced != kNone) rebuild_subtree(unbalanced);
 }
 
 // Entries, heights and leaf counts from node i to the root.
 void SnapIndex::refit_up(uint32_t i) {
-  for (; i != kNone; i = parent_[i]) {
+  for (; i != kNone; i = info_[i].parent) {
     fill(i, 0);
     fill(i, 1);
     const Node& n = nodes_[i];
-    height_[i] = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
-    leaves_under_[i] = leaves_of(n.child[0]) + leaves_of(n.child[1]);
+    info_[i].height = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
+    info_[i].leaves = leaves_of(n.child[0]) + leaves_of(n.child[1]);
   }
 }
 
@@ -376,16 +409,16 @@ void SnapIndex::refit_touched() {
   if (touched_.empty()) return;
   marked_list_.clear();
   for (uint32_t t : touched_) {
-    if (parent_[t] == kFreed) continue;
-    for (; t != kNone && !marked_[t]; t = parent_[t]) {
-      marked_[t] = 1;
+    if (info_[t].parent == kFreed) continue;
+    for (; t != kNone && !info_[t].marked; t = info_[t].parent) {
+      info_[t].marked = 1;
       marked_list_.push_back(t);
     }
   }
   touched_.clear();
   unbalanced_.clear();
-  if (root_ != kNone && !(root_ & kLeafRef) && marked_[root_]) refit_marked(root_, unbalanced_);
-  for (uint32_t m : marked_list_) marked_[m] = 0;
+  if (root_ != kNone && !(root_ & kLeafRef) && info_[root_].marked) refit_marked(root_, unbalanced_);
+  for (uint32_t m : marked_list_) info_[m].marked = 0;
   for (uint32_t n : unbalanced_) rebuild_subtree(n);
 }
 
@@ -394,13 +427,13 @@ void SnapIndex::refit_marked(uint32_t i, std::vector<uint32_t>& unbalanced) {
   Node& n = nodes_[i];
   for (int s = 0; s < 2; ++s) {
     const uint32_t c = n.child[s];
-    if (c & kLeafRef || !marked_[c]) continue;
+    if (c & kLeafRef || !info_[c].marked) continue;
     refit_marked(c, unbalanced);
     fill(i, s);
   }
-  height_[i] = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
-  leaves_under_[i] = leaves_of(n.child[0]) + leaves_of(n.child[1]);
-  if (height_[i] > depth_limit(leaves_under_[i])) {
+  info_[i].height = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
+  info_[i].leaves = leaves_of(n.child[0]) + leaves_of(n.child[1]);
+  if (info_[i].height > depth_limit(info_[i].leaves)) {
     unbalanced.resize(below);  // rebuilding this subtree rebuilds those inside it
     unbalanced.push_back(i);
   }
@@ -408,10 +441,7 @@ void SnapIndex::refit_marked(uint32_t i, std::vector<uint32_t>& unbalanced) {
 
 void SnapIndex::rebuild() {
   nodes_.clear();
-  parent_.clear();
-  height_.clear();
-  leaves_under_.clear();
-  marked_.clear();
+  info_.clear();
   free_nodes_.clear();
   touched_.clear();
   std::vector<Item> items;
@@ -441,14 +471,14 @@ void SnapIndex::rebuild_subtree(uint32_t top) {
     }
     if (i != top) free_nodes_.push_back(i);
   }
-  build(items, top, parent_[top]);
-  refit_up(parent_[top]);
+  build(items, top, info_[top].parent);
+  refit_up(info_[top].parent);
 }
 
 // Top-down into inner node `node` (at least two items): split at the median of the box centres along the
 // axis where they spread most.
 void SnapIndex::build(std::span<Item> items, uint32_t node, uint32_t parent) {
-  parent_[node] = parent;
+  info_[node].parent = parent;
   double lo[3], hi[3];
   for (int a = 0; a < 3; ++a) {
     lo[a] = std::numeric_limits<double>::infinity();
@@ -480,8 +510,8 @@ void SnapIndex::build(std::span<Item> items, uint32_t node, uint32_t parent) {
     fill(node, s);
   }
   const Node& n = nodes_[node];
-  height_[node] = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
-  leaves_under_[node] = leaves_of(n.child[0]) + leaves_of(n.child[1]);
+  info_[node].height = 1 + std::max(height_of(n.child[0]), height_of(n.child[1]));
+  info_[node].leaves = leaves_of(n.child[0]) + leaves_of(n.child[1]);
 }
 
 // ---- queries
@@ -496,15 +526,20 @@ void SnapIndex::prefetch(uint32_t ref) const {
 
 namespace {
 
-// A node's four entry gaps, and which entry is nearest (an empty entry's NaN counts as farthest).
+// A node's entry gaps, and which entry is nearest (an empty entry's NaN counts as farthest).
 template <class Node>
-[[gnu::always_inline]] inline int nearest_entry(const Node& n, const Vec3& p, double (&g)[4]) {
-  const DoublePair g01 = entry_gaps(n, 0, p), g23 = entry_gaps(n, 1, p);
-  g[0] = g01[0], g[1] = g01[1], g[2] = g23[0], g[3] = g23[1];
+[[gnu::always_inline]] inline int nearest_entry(const Node& n, const Vec3& p, double (&g)[8]) {
   constexpr double inf = std::numeric_limits<double>::infinity();
-  const DoublePair k01 = g01 == g01 ? g01 : inf, k23 = g23 == g23 ? g23 : inf;
-  const int m01 = k01[1] < k01[0] ? 1 : 0, m23 = k23[1] < k23[0] ? 3 : 2;
-  return (m23 == 3 ? k23[1] : k23[0]) < (m01 == 1 ? k01[1] : k01[0]) ? m23 : m01;
+  double key[8];
+  for (int h = 0; h < 4; ++h) {
+    const DoublePair gh = entry_gaps(n, h, p), kh = gh == gh ? gh : inf;
+    g[2 * h] = gh[0], g[2 * h + 1] = gh[1];
+    key[2 * h] = kh[0], key[2 * h + 1] = kh[1];
+  }
+  int m[4];
+  for (int h = 0; h < 4; ++h) m[h] = key[2 * h + 1] < key[2 * h] ? 2 * h + 1 : 2 * h;
+  const int a = key[m[1]] < key[m[0]] ? m[1] : m[0], b = key[m[3]] < key[m[2]] ? m[3] : m[2];
+  return key[b] < key[a] ? b : a;
 }
 
 }  // namespace
@@ -546,13 +581,13 @@ SnapHit SnapIndex::nearest(const Vec3& p, double radius) const {
       continue;
     }
     const Node& n = nodes_[ref];
-    double g[4];
+    double g[8];
     const int m = nearest_entry(n, p, g);
     // The nearest entry goes on top, so it is searched first and tightens the bound for the others.
     // Pushes are unconditional writes with a conditional count: which entry is nearest is a coin toss
     // that branches would mispredict.
     const size_t first = top;
-    for (int k = 0; k < 4; ++k) {
+    for (int k = 0; k < 8; ++k) {
       stack[top] = {n.entry[k], g[k]};
       top += k != m && g[k] <= bound;
     }
@@ -598,9 +633,11 @@ void SnapIndex::nearest_per_edge(const Vec3& p, double radius, std::vector<SnapH
     const uint32_t ref = stack[--top];
     if (!(ref & kLeafRef)) {
       const Node& n = nodes_[ref];
-      const DoublePair g[2] = {entry_gaps(n, 0, p), entry_gaps(n, 1, p)};
-      for (int k = 0; k < 4; ++k)
-        if (g[k / 2][k % 2] <= bound) stack[top++] = n.entry[k];
+      for (int h = 0; h < 4; ++h) {
+        const DoublePair g = entry_gaps(n, h, p);
+        for (int k = 0; k < 2; ++k)
+          if (g[k] <= bound) stack[top++] = n.entry[2 * h + k];
+      }
       continue;
     }
     const Leaf& l = leaves_[ref & ~kLeafRef];
@@ -640,31 +677,22 @@ std::string SnapIndex::validate_ref(uint32_t ref, uint32_t parent, const Box& bo
     ++leaves;
     return "";
   }
-  if (parent_[ref] != parent) return "node " + std::to_string(ref) + " has a wrong parent";
+  if (info_[ref].parent != parent) return "node " + std::to_string(ref) + " has a wrong parent";
   const Node& n = nodes_[ref];
-  for (int s = 0; s < 2; ++s) {
-    const uint32_t c = n.child[s];
-    for (int k = 0; k < 2; ++k) {
-      const bool leaf = c & kLeafRef;
-      const uint32_t want = leaf ? (k == 0 ? c : kNone) : nodes_[c].child[k];
-      if (n.entry[2 * s + k] != want) return "node " + std::to_string(ref) + " holds a wrong grandchild";
-      const Box b = n.entry_box(2 * s + k);
-      if (want == kNone) {
-        // Queries rely on an empty entry's gap being NaN.
-        for (int a = 0; a < 3; ++a)
-          if (!std::isnan(b.lo[a]) || !std::isnan(b.hi[a])) return "node " + std::to_string(ref) + " has an empty entry with a box";
-        continue;
-      }
-      const Box own = leaf ? box_of(c) : nodes_[c].box(k);
-      if (!same_box(b.lo, b.hi, own.lo, own.hi)) return "node " + std::to_string(ref) + " holds a wrong grandchild's box";
-    }
-    if (auto why = validate_ref(c, ref, n.box(s), leaves); !why.empty()) return why;
-  }
-  if (height_[ref] != 1 + std::max(height_of(n.child[0]), height_of(n.child[1])))
+  // The entries must be what a refill from the children gives now (empty ones NaN: queries rely on it).
+  Node want = n;
+  fill_entries(want, 0);
+  fill_entries(want, 1);
+  if (std::memcmp(want.lo, n.lo, sizeof n.lo) || std::memcmp(want.hi, n.hi, sizeof n.hi) ||
+      std::memcmp(want.entry, n.entry, sizeof n.entry) || std::memcmp(want.mid, n.mid, sizeof n.mid))
+    return "node " + std::to_string(ref) + " holds stale entries";
+  for (int s = 0; s < 2; ++s)
+    if (auto why = validate_ref(n.child[s], ref, n.box(s), leaves); !why.empty()) return why;
+  if (info_[ref].height != 1 + std::max(height_of(n.child[0]), height_of(n.child[1])))
     return "node " + std::to_string(ref) + " has a wrong height";
-  if (leaves_under_[ref] != leaves_of(n.child[0]) + leaves_of(n.child[1]))
+  if (info_[ref].leaves != leaves_of(n.child[0]) + leaves_of(n.child[1]))
     return "node " + std::to_string(ref) + " has a wrong count";
-  if (height_[ref] > depth_limit(leaves_under_[ref])) return "node " + std::to_string(ref) + " is too deep for its leaves";
+  if (info_[ref].height > depth_limit(info_[ref].leaves)) return "node " + std::to_string(ref) + " is too deep for its leaves";
   return "";
 }
 

@@ -73,20 +73,23 @@ class SnapIndex {
   struct Box {
     float lo[3], hi[3];
   };
-  // An inner node is a binary node (child[]) that holds its grandchildren's boxes and references, so a
-  // query decides on four subtrees from the one node it has loaded and skips a level of dependent loads.
-  // Entries 2s and 2s+1 are child s's two children, or child s itself and an empty entry (kNone, NaN box)
-  // when it is a leaf record; child s's box is the union of its two entries. Boxes axis by axis
-  // ([axis][entry]), so a query computes the four distances at once. A reference is an inner node or a
-  // leaf record (kLeafRef set).
-  struct alignas(64) Node {  // two cache lines
-    float lo[3][4], hi[3][4];
-    uint32_t entry[4];
+  // An inner node is a binary node (child[]) that holds its great-grandchildren's boxes and references
+  // (entries), so a query decides on eight subtrees from the one node it has loaded and skips two levels of
+  // dependent loads. Entries 4s to 4s+3 lie under child s, in the order of the paths to them; a leaf
+  // record met on the way down takes the first entry of its range and leaves the rest empty (kNone, NaN
+  // box). mid[] holds the grandchildren in the same way, so that a parent can fill its own entries from
+  // this node alone; child s's box is the union of its entries. Boxes axis by axis ([axis][entry]), so a
+  // query computes the distances two entries at a time. A reference is an inner node or a leaf record
+  // (kLeafRef set).
+  struct alignas(64) Node {  // four cache lines
+    float lo[3][8], hi[3][8];
+    uint32_t entry[8];
+    uint32_t mid[4];
     uint32_t child[2];
     Box entry_box(int k) const {
       return {{lo[0][k], lo[1][k], lo[2][k]}, {hi[0][k], hi[1][k], hi[2][k]}};
     }
-    Box box(int s) const;
+    Box box(int s) const;  // of child s: the union of entries 4s to 4s+3
     void set_entry(int k, uint32_t ref, const Box& b) {
       entry[k] = ref;
       for (int a = 0; a < 3; ++a) {
@@ -96,7 +99,7 @@ class SnapIndex {
     }
   };
   static constexpr uint32_t kLeafRef = 0x80000000u;
-  static constexpr uint32_t kFreed = kNone - 1;  // parent_ of a node on the free list
+  static constexpr uint32_t kFreed = kNone - 1;  // Info::parent of a node on the free list
   struct alignas(64) Leaf {  // four cache lines
     Box box;
     uint32_t edge, first, count, parent;  // parent: inner node, or kNone at the root
@@ -111,15 +114,17 @@ class SnapIndex {
   void remove_edge(uint32_t e);
   void add_leaves(uint32_t e, std::span<const Vec3> line, std::vector<uint32_t>& fresh);
   uint32_t new_node();
-  uint32_t& parent_of(uint32_t ref) { return ref & kLeafRef ? leaves_[ref & ~kLeafRef].parent : parent_[ref]; }
-  int32_t height_of(uint32_t ref) const { return ref & kLeafRef ? 0 : height_[ref]; }
-  uint32_t leaves_of(uint32_t ref) const { return ref & kLeafRef ? 1 : leaves_under_[ref]; }
+  uint32_t& parent_of(uint32_t ref) { return ref & kLeafRef ? leaves_[ref & ~kLeafRef].parent : info_[ref].parent; }
+  int32_t height_of(uint32_t ref) const { return ref & kLeafRef ? 0 : info_[ref].height; }
+  uint32_t leaves_of(uint32_t ref) const { return ref & kLeafRef ? 1 : info_[ref].leaves; }
   Box box_of(uint32_t ref) const;
-  void fill(uint32_t node, int s);
+  void fill_entries(Node& n, int s) const;
+  void fill(uint32_t node, int s) { fill_entries(nodes_[node], s); }
   void replace_child(uint32_t parent, uint32_t old_ref, uint32_t new_ref);
   void insert_leaf(uint32_t ref);
   void remove_leaf(uint32_t ref);
   void refit_up(uint32_t node);
+  void refit_path(uint32_t node);
   void refit_touched();
   void refit_marked(uint32_t node, std::vector<uint32_t>& unbalanced);
   void rebuild();
@@ -129,12 +134,16 @@ class SnapIndex {
   std::string validate_ref(uint32_t ref, uint32_t parent, const Box& box, size_t& leaves) const;
 
   std::vector<Node> nodes_;
-  std::vector<uint32_t> parent_;
-  std::vector<int32_t> height_;  // edges to the deepest leaf record below
-  std::vector<uint32_t> leaves_under_;
+  // Per inner node, what only updates read, together so that a refit misses once per node.
+  struct Info {
+    uint32_t parent = kNone;
+    int32_t height = 0;  // edges to the deepest leaf record below
+    uint32_t leaves = 0;
+    uint8_t marked = 0;  // scratch of refit_touched(), all clear between calls
+  };
+  std::vector<Info> info_;
   std::vector<uint32_t> touched_;  // nodes whose subtree changed since the last refit
-  // Scratch of refit_touched(), kept to spare allocations; marked_ is all clear between calls.
-  std::vector<uint8_t> marked_;
+  // Scratch of refit_touched(), kept to spare allocations.
   std::vector<uint32_t> marked_list_, unbalanced_;
   std::vector<uint32_t> free_nodes_;
   std::vector<Leaf> leaves_;
