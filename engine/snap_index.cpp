@@ -98,6 +98,18 @@ DoublePair entry_gaps(const Node& n, int h, const Vec3& p) {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
+// Doubles a full pool's capacity and writes to all of it at once, so that the memory's first-touch page
+// faults fall on this rare step instead of on later insertions one by one (removed leaf records are not
+// reused until purged, so insertions keep reaching fresh memory).
+template <class T>
+void grow(std::vector<T>& v) {
+  if (v.size() < v.capacity()) return;
+  const size_t n = v.size();
+  v.reserve(std::max<size_t>(64, 2 * n));
+  v.resize(v.capacity());
+  v.resize(n);
+}
+
 // The depth a subtree with this many leaves may reach before it is rebuilt.
 int32_t depth_limit(uint32_t leaves) { return 2 * int32_t(std::bit_width(leaves)) + 2; }
 
@@ -132,16 +144,35 @@ bool SnapIndex::same_polyline(uint32_t e, std::span<const Vec3> line) const {
   return n == line.size();
 }
 
+// The edge's leaf records stay in the tree, dead: NaN points, which no query admits (as nanoflann's
+// dynamic index marks its removed points), until purge_dead() takes them out together.
 void SnapIndex::remove_edge(uint32_t e) {
   if (e >= edge_leaves_.size() || edge_leaves_[e].empty()) return;
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   for (uint32_t r : edge_leaves_[e]) {
-    remove_leaf(r | kLeafRef);
-    points_ -= leaves_[r].count;
-    leaves_[r].edge = kNone;
-    free_leaves_.push_back(r);
+    Leaf& l = leaves_[r];
+    points_ -= l.count;
+    l.edge = kNone;
+    std::fill_n(l.x, kLeafPoints, nan);
+    std::fill_n(l.y, kLeafPoints, nan);
+    std::fill_n(l.z, kLeafPoints, nan);
+    dead_leaves_.push_back(r);
   }
   edge_leaves_[e].clear();
   --edges_;
+}
+
+// Dead leaf records cost queries only the visits their boxes still draw; once they are more than an
+// eighth of the live ones, one refit for all of them (after the caller's refit_touched()) is cheap per
+// record.
+void SnapIndex::purge_dead() {
+  const size_t live = leaves_.size() - free_leaves_.size() - dead_leaves_.size();
+  if (dead_leaves_.size() * 8 <= live) return;
+  for (uint32_t r : dead_leaves_) {
+    remove_leaf(r | kLeafRef);
+    free_leaves_.push_back(r);
+  }
+  dead_leaves_.clear();
 }
 
 void SnapIndex::add_leaves(uint32_t e, std::span<const Vec3> line, std::vector<uint32_t>& fresh) {
@@ -153,6 +184,7 @@ void SnapIndex::add_leaves(uint32_t e, std::span<const Vec3> line, std::vector<u
       free_leaves_.pop_back();
     } else {
       r = static_cast<uint32_t>(leaves_.size());
+      grow(leaves_);
       leaves_.emplace_back();
     }
     Leaf& l = leaves_[r];
@@ -199,7 +231,8 @@ void SnapIndex::update(const Mesh& mesh, std::span<const uint32_t> changed_edge_
     remove_edge(e);
     add_leaves(e, line, fresh);
   }
-  const size_t held = leaves_.size() - free_leaves_.size() - fresh.size();
+  purge_dead();
+  const size_t held = leaves_.size() - free_leaves_.size() - dead_leaves_.size() - fresh.size();
   // Inserting one by one costs a descent each and leaves a looser tree than a top-down build; when most
   // of the index is new (loading, a first sync, an undo that touched everything) build it whole.
   if (!fresh.empty() && fresh.size() > held) {
@@ -247,6 +280,7 @@ void SnapIndex::remap(const CompactionMap& map) {
     moved[to] = std::move(edge_leaves_[e]);
   }
   edge_leaves_ = std::move(moved);
+  purge_dead();
   refit_touched();
 }
 
@@ -263,6 +297,8 @@ uint32_t SnapIndex::new_node() {
     free_nodes_.pop_back();
     return n;
   }
+  grow(nodes_);
+  grow(info_);
   nodes_.emplace_back();
   info_.push_back({});
   return static_cast<uint32_t>(nodes_.size() - 1);
@@ -444,6 +480,8 @@ void SnapIndex::rebuild() {
   info_.clear();
   free_nodes_.clear();
   touched_.clear();
+  free_leaves_.insert(free_leaves_.end(), dead_leaves_.begin(), dead_leaves_.end());
+  dead_leaves_.clear();
   std::vector<Item> items;
   for (uint32_t r = 0; r < leaves_.size(); ++r)
     if (leaves_[r].edge != kNone) items.push_back({r | kLeafRef, leaves_[r].box});
@@ -663,12 +701,18 @@ bool same_box(const float (&alo)[3], const float (&ahi)[3], const float (&blo)[3
 }
 }  // namespace
 
-std::string SnapIndex::validate_ref(uint32_t ref, uint32_t parent, const Box& box, size_t& leaves) const {
+std::string SnapIndex::validate_ref(uint32_t ref, uint32_t parent, const Box& box, size_t& leaves, size_t& dead) const {
   const Box own = box_of(ref);
   if (!same_box(own.lo, own.hi, box.lo, box.hi)) return "a box held by a parent is not its child's";
   if (ref & kLeafRef) {
     const Leaf& l = leaves_[ref & ~kLeafRef];
-    if (l.parent != parent || l.edge == kNone) return "a leaf record has a wrong parent or is free";
+    if (l.parent != parent) return "a leaf record has a wrong parent";
+    if (l.edge == kNone) {
+      for (uint32_t k = 0; k < kLeafPoints; ++k)
+        if (!std::isnan(l.x[k]) || !std::isnan(l.y[k]) || !std::isnan(l.z[k])) return "a dead leaf record has a point";
+      ++dead;
+      return "";
+    }
     for (uint32_t k = 0; k < l.count; ++k) {
       const double q[3] = {l.x[k], l.y[k], l.z[k]};
       for (int a = 0; a < 3; ++a)
@@ -687,7 +731,7 @@ std::string SnapIndex::validate_ref(uint32_t ref, uint32_t parent, const Box& bo
       std::memcmp(want.entry, n.entry, sizeof n.entry) || std::memcmp(want.mid, n.mid, sizeof n.mid))
     return "node " + std::to_string(ref) + " holds stale entries";
   for (int s = 0; s < 2; ++s)
-    if (auto why = validate_ref(n.child[s], ref, n.box(s), leaves); !why.empty()) return why;
+    if (auto why = validate_ref(n.child[s], ref, n.box(s), leaves, dead); !why.empty()) return why;
   if (info_[ref].height != 1 + std::max(height_of(n.child[0]), height_of(n.child[1])))
     return "node " + std::to_string(ref) + " has a wrong height";
   if (info_[ref].leaves != leaves_of(n.child[0]) + leaves_of(n.child[1]))
@@ -709,10 +753,12 @@ std::string SnapIndex::validate(const Mesh& mesh) const {
     ++edges;
   }
   if (points != points_ || edges != edges_) return "the point or edge count is off";
-  size_t leaves = 0;
+  size_t leaves = 0, dead = 0;
   if (root_ != kNone)
-    if (auto why = validate_ref(root_, kNone, box_of(root_), leaves); !why.empty()) return why;
-  if (leaves != leaves_.size() - free_leaves_.size()) return "the tree does not hold every leaf record";
+    if (auto why = validate_ref(root_, kNone, box_of(root_), leaves, dead); !why.empty()) return why;
+  if (dead != dead_leaves_.size()) return "the tree holds other dead leaf records than those listed";
+  if (leaves + dead != leaves_.size() - free_leaves_.size()) return "the tree does not hold every leaf record";
+  if (dead * 8 > leaves) return "dead leaf records were not purged";
   return "";
 }
 

@@ -112,6 +112,7 @@ class SnapIndex {
 
   bool same_polyline(uint32_t e, std::span<const Vec3> line) const;
   void remove_edge(uint32_t e);
+  void purge_dead();
   void add_leaves(uint32_t e, std::span<const Vec3> line, std::vector<uint32_t>& fresh);
   uint32_t new_node();
   uint32_t& parent_of(uint32_t ref) { return ref & kLeafRef ? leaves_[ref & ~kLeafRef].parent : info_[ref].parent; }
@@ -131,7 +132,7 @@ class SnapIndex {
   void rebuild_subtree(uint32_t node);
   void build(std::span<Item> items, uint32_t node, uint32_t parent);
   void prefetch(uint32_t ref) const;
-  std::string validate_ref(uint32_t ref, uint32_t parent, const Box& box, size_t& leaves) const;
+  std::string validate_ref(uint32_t ref, uint32_t parent, const Box& box, size_t& leaves, size_t& dead) const;
 
   std::vector<Node> nodes_;
   // Per inner node, what only updates read, together so that a refit misses once per node.
@@ -148,6 +149,7 @@ class SnapIndex {
   std::vector<uint32_t> free_nodes_;
   std::vector<Leaf> leaves_;
   std::vector<uint32_t> free_leaves_;
+  std::vector<uint32_t> dead_leaves_;  // in the tree, but of removed runs (remove_edge)
   std::vector<std::vector<uint32_t>> edge_leaves_;  // per edge slot: its leaf records in point order
   uint32_t root_ = kNone;                           // a child reference
   size_t points_ = 0, edges_ = 0;
