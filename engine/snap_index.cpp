@@ -513,8 +513,7 @@ void SnapIndex::rebuild_subtree(uint32_t top) {
   refit_up(info_[top].parent);
 }
 
-// Top-down into inner node `node` (at least two items): split at the median of the box centres along the
-// axis where they spread most.
+// Top-down into inner node `node` (at least two items).
 void SnapIndex::build(std::span<Item> items, uint32_t node, uint32_t parent) {
   info_[node].parent = parent;
   double lo[3], hi[3];
@@ -528,12 +527,62 @@ void SnapIndex::build(std::span<Item> items, uint32_t node, uint32_t parent) {
       lo[a] = std::min(lo[a], centre(it, a));
       hi[a] = std::max(hi[a], centre(it, a));
     }
-  int axis = 0;
-  for (int a = 1; a < 3; ++a)
-    if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
-  const size_t mid = items.size() / 2;
-  std::nth_element(items.begin(), items.begin() + static_cast<std::ptrdiff_t>(mid), items.end(),
-                   [&](const Item& x, const Item& y) { return centre(x, axis) < centre(y, axis); });
+  // Binned surface area heuristic: of the planes between 16 bins of box centres per axis, the one that
+  // minimises area times count on both sides, among those that leave each side at least 30 % of the
+  // items (so heights stay within depth_limit); the median of the widest axis when none does.
+  constexpr int kBins = 16;
+  const size_t count = items.size();
+  int best_axis = -1, best_k = 0;
+  double best_cost = std::numeric_limits<double>::infinity();
+  auto bin_of = [&](const Item& it, int a) {  // written so that no value, NaN included, leaves the bins
+    const double t = (centre(it, a) - lo[a]) * (kBins / (hi[a] - lo[a]));
+    return t < kBins - 1 ? (t > 0 ? int(t) : 0) : kBins - 1;
+  };
+  constexpr float finf = std::numeric_limits<float>::infinity();
+  const Box empty = {{finf, finf, finf}, {-finf, -finf, -finf}};
+  for (int a = 0; a < 3 && count >= 4; ++a) {
+    if (!(hi[a] > lo[a]) || !std::isfinite(hi[a] - lo[a])) continue;
+    Box box[kBins];
+    size_t n[kBins] = {};
+    std::fill_n(box, kBins, empty);
+    for (const Item& it : items) {
+      const int b = bin_of(it, a);
+      ++n[b];
+      merge_into(box[b], it.box);
+    }
+    double left_area[kBins];
+    size_t left_n[kBins];
+    Box acc = empty;
+    size_t c = 0;
+    for (int k = 0; k < kBins; ++k) {
+      merge_into(acc, box[k]);
+      c += n[k];
+      left_n[k] = c;
+      left_area[k] = c ? half_area(acc) : 0.0;
+    }
+    acc = empty;
+    c = 0;
+    for (int k = kBins - 1; k > 0; --k) {
+      merge_into(acc, box[k]);
+      c += n[k];
+      const size_t l = left_n[k - 1];
+      if (10 * l < 3 * count || 10 * c < 3 * count) continue;
+      const double cost = left_area[k - 1] * double(l) + half_area(acc) * double(c);
+      if (cost < best_cost) best_cost = cost, best_axis = a, best_k = k;
+    }
+  }
+  size_t mid;
+  if (best_axis >= 0) {
+    mid = size_t(std::partition(items.begin(), items.end(), [&](const Item& it) { return bin_of(it, best_axis) < best_k; }) -
+                 items.begin());
+  } else {
+    int axis = 0;
+    for (int a = 1; a < 3; ++a)
+      if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
+    mid = count / 2;
+    std::nth_element(items.begin(), items.begin() + static_cast<std::ptrdiff_t>(mid), items.end(),
+                     [&](const Item& x, const Item& y) { return centre(x, axis) < centre(y, axis); });
+  }
   const std::span<Item> half[2] = {items.first(mid), items.subspan(mid)};
   for (int s = 0; s < 2; ++s) {
     uint32_t ref;
