@@ -237,12 +237,13 @@ void SnapIndex::update(const Mesh& mesh, std::span<const uint32_t> changed_edge_
   // of the index is new (loading, a first sync, an undo that touched everything) build it whole.
   if (!fresh.empty() && fresh.size() > held) {
     rebuild();
-    return;
+  } else {
+    // Removals refit once for all; each insertion refits (and rebalances) before the next descends, or
+    // a curve's leaves would pile up in one deep chain.
+    refit_touched();
+    for (uint32_t r : fresh) insert_leaf(r | kLeafRef);
   }
-  // Removals refit once for all; each insertion refits (and rebalances) before the next descends, or a
-  // curve's leaves would pile up in one deep chain.
-  refit_touched();
-  for (uint32_t r : fresh) insert_leaf(r | kLeafRef);
+  root_box_ = root_ == kNone ? Box{} : box_of(root_);
 }
 
 void SnapIndex::sync(const Mesh& mesh) {
@@ -282,6 +283,7 @@ void SnapIndex::remap(const CompactionMap& map) {
   edge_leaves_ = std::move(moved);
   purge_dead();
   refit_touched();
+  root_box_ = root_ == kNone ? Box{} : box_of(root_);
 }
 
 // ---- the tree
@@ -633,8 +635,9 @@ template <class Node>
 
 SnapHit SnapIndex::nearest(const Vec3& p, double radius) const {
   SnapHit best;
-  if (root_ == kNone) return best;
   double bound = bound_of(radius);
+  // Most queries far from the network end here, without reading the root's eight entries.
+  if (root_ == kNone || squared_gap(root_box_, p) > bound) return best;
   auto visit = [&](const Leaf& l) {
     for (uint32_t k = 0; k < kLeafPoints; k += 2) {
       DoublePair x, y, z;
@@ -805,6 +808,10 @@ std::string SnapIndex::validate(const Mesh& mesh) const {
   size_t leaves = 0, dead = 0;
   if (root_ != kNone)
     if (auto why = validate_ref(root_, kNone, box_of(root_), leaves, dead); !why.empty()) return why;
+  if (root_ != kNone) {
+    const Box b = box_of(root_);
+    if (!same_box(b.lo, b.hi, root_box_.lo, root_box_.hi)) return "the root's box is stale";
+  }
   if (dead != dead_leaves_.size()) return "the tree holds other dead leaf records than those listed";
   if (leaves + dead != leaves_.size() - free_leaves_.size()) return "the tree does not hold every leaf record";
   if (dead * 8 > leaves) return "dead leaf records were not purged";

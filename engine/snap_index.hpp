@@ -152,6 +152,7 @@ class SnapIndex {
   std::vector<uint32_t> dead_leaves_;  // in the tree, but of removed runs (remove_edge)
   std::vector<std::vector<uint32_t>> edge_leaves_;  // per edge slot: its leaf records in point order
   uint32_t root_ = kNone;                           // a child reference
+  Box root_box_ = {};                               // box_of(root_), kept by update() and remap()
   size_t points_ = 0, edges_ = 0;
   // What sync() has seen of the mesh.
   bool synced_ = false;
