@@ -3,11 +3,13 @@
 // edges, kept in step with the mesh by incremental updates instead of rebuilds.
 //
 // Leaves are runs of up to kLeafPoints consecutive points of one polyline (a curve is spatially coherent
-// along its length, so a run's box is thin); inner nodes form a dynamic AABB tree: a new leaf goes next to
-// the sibling that adds the least box area, and a subtree that grows too deep for its size is rebuilt
-// top-down (as a scapegoat tree does), which keeps the depth logarithmic without rotations that would
-// pair far-apart subtrees. The index holds its own copy of the points, so it answers
-// between syncs without reading the mesh, and compaction only relabels edges.
+// along its length, so a run's box is thin); inner nodes form a dynamic binary AABB tree: a new leaf goes
+// next to the sibling that adds the least box area, and a subtree that grows too deep for its size is
+// rebuilt top-down by the surface area heuristic (as a scapegoat tree does), which keeps the depth
+// logarithmic without rotations that would pair far-apart subtrees. Each inner node also carries its
+// great-grandchildren's boxes, so queries read every third level. A removed run stays in the tree as a
+// dead record (NaN points) until dead records are an eighth of the live ones. The index holds its own copy
+// of the points, so it answers between syncs without reading the mesh, and compaction only relabels edges.
 //
 // Answers and tie-breaks equal the exhaustive searches of the sketch system: distances are computed with
 // the same expression, `(q - p).norm()`, and pruning is conservative, so a tie is never cut off.
