@@ -7,12 +7,13 @@
 // built in one update (loading). nanoflann: KDTreeSingleIndexAdaptor (static, default leaf size) for queries;
 // KDTreeSingleIndexDynamicAdaptor for inserting and deleting one 100-point curve, against SnapIndex::update
 // with the curve's edge added to or removed from the mesh. Timings are the thread's CPU time, best of
-// several repetitions (the machine is shared).
+// several repetitions that interleave the sides compared (the machine is shared).
 #include <time.h>
 
 #include <nanoflann.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -44,13 +45,21 @@ double cpu_now() {
   return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
-template <class F>
-double best_seconds(F&& run) {
-  double best = 1e300;
+// Each run's best time over the repetitions, the runs taking turns within each repetition, so that a
+// change in the machine's load falls on all of them alike.
+template <class... F>
+std::array<double, sizeof...(F)> best_seconds(F&&... run) {
+  std::array<double, sizeof...(F)> best;
+  best.fill(1e300);
   for (int r = 0; r < kRepetitions; ++r) {
-    const double t0 = cpu_now();
-    run();
-    best = std::min(best, cpu_now() - t0);
+    size_t i = 0;
+    ((best[i] = std::min(best[i], [&] {
+        const double t0 = cpu_now();
+        run();
+        return cpu_now() - t0;
+      }()),
+      ++i),
+     ...);
   }
   return best;
 }
@@ -228,13 +237,12 @@ int main() {
       if (mismatches) die(std::string(row.name) + ": " + std::to_string(mismatches) + " answers differ from nanoflann's");
       double sink = 0;
       auto ours = [&](const SnapIndex& index) {
-        return best_seconds([&] {
-          for (const Vec3& q : row.queries) sink += index.nearest(q, row.radius).distance;
+        return [&, at = &index] {
+          for (const Vec3& q : row.queries) sink += at->nearest(q, row.radius).distance;
           g_sink = sink;
-        });
+        };
       };
-      const double inc = ours(incremental), blk = ours(bulk);
-      const double nano = best_seconds([&] {
+      const auto [inc, blk, nano] = best_seconds(ours(incremental), ours(bulk), [&] {
         for (const Vec3& q : row.queries) sink += nano_query(tree, q, row.radius);
         g_sink = sink;
       });
