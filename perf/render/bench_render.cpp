@@ -65,7 +65,7 @@ struct Stages {
 struct Measurement {
   std::string name, device;
   Config config;
-  size_t faces_before = 0, faces_after = 0, quads = 0, rejections = 0;
+  size_t faces_before = 0, faces_after = 0, quads = 0;
   double scene_bytes = 0;  // the first frame's upload: everything
   // idle
   size_t frames = 0;
@@ -228,7 +228,6 @@ Measurement run(const Config& c, double seconds) {
   }
   r.faces_after = w.mesh.face_count();
   r.quads = w.surface.quad_count();
-  r.rejections = w.rejections.size();
   if (r.faces_after != r.faces_before + kStrokes)
     r.problem = std::to_string(r.faces_after - r.faces_before) + " of " + std::to_string(kStrokes) +
                 " strokes split a face" + (w.rejections.empty() ? "" : "; last rejection: " + w.rejections.back().reason);
