@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "perf/frame/grid_drawing.hpp"
 #include "platform/files.hpp"
 #include "tools/fire/session.hpp"
 
@@ -29,48 +30,6 @@ int64_t thread_cpu_ns() {
   timespec t;
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
   return int64_t(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
-}
-
-double sheet(double x, double y) { return 0.015 * std::sin(12 * x) * std::cos(9 * y); }
-
-// The grid drawing: cells of 2 cm, 20 across and 10 up; strokes at 100 Hz, 5 mm apart, half a second
-// between strokes, with a fixed +-0.2 mm jitter inside every stroke.
-std::vector<InputEvent> grid_drawing(int nx, int ny) {
-  const double cell = 0.02, W = nx * cell, H = ny * cell;
-  std::vector<InputEvent> out;
-  int64_t t = 1'000'000;
-  uint64_t state = 12345;
-  auto jitter = [&] {
-    state = state * 6364136223846793005ull + 1442695040888963407ull;
-    return (double(state >> 11) / 9007199254740992.0 - 0.5) * 0.0004;
-  };
-  auto event = [&](EventKind kind, const Vec3& p = Vec3::Zero()) {
-    InputEvent e;
-    e.t_us = t;
-    e.kind = kind;
-    e.p = p;
-    out.push_back(e);
-    t += 10'000;
-  };
-  auto stroke = [&](double ax, double ay, double bx, double by) {
-    const int n = std::max(2, int(std::hypot(bx - ax, by - ay) / 0.005) + 1);
-    event(EventKind::Down);
-    for (int i = 0; i < n; ++i) {
-      const double s = double(i) / (n - 1), x = ax + s * (bx - ax), y = ay + s * (by - ay);
-      const bool end = i == 0 || i == n - 1;
-      event(EventKind::Pen, Vec3(x + (end ? 0 : jitter()), y + (end ? 0 : jitter()), sheet(x, y)));
-    }
-    event(EventKind::Up);
-    t += 500'000;
-  };
-  stroke(0, 0, W, 0);
-  stroke(W, 0, W, H);
-  stroke(W, H, 0, H);
-  stroke(0, H, 0.0005, 0.0005);
-  for (int i = 1; i < nx; ++i) stroke(i * cell, 0, i * cell, H);
-  for (int i = 0; i < nx; ++i)
-    for (int j = 1; j < ny; ++j) stroke(i * cell, j * cell, (i + 1) * cell, j * cell);
-  return out;
 }
 
 struct Run {
@@ -157,7 +116,7 @@ void report_systems(const char* drawing, uint32_t levels, const Run& r) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::vector<InputEvent> grid = grid_drawing(20, 10);
+  const std::vector<InputEvent> grid = perf::grid_drawing(20, 10);
   if (argc == 3 && std::strcmp(argv[1], "--write-grid-log") == 0) {
     if (Status s = write_file_atomic(argv[2], format_input_log(grid)); !s) {
       std::fprintf(stderr, "bench_frame: %s\n", s.error.c_str());

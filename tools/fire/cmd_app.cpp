@@ -21,10 +21,8 @@
 #include "platform/files.hpp"
 #include "platform/network_file.hpp"
 #include "platform/obj.hpp"
-#include "platform/render/present.hpp"
-#include "platform/window/hud.hpp"
-#include "platform/window/window.hpp"
 #include "systems/evaluate/evaluate.hpp"
+#include "tools/fire/app_window.hpp"
 #include "tools/fire/commands.hpp"
 #include "tools/fire/session.hpp"
 
@@ -147,16 +145,6 @@ Result<std::vector<ScriptEvent>> read_script(const std::string& path) {
   return events;
 }
 
-render::Box scene_box(const Mesh& mesh, const SurfaceLevels& surface, const std::vector<Vec3>& reference) {
-  render::Box box;
-  for (uint32_t e = 0; e < mesh.edge_slots(); ++e)
-    if (mesh.edge_alive(e))
-      for (const Vec3& p : mesh.polyline(e)) box.add(p);
-  for (const Vec3& p : surface.positions) box.add(p);
-  for (const Vec3& p : reference) box.add(p);
-  return box;
-}
-
 // The polyline point nearest to the cursor on screen, within `radius` pixels: what Delete picks.
 bool curve_point_under(const Mesh& mesh, const render::Camera& camera, uint32_t width, uint32_t height, glm::vec2 cursor,
                        float radius, Vec3& out) {
@@ -245,61 +233,32 @@ int run_app(const AppArgs& a) {
   Scheduler scheduler = make_scheduler(w, monotonic_ns);
   replay_headless(w, scheduler);
 
-  auto win = window::Window::create("FIRE", width, height);
-  if (!win) return fail(win.error());
-  window::Window& window = **win;
-  auto context = render::Context::create(window.context_options());
-  if (!context) return fail(context.error());
-  auto surface = window.create_surface((*context)->instance());
-  if (!surface) return fail(surface.error());
-  window.framebuffer_size(width, height);
-  auto presenter = render::Presenter::create(**context, *surface, width, height);
-  if (!presenter) return fail(presenter.error());
-  auto renderer = render::Renderer::create(**context, {std::max(width, 1u), std::max(height, 1u)});
-  if (!renderer) return fail(renderer.error());
-  if (Status s = (*renderer)->set_reference(reference.positions, reference.triangles); !s) return fail(s.error);
-  auto hud = window::Hud::create(**context, **presenter, window);
-  if (!hud) return fail(hud.error());
+  auto opened = AppWindow::open(w, scheduler, width, height, reference.positions, reference.triangles);
+  if (!opened) return fail(opened.error());
+  AppWindow& app = **opened;
+  window::Window& window = app.window();
 
-  render::Orbit orbit = frame_orbit(scene_box(w.mesh, w.surface, reference_positions), width, height);
-  window::HudData hud_data;
+  render::Orbit orbit = frame_orbit(scene_box(w.mesh, w.surface, reference_positions), app.width(), app.height());
+  window::HudData& hud_data = app.hud_data;
   hud_data.keys = kKeys;
-  hud_data.wireframe_supported = (*context)->wireframe_supported();
   const std::string out_path = a.out_path.empty() ? default_output(a.input_path) : a.out_path;
-  size_t rejections_seen = w.rejections.size();
-  if (!w.rejections.empty()) hud_data.last_rejection = w.rejections.back().reason;
-
-  // The log's clock continues from the next frame; the wall clock says how far it has advanced.
-  using WallClock = std::chrono::steady_clock;
-  const auto wall_start = WallClock::now();
-  const int64_t session_origin_us = w.frame.begin_us;
-  auto session_us = [&] {
-    return session_origin_us +
-           std::chrono::duration_cast<std::chrono::microseconds>(WallClock::now() - wall_start).count();
-  };
-  render::Camera camera;  // the view of the last displayed frame: what the cursor points at
-  auto log_event = [&](InputEvent e) {
-    // Never before the frame about to run, nor before the last event: the log stays in time order.
-    e.t_us = std::max({session_us(), w.frame.begin_us, w.log.events.back().t_us});
-    e.line = uint32_t(w.log.events.size() + 2);  // its line in the recorded log (after the header)
-    w.log.events.push_back(std::move(e));
-  };
   auto log_command = [&](CommandKind command, const Vec3& p) {
     InputEvent e;
     e.kind = EventKind::Command;
     e.command = command;
     e.p = p;
-    log_event(std::move(e));
+    app.log_event(std::move(e));
   };
   auto log_pen = [&](EventKind kind) {
     InputEvent e;
     e.kind = kind;
-    log_event(std::move(e));
+    app.log_event(std::move(e));
   };
   // The mouse pen: the ray from the cursor onto the reference; a hit is a pen sample with the snap radius
   // of --snap-pixels at its depth, both logged, so the drawing replays without the view.
   auto pen_sample = [&](glm::vec2 pixel) {
-    const glm::vec3 direction = render::ray_through_pixel(camera, pixel, width, height);
+    const render::Camera& camera = app.camera();
+    const glm::vec3 direction = render::ray_through_pixel(camera, pixel, app.width(), app.height());
     const evaluate::TriangleBvh::Hit hit = reference_bvh.ray_cast(
         Vec3(camera.eye.x, camera.eye.y, camera.eye.z), Vec3(direction.x, direction.y, direction.z));
     if (hit.triangle == evaluate::kNoTriangle) return false;
@@ -307,22 +266,15 @@ int run_app(const AppArgs& a) {
     e.kind = EventKind::Pen;
     e.p = hit.point;
     const glm::vec3 p(float(hit.point.x()), float(hit.point.y()), float(hit.point.z()));
-    e.snap = a.snap_pixels * double(render::pixel_size_at(camera, p, height));
-    log_event(std::move(e));
+    e.snap = a.snap_pixels * double(render::pixel_size_at(camera, p, app.height()));
+    app.log_event(std::move(e));
     return true;
   };
-  auto run_frame = [&] {
-    scheduler.run_frame();
-    begin_frame(w, w.frame.index + 1, w.frame.end_us);
-  };
-
   bool dragging = false, panning = false, drawing = false;
   const bool can_draw = !reference.triangles.empty();
   glm::vec2 cursor(0.0f);
   uint64_t display_frame = 0;
   size_t next_script = 0;
-  auto last_frame = WallClock::now();
-  Status status;
 
   auto handle = [&](const window::WindowEvent& e) {
     using window::EventKind;
@@ -331,7 +283,7 @@ int run_app(const AppArgs& a) {
       case EventKind::CursorMove: {
         const glm::vec2 now(float(e.x), float(e.y)), d = now - cursor;
         if (dragging) orbit.rotate(d.x, d.y);
-        if (panning) orbit.pan(d.x, d.y, std::max(height, 1u));
+        if (panning) orbit.pan(d.x, d.y, std::max(app.height(), 1u));
         if (drawing) {  // samples every 2 pixels along the move, so a fast drag still makes a dense stroke
           const int steps = std::max(1, int(std::ceil(glm::length(d) / 2.0f)));
           for (int k = 1; k <= steps; ++k) pen_sample(cursor + d * (float(k) / float(steps)));
@@ -341,7 +293,7 @@ int run_app(const AppArgs& a) {
       }
       case EventKind::ButtonPress:
         cursor = glm::vec2(float(e.x), float(e.y));
-        if ((*hud)->wants_mouse() || dragging || panning || drawing) break;
+        if (app.hud().wants_mouse() || dragging || panning || drawing) break;
         if (shift || e.button == window::Button::Middle) panning = true;
         else if (e.button == window::Button::Left && can_draw) {
           // A stroke starts only on the reference: the pen goes down with its first sample.
@@ -359,7 +311,7 @@ int run_app(const AppArgs& a) {
         dragging = panning = drawing = false;
         break;
       case EventKind::Scroll:
-        if (!(*hud)->wants_mouse()) orbit.zoom(float(e.y));
+        if (!app.hud().wants_mouse()) orbit.zoom(float(e.y));
         break;
       case EventKind::KeyPress:
         if (ctrl && e.key == GLFW_KEY_Z) log_command(shift ? CommandKind::Redo : CommandKind::Undo, Vec3::Zero());
@@ -372,12 +324,12 @@ int run_app(const AppArgs& a) {
         else if (e.key == GLFW_KEY_C) log_command(CommandKind::Close, Vec3::Zero());
         else if (e.key == GLFW_KEY_DELETE) {
           Vec3 p;
-          if (curve_point_under(w.mesh, camera, width, height, cursor, 12.0f, p)) log_command(CommandKind::Delete, p);
+          if (curve_point_under(w.mesh, app.camera(), app.width(), app.height(), cursor, 12.0f, p)) log_command(CommandKind::Delete, p);
           else hud_data.status = "no curve under the cursor to delete";
         } else if (e.key == GLFW_KEY_1) hud_data.view.surface = !hud_data.view.surface;
         else if (e.key == GLFW_KEY_2) hud_data.view.curves = !hud_data.view.curves;
         else if (e.key == GLFW_KEY_3) hud_data.view.wireframe = !hud_data.view.wireframe;
-        else if (e.key == GLFW_KEY_F) orbit = frame_orbit(scene_box(w.mesh, w.surface, reference_positions), width, height);
+        else if (e.key == GLFW_KEY_F) orbit = frame_orbit(scene_box(w.mesh, w.surface, reference_positions), app.width(), app.height());
         else if (e.key == GLFW_KEY_H || e.key == GLFW_KEY_F1) hud_data.help = !hud_data.help;
         else if (e.key == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(window.handle(), GLFW_TRUE);
         break;
@@ -386,46 +338,7 @@ int run_app(const AppArgs& a) {
     }
   };
 
-  // One displayed frame: systems due by the wall clock, the upload, the HUD, the present.
-  auto display = [&](render::Image* capture) -> bool {
-    const int64_t now_us = session_us();
-    while (w.frame.end_us <= now_us) run_frame();
-    if (w.rejections.size() > rejections_seen) {
-      hud_data.last_rejection = w.rejections.back().reason;
-      rejections_seen = w.rejections.size();
-    }
-    window.framebuffer_size(width, height);
-    if (width == 0 || height == 0) return false;  // minimised: systems go on, nothing to show
-    camera = render::orbit_camera(orbit, width, height);
-    if (status = (*presenter)->wait(); !status) return false;
-    if (status = (*renderer)->upload(w.mesh, w.surface); !status) return false;
-    const std::span<const Vec3> stroke = w.sketch.pen_down ? std::span<const Vec3>(w.sketch.stroke) : std::span<const Vec3>();
-    if (status = (*renderer)->set_stroke(stroke); !status) return false;
-    const auto wall_now = WallClock::now();
-    hud_data.frame_ms = std::chrono::duration<double, std::milli>(wall_now - last_frame).count();
-    last_frame = wall_now;
-    hud_data.frames = scheduler.frames();
-    hud_data.timings = &scheduler.timings();
-    hud_data.frame_timing = &scheduler.frame_timing();
-    hud_data.vertices = w.mesh.vertex_count();
-    hud_data.edges = w.mesh.edge_count();
-    hud_data.faces = w.mesh.face_count();
-    hud_data.points = w.mesh.live_point_count();
-    hud_data.surface_quads = w.surface.quad_count();
-    hud_data.border_mode = w.mesh.face_count() == 0;
-    (*hud)->build(hud_data);
-    auto shown = (*presenter)->frame(**renderer, camera, hud_data.view, [&](VkCommandBuffer cmd) { (*hud)->draw(cmd); },
-                                     capture);
-    if (!shown) {
-      status = Status::failure(shown.error());
-      return false;
-    }
-    if (status = (*hud)->status(); !status) return false;
-    if (!*shown) status = (*presenter)->resize(width, height);
-    return *shown;
-  };
-
-  while (status && !window.should_close()) {
+  while (app.status() && !window.should_close()) {
     for (; next_script < script.size() && script[next_script].frame <= display_frame; ++next_script) {
       const ScriptEvent& s = script[next_script];
       if (s.resize_width) window.request_size(s.resize_width, s.resize_height);
@@ -434,29 +347,24 @@ int run_app(const AppArgs& a) {
     window.poll();
     for (const window::WindowEvent& e : window.events()) handle(e);
     window.events().clear();
-    if (!display(nullptr) && status && width == 0) std::this_thread::sleep_for(std::chrono::milliseconds(16));
+    if (!app.display(orbit) && app.status() && app.width() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(16));
     ++display_frame;
   }
-  if (!status) return fail("Vulkan: " + status.error);
+  if (!app.status()) return fail("Vulkan: " + app.status().error);
 
   // Every logged event handled, as `fire replay` ends; then the last picture, which --screenshot keeps.
-  while (w.cursor.next < w.log.events.size() || !w.sketch.pending.empty()) run_frame();
+  while (w.cursor.next < w.log.events.size() || !w.sketch.pending.empty()) app.run_frame();
   render::Image shot;
   if (!a.screenshot_path.empty()) {
     bool shown = false;
-    for (int attempt = 0; attempt < 3 && status && !shown; ++attempt) shown = display(&shot);
-    if (!status) return fail("Vulkan: " + status.error);
+    for (int attempt = 0; attempt < 3 && app.status() && !shown; ++attempt) shown = app.display(orbit, &shot);
+    if (!app.status()) return fail("Vulkan: " + app.status().error);
     if (!shown) return fail("--screenshot: the window could not be drawn (minimised?)");
   }
   const uint64_t hash = world_hash(w);
-  const std::string device = (*context)->device_name();
-  const bool validation = (*context)->validation();
-  hud->reset();
-  presenter->reset();
-  renderer->reset();
-  const size_t messages = (*context)->validation_message_count();
-  context->reset();
-  win->reset();
+  const std::string device = app.context().device_name();
+  const bool validation = app.context().validation();
+  const size_t messages = app.close();
   if (messages) return fail(std::to_string(messages) + " Vulkan validation message(s), see above");
   if (!a.screenshot_path.empty())
     if (Status s = render::write_png(shot, a.screenshot_path); !s) return fail(s.error);
