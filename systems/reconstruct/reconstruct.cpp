@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
+
+#include <Eigen/Geometry>
 
 #include "systems/reconstruct/fit.hpp"
 #include "systems/subdivide/subdivide.hpp"
@@ -79,6 +82,21 @@ bool border_corner(const Mesh& net, uint32_t v) {
 
 
 }  // namespace
+
+double worst_quad_aspect(const BaseMesh& base) {
+  double worst = 0;
+  for (uint32_t f = 0; f < base.face_count(); ++f) {
+    const uint32_t first = base.face_offsets[f], n = base.face_offsets[f + 1] - first;
+    if (n != 4) continue;
+    const Vec3* p[4];
+    for (uint32_t k = 0; k < 4; ++k) p[k] = &base.positions[base.face_vertices[first + k]];
+    double longest = 0;
+    for (uint32_t k = 0; k < 4; ++k) longest = std::max(longest, (*p[(k + 1) % 4] - *p[k]).norm());
+    const double area = 0.5 * (*p[2] - *p[0]).cross(*p[3] - *p[1]).norm();
+    worst = std::max(worst, area > 0 ? longest * longest / area : std::numeric_limits<double>::infinity());
+  }
+  return worst;
+}
 
 Status check_reconstruction_input(const Mesh& net, const Options& options) {
   if (options.coons_steps < 1 || options.coons_steps > kMaxCoonsSteps)

@@ -78,6 +78,11 @@ struct BaseMesh {
   }
 };
 
+// The worst-shaped quad of a base mesh: the largest (longest side)^2 / area, 1 for a square, 1/w for a
+// 1 x w rectangle, about 2.4 for a rhombus with 25-degree corners (area from the diagonals' cross product);
+// infinite for a quad of zero area.
+double worst_quad_aspect(const BaseMesh& base);
+
 // What the last reconstruct_update() did.
 struct UpdateStats {
   size_t edges_recomputed = 0;

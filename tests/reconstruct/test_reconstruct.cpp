@@ -134,6 +134,20 @@ TEST_CASE("FIRE: a border vertex is a corner only where the border turns", "[rec
   CHECK(base_of(disk, {Method::thesis, 1, 2, Planarity::least_squares}).border_corners.empty());
 }
 
+TEST_CASE("the worst base quad's aspect: 1 for a square, 1/w for a 1 x w rectangle", "[reconstruct]") {
+  BaseMesh b;
+  b.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {2, 0, 0}, {2, 0.25, 0}, {1, 0.25, 0}};
+  b.face_vertices = {0, 1, 2, 3};
+  b.face_offsets = {0, 4};
+  CHECK(worst_quad_aspect(b) == Approx(1.0));
+  b.face_vertices.insert(b.face_vertices.end(), {1, 4, 5, 6});
+  b.face_offsets.push_back(8);
+  CHECK(worst_quad_aspect(b) == Approx(4.0));
+  b.positions[5] = {3, 0, 0};  // all four on one line: no area
+  b.positions[6] = {1.5, 0, 0};
+  CHECK(std::isinf(worst_quad_aspect(b)));
+}
+
 TEST_CASE("FIRE: the fitted limit surface passes through the drawn samples", "[reconstruct][fire][fit]") {
   // Curves sampled on the limit surface of a 4 x 4 control grid at its level-3 vertices: the FIRE base
   // mesh has the grid's topology, so a surface through every sample exists.

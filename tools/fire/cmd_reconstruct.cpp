@@ -57,6 +57,7 @@ int run_reconstruct(const ReconstructArgs& a) {
   out["faces"] = surface.face_count();
   out["vertices"] = surface.positions.size();
   out["seconds"] = seconds;
+  out["worst_quad_aspect"] = reconstruct::worst_quad_aspect(state.base());
   std::cout << out.dump() << "\n";
   return 0;
 }
@@ -71,7 +72,8 @@ void add_reconstruct_commands(CLI::App& app, Registry& registry) {
       "around a centre per face from an n-sided transfinite patch, then base points fitted so that the "
       "Catmull-Clark limit surface passes through the drawn curves. Writes the level-L quads at their limit "
       "positions with limit normals, atomically; the format follows the extension (.obj .ply .stl .glb). Prints one "
-      "JSON line: method, coons_steps, levels, base_faces, faces, vertices and seconds (reconstruction only, no I/O).");
+      "JSON line: method, coons_steps, levels, base_faces, faces, vertices, seconds (reconstruction only, no I/O) "
+      "and worst_quad_aspect (the base mesh's worst quad: longest side squared over area, 1 for a square).");
   cmd->add_option("NET", a->network_path, "curve network file (format: engine/NETWORK_FORMAT.md)")->required();
   cmd->add_option("-o,--output", a->out_path, "surface file to write: .obj, .ply, .stl or .glb")->required();
   cmd->add_option("--method", a->method, "thesis or fire")->capture_default_str();
