@@ -75,7 +75,6 @@ double squared_gap(const B& b, const Vec3& p) {
 using DoublePair = double __attribute__((vector_size(16)));
 using FloatPair = float __attribute__((vector_size(8)));
 using FloatQuad = float __attribute__((vector_size(16)));
-using IntQuad = int32_t __attribute__((vector_size(16)));
 
 // squared_gap() of a node's entries 2h and 2h+1 at once, with the same arithmetic in the same order; NaN
 // for an empty entry, which no bound admits. (Pairs, not one four-wide vector: without AVX, GCC spills
@@ -328,13 +327,13 @@ void SnapIndex::fill_entries(Node& n, int s) const {
   // Grandchild t's box is the union of the child's entries 2t and 2t+1, taken for all four at once: an
   // empty odd entry (NaN) loses the comparison and keeps the even one; both empty stay NaN.
   const Node& cn = nodes_[c];
-  constexpr IntQuad even = {0, 2, 4, 6}, odd = {1, 3, 5, 7};
   for (int a = 0; a < 3; ++a) {
     FloatQuad l[2], h[2];
     std::memcpy(l, cn.lo[a], sizeof l);
     std::memcpy(h, cn.hi[a], sizeof h);
-    const FloatQuad le = __builtin_shuffle(l[0], l[1], even), lo = __builtin_shuffle(l[0], l[1], odd);
-    const FloatQuad he = __builtin_shuffle(h[0], h[1], even), ho = __builtin_shuffle(h[0], h[1], odd);
+    // __builtin_shufflevector: GCC (12 and later) and clang (the fuzz build) both have it.
+    const FloatQuad le = __builtin_shufflevector(l[0], l[1], 0, 2, 4, 6), lo = __builtin_shufflevector(l[0], l[1], 1, 3, 5, 7);
+    const FloatQuad he = __builtin_shufflevector(h[0], h[1], 0, 2, 4, 6), ho = __builtin_shufflevector(h[0], h[1], 1, 3, 5, 7);
     const FloatQuad lu = lo < le ? lo : le, hu = ho > he ? ho : he;
     std::memcpy(n.lo[a] + 4 * s, &lu, sizeof lu);
     std::memcpy(n.hi[a] + 4 * s, &hu, sizeof hu);
