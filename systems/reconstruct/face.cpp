@@ -5,7 +5,6 @@
 #include <bit>
 #include <cmath>
 #include <map>
-#include <numbers>
 
 namespace fire::reconstruct {
 
@@ -123,15 +122,6 @@ enum class Rule : uint8_t {
   fire_coons,     // FIRE later steps: bilinear Coons with linear sampling
 };
 
-// The oriented local edges of one side of a face being refined, in walking order.
-using SideEdges = std::vector<uint32_t>;
-
-std::vector<SideEdges> single_sides(const std::vector<uint32_t>& loop) {
-  std::vector<SideEdges> sides;
-  for (uint32_t oe : loop) sides.push_back({oe});
-  return sides;
-}
-
 struct Refiner {
   LocalMesh& mesh;
   double spacing;  // mean segment length of the network face's polylines: spokes are sampled as densely
@@ -144,40 +134,21 @@ struct Refiner {
   }
 
   // Splits every side of the face, puts a centre vertex inside, joins it to the side midpoints with
-  // spokes and returns the n faces around it (corner k: P_k, M_k, C, M_k-1). A side is one edge, or two
-  // (fire_sided) whose shared vertex goes straight on: that vertex is then the side's split point, each
-  // edge keeps its own, and the faces beside it have 5 or 6 corners instead of a corner of 180 degrees.
-  std::vector<std::vector<uint32_t>> refine(const std::vector<SideEdges>& loop, Rule rule, uint32_t remaining) {
+  // spokes and returns the n quads (corner k: P_k, M_k, C, M_k-1).
+  std::vector<std::vector<uint32_t>> refine(const std::vector<uint32_t>& loop, Rule rule, uint32_t remaining) {
     const uint32_t n = static_cast<uint32_t>(loop.size());
-    for (const SideEdges& side : loop)
-      for (uint32_t oe : side) {
-        mesh.split(oe >> 1);
-        mesh.params(oe >> 1);
-      }
-    std::vector<std::vector<Vec3>> joined(n);
-    std::vector<std::vector<double>> joined_params(n);
+    for (uint32_t oe : loop) {
+      mesh.split(oe >> 1);
+      mesh.params(oe >> 1);
+    }
+    std::vector<Side> sides(n);
+    for (uint32_t k = 0; k < n; ++k) sides[k] = mesh.side(loop[k]);
     std::vector<Vec3> mids(n);
     std::vector<double> t(n);
     for (uint32_t k = 0; k < n; ++k) {
-      const SideEdges& side = loop[k];
-      if (side.size() == 1) {
-        mids[k] = mesh.mid_position(side[0]);
-        t[k] = mesh.mid_walk_param(side[0]);
-        continue;
-      }
-      for (uint32_t oe : side) {
-        const std::span<const Vec3> line = mesh.edges[oe >> 1].line();
-        const size_t skip = joined[k].empty() ? 0 : 1;
-        if (oe & 1) joined[k].insert(joined[k].end(), line.rbegin() + ptrdiff_t(skip), line.rend());
-        else joined[k].insert(joined[k].end(), line.begin() + ptrdiff_t(skip), line.end());
-      }
-      joined_params[k] = arc_parameters(joined[k]);
-      mids[k] = mesh.tail_position(side[1]);
-      t[k] = joined_params[k][mesh.edges[side[0] >> 1].line().size() - 1];
+      mids[k] = mesh.mid_position(loop[k]);
+      t[k] = mesh.mid_walk_param(loop[k]);
     }
-    std::vector<Side> sides(n);
-    for (uint32_t k = 0; k < n; ++k)
-      sides[k] = loop[k].size() == 1 ? mesh.side(loop[k][0]) : Side{joined[k], joined_params[k], false};
 
     // A 2-sided face is the degenerate quad whose sides 1 and 3 are its corners.
     const std::array<Vec3, 2> corner0{sides[0].start(), sides[0].start()};
@@ -235,59 +206,18 @@ struct Refiner {
     for (uint32_t k = 0; k < n; ++k) {
       LocalEdge e;
       e.from = centre_ref;
-      e.to = loop[k].size() == 1 ? mesh.mid(loop[k][0]) : mesh.tail(loop[k][1]);
+      e.to = mesh.mid(loop[k]);
       e.own = std::move(spokes[k]);
       spoke[k] = mesh.add_edge(std::move(e));
     }
-    std::vector<std::vector<uint32_t>> faces(n);
+    std::vector<std::vector<uint32_t>> quads(n);
     for (uint32_t k = 0; k < n; ++k) {
       const uint32_t before = (k + n - 1) % n;
-      const SideEdges &side = loop[k], &previous = loop[before];
-      std::vector<uint32_t>& f = faces[k];
-      f.push_back(mesh.first_half(side[0]));
-      if (side.size() == 2) f.push_back(mesh.second_half(side[0]));
-      f.push_back(spoke[k] << 1 | 1u);
-      f.push_back(spoke[before] << 1);
-      if (previous.size() == 2) f.push_back(mesh.first_half(previous[1]));
-      f.push_back(mesh.second_half(previous.back()));
+      quads[k] = {mesh.first_half(loop[k]), spoke[k] << 1 | 1u, spoke[before] << 1, mesh.second_half(loop[before])};
     }
-    return faces;
+    return quads;
   }
 };
-
-// The face's sides between its corners: a vertex where the curve goes straight on (turning by at most
-// kStraightTurnDegrees) joins its two edges into one side, as long as the face keeps 3 corners and no side
-// gets more than 2 edges; the straightest go first. Without such vertices, one side per edge, in loop order.
-std::vector<SideEdges> sides_between_corners(LocalMesh& mesh, const std::vector<uint32_t>& loop) {
-  const uint32_t n = static_cast<uint32_t>(loop.size());
-  std::vector<std::pair<double, uint32_t>> candidates;  // (turn, corner k between loop[k-1] and loop[k])
-  for (uint32_t k = 0; k < n; ++k) {
-    const Side in = mesh.side(loop[(k + n - 1) % n]), out = mesh.side(loop[k]);
-    const Vec3 corner = out.start();
-    const Vec3 back = (in.at(1.0 - kTangentReach, Sampling::linear) - corner).normalized();
-    const Vec3 ahead = (out.at(kTangentReach, Sampling::linear) - corner).normalized();
-    const double turn = 180.0 - std::acos(std::clamp(back.dot(ahead), -1.0, 1.0)) * 180.0 / std::numbers::pi;
-    if (turn <= kStraightTurnDegrees) candidates.emplace_back(turn, k);
-  }
-  std::sort(candidates.begin(), candidates.end());
-  std::vector<uint8_t> straight(n, 0);
-  uint32_t corners = n;
-  for (const auto& [turn, k] : candidates) {
-    if (corners <= 3) break;
-    if (straight[(k + 1) % n] || straight[(k + n - 1) % n]) continue;
-    straight[k] = 1;
-    --corners;
-  }
-  uint32_t first = 0;
-  while (straight[first]) ++first;
-  std::vector<SideEdges> sides;
-  for (uint32_t i = 0; i < n; ++i) {
-    const uint32_t k = (first + i) % n;
-    if (straight[k]) sides.back().push_back(loop[k]);
-    else sides.push_back({loop[k]});
-  }
-  return sides;
-}
 
 }  // namespace
 
@@ -354,28 +284,24 @@ FacePatch build_face_patch(const Mesh& net, uint32_t face, std::span<const EdgeS
       std::vector<std::vector<uint32_t>> refined;
       for (const auto& f : faces) {
         const Rule rule = f.size() == 3 ? Rule::thesis_centroid : Rule::thesis_coons;
-        for (auto& q : refiner.refine(single_sides(f), rule, steps - step)) refined.push_back(std::move(q));
+        for (auto& q : refiner.refine(f, rule, steps - step)) refined.push_back(std::move(q));
       }
       faces = std::move(refined);
     }
   } else {
-    const std::vector<SideEdges> sides = n >= 3 ? sides_between_corners(mesh, loop) : single_sides(loop);
-    patch.first_stage_sizes.push_back(static_cast<uint32_t>(sides.size()));
-    faces = refiner.refine(sides, Rule::fire_sided, steps);
+    patch.first_stage_sizes.push_back(n);
+    faces = refiner.refine(loop, Rule::fire_sided, steps);
     for (uint32_t step = 1; step < steps; ++step) {
       std::vector<std::vector<uint32_t>> refined;
       for (const auto& f : faces)
-        for (auto& q : refiner.refine(single_sides(f), f.size() == 4 ? Rule::fire_coons : Rule::fire_sided, steps - step))
-          refined.push_back(std::move(q));
+        for (auto& q : refiner.refine(f, Rule::fire_coons, steps - step)) refined.push_back(std::move(q));
       faces = std::move(refined);
     }
   }
 
   patch.interior = mesh.interior;
-  for (const auto& f : faces) {
-    for (uint32_t oe : f) patch.faces.push_back(mesh.tail(oe));
-    patch.face_offsets.push_back(static_cast<uint32_t>(patch.faces.size()));
-  }
+  for (const auto& f : faces)
+    for (uint32_t oe : f) patch.quads.push_back(mesh.tail(oe));
   for (const LocalEdge& e : mesh.edges) {
     if (e.splits || e.first_child >= 0) continue;
     patch.curve_ends.push_back(e.from);

@@ -14,15 +14,6 @@ namespace fire::reconstruct {
 
 enum class Method : uint8_t { thesis, fire };
 
-// fire: a network vertex where the curves turn by at most kStraightTurnDegrees is no corner. On a face's
-// loop it is a point inside one of its sides (the face is split as if it had one corner fewer), and on the
-// border a smooth point of the surface's border (Catmull-Clark's crease rule instead of a corner). The
-// turn is measured between the directions in which the two curves leave the vertex, each towards its
-// point kTangentReach of the curve's length away: far enough that a hand's jitter does not turn it, near
-// enough to be the curve's own direction.
-inline constexpr double kStraightTurnDegrees = 30.0;
-inline constexpr double kTangentReach = 0.15;
-
 // A base-mesh vertex before global numbering: a network vertex (index = vertex slot), a split point of a
 // network edge (index = edge slot, sub = 1 .. 2^N - 1 along the edge's stored direction), or a vertex made
 // inside a face (index = its position in FacePatch::interior).
@@ -55,16 +46,13 @@ struct FaceSettings {
 // What one network face contributes to the base mesh.
 struct FacePatch {
   std::vector<Vec3> interior;       // positions of the vertices made inside the face
-  // The base faces, in the face's winding: quads, and faces of 5 or 6 corners beside a vertex where the
-  // curve goes straight on (see kStraightTurnDegrees).
-  std::vector<VertexRef> faces;
-  std::vector<uint32_t> face_offsets{0};
+  std::vector<VertexRef> quads;     // 4 per base quad, in the face's winding
   // Base edges inside the face (triquadrification cuts, spokes) with the polylines they carry: straight
   // (thesis) or sampled from the transfinite patch (FIRE). 2 ends per curve.
   std::vector<VertexRef> curve_ends;
   std::vector<uint32_t> curve_offsets{0};
   std::vector<Vec3> curve_points;
-  uint32_t face_count() const { return static_cast<uint32_t>(face_offsets.size() - 1); }
+  uint32_t quad_count() const { return static_cast<uint32_t>(quads.size() / 4); }
   uint32_t curve_count() const { return static_cast<uint32_t>(curve_offsets.size() - 1); }
   std::span<const Vec3> curve(uint32_t c) const {
     return std::span<const Vec3>(curve_points).subspan(curve_offsets[c], curve_offsets[c + 1] - curve_offsets[c]);

@@ -54,8 +54,9 @@ bool used_by_face(const Mesh& net, uint32_t e) {
   return net.edges.face[e][0] != kNone || net.edges.face[e][1] != kNone;
 }
 
-// The unit direction in which edge e leaves its end v, towards the polyline's point a fraction
-// kTangentReach of its length along.
+// The unit direction in which edge e leaves its end v, from v to the polyline's point a fraction
+// kTangentReach of its length along: far enough that a hand's jitter does not turn it, near enough to
+// be the curve's own direction.
 Vec3 leaving_direction(const Mesh& net, uint32_t e, uint32_t v) {
   std::vector<Vec3> line(net.polyline(e).begin(), net.polyline(e).end());
   if (net.edges.vertex[e][0] != v) std::reverse(line.begin(), line.end());
@@ -65,7 +66,7 @@ Vec3 leaving_direction(const Mesh& net, uint32_t e, uint32_t v) {
 }
 
 // A border network vertex is a corner of the surface where the border turns by more than
-// kStraightTurnDegrees; where it goes straight on it is a smooth point of the border.
+// kBorderCornerTurnDegrees; where it goes straight on it is a smooth point of the border.
 bool border_corner(const Mesh& net, uint32_t v) {
   uint32_t border[2], count = 0;
   for (uint32_t e : net.vertex_edges(v))
@@ -76,7 +77,7 @@ bool border_corner(const Mesh& net, uint32_t v) {
   if (count != 2) return true;
   const double cosine = leaving_direction(net, border[0], v).dot(leaving_direction(net, border[1], v));
   const double turn = 180.0 - std::acos(std::clamp(cosine, -1.0, 1.0)) * 180.0 / std::numbers::pi;
-  return !(turn <= kStraightTurnDegrees);
+  return !(turn <= kBorderCornerTurnDegrees);
 }
 
 
@@ -217,10 +218,9 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
   };
   for (uint32_t f = 0; f < net.face_slots(); ++f) {
     if (!net.face_alive(f)) continue;
-    const FacePatch& p = c.faces[f];
-    for (uint32_t q = 0; q < p.face_count(); ++q) {
-      for (uint32_t i = p.face_offsets[q]; i < p.face_offsets[q + 1]; ++i) base.face_vertices.push_back(id(p.faces[i], f));
-      base.face_offsets.push_back(static_cast<uint32_t>(base.face_vertices.size()));
+    for (const VertexRef& r : c.faces[f].quads) {
+      base.face_vertices.push_back(id(r, f));
+      if (base.face_vertices.size() % 4 == 0) base.face_offsets.push_back(static_cast<uint32_t>(base.face_vertices.size()));
     }
   }
   // Drawn curves: the pieces of each network edge, between its vertices and split points.

@@ -5,10 +5,9 @@
 //     measure; cuts get straight polylines), N steps of Coons refinement (bilinearly blended Coons
 //     patches over the polylines, nearest samples; triangles by the centroid of their edge midpoints),
 //     then Catmull-Clark to level L. The surface follows the base mesh, not the drawn curves.
-//   fire (default): every face with n corners becomes n faces around a centre (quads; a vertex where the
-//     curves go straight on is no corner but a side's split point, and the faces beside it have 5 or 6
-//     corners; face.hpp), the centre and the spokes sampled from an n-sided transfinite patch over the
-//     face's polylines (systems/reconstruct/geometry.hpp); N-1 further Coons steps (linear sampling); a 2-sided face gives 2 quads; then the
+//   fire (default): every face with n sides becomes n quads around a centre, the centre and the spokes
+//     sampled from an n-sided transfinite patch over the face's polylines (systems/reconstruct/
+//     geometry.hpp); N-1 further Coons steps (linear sampling); a 2-sided face gives 2 quads; then the
 //     base points are fitted so that the Catmull-Clark limit surface passes through the drawn
 //     polylines (least squares with a fairness term, systems/reconstruct/fit.hpp).
 //
@@ -31,6 +30,12 @@
 namespace fire::reconstruct {
 
 inline constexpr uint32_t kMaxCoonsSteps = 5;
+// fire: a border vertex of the network is a corner of the surface only where the border turns by more
+// than this many degrees, the turn measured between the directions in which its two border curves leave
+// it, each towards its point kTangentReach of the curve's length away. Elsewhere the border runs
+// smoothly through it (thesis: a vertex where a curve merely goes on is no corner).
+inline constexpr double kBorderCornerTurnDegrees = 30.0;
+inline constexpr double kTangentReach = 0.15;
 // Surface levels the options allow (the Catmull-Clark library itself refines further).
 inline constexpr uint32_t kMaxSurfaceLevels = 6;
 
@@ -46,8 +51,7 @@ struct Options {
   friend bool operator==(const Options&, const Options&) = default;
 };
 
-// The base mesh handed to subdivision (quads, and fire's faces beside straight vertices), and the
-// polylines the fit follows along its edges.
+// The quad base mesh handed to subdivision, and the polylines the fit follows along its edges.
 struct BaseMesh {
   std::vector<Vec3> positions;
   std::vector<uint32_t> face_offsets{0};

@@ -20,7 +20,7 @@ void add_face(Mesh& m, std::initializer_list<std::pair<uint32_t, bool>> loop) {
 
 }  // namespace
 
-Mesh polygon_network(uint32_t n, uint32_t samples, bool chords) {
+Mesh polygon_network(uint32_t n, uint32_t samples) {
   Mesh m;
   auto point = [](double angle) { return Vec3(std::cos(angle), std::sin(angle), 0.2 * std::cos(2 * angle)); };
   std::vector<uint32_t> corners;
@@ -28,15 +28,8 @@ Mesh polygon_network(uint32_t n, uint32_t samples, bool chords) {
   std::vector<uint32_t> oriented;
   for (uint32_t k = 0; k < n; ++k) {
     std::vector<Vec3> line;
-    for (uint32_t i = 0; i < samples; ++i) {
-      const double u = double(i) / (samples - 1);
-      Vec3 p = point(2 * std::numbers::pi * (k + u) / n);
-      if (chords) {
-        const Vec3 a = point(2 * std::numbers::pi * k / n), b = point(2 * std::numbers::pi * (k + 1) / n);
-        p.head<2>() = (1 - u) * a.head<2>() + u * b.head<2>();
-      }
-      line.push_back(p);
-    }
+    for (uint32_t i = 0; i < samples; ++i)
+      line.push_back(point(2 * std::numbers::pi * (k + double(i) / (samples - 1)) / n));
     oriented.push_back(make_oriented(m.add_edge(corners[k], corners[(k + 1) % n], line), false));
   }
   REQUIRE(m.add_face(oriented) != kNone);

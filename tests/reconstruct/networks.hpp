@@ -13,9 +13,8 @@ namespace fire::test {
 using Height = std::function<double(double, double)>;
 
 // One face with n sides (n >= 2): corners on the unit circle at angles 2 pi k / n, each side the arc
-// of the circle between its corners (or, with `chords`, the straight chord, so that every corner turns)
-// lifted to z = 0.2 cos(2 angle), with `samples` points.
-Mesh polygon_network(uint32_t n, uint32_t samples = 9, bool chords = false);
+// of the circle between its corners lifted to z = 0.2 cos(2 angle), with `samples` points.
+Mesh polygon_network(uint32_t n, uint32_t samples = 9);
 
 // A grid of nx by ny square faces over [0, nx] x [0, ny], every curve on the surface z = height(x, y)
 // with `samples` points; faces counter-clockwise seen from +z, numbered row by row (face j*nx + i).
