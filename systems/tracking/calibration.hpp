@@ -36,6 +36,9 @@ struct CalibrationResult {
   // RMS over the used frames of |A - B| - wand length, with A, B triangulated (Optimal method)
   // from the calibrated cameras, millimetres. (Inside the adjustment the length is fixed.)
   double wand_length_error_mm = 0;
+  // Camera 1's latency minus camera 0's when the wand was waved (calibrate_wand_streams; 0 from
+  // calibrate_wand alone). Where tracking starts; it changes whenever a remote reconnects.
+  double time_offset_us = 0;
   int observations_used = 0;
   int observations_rejected = 0;
   int iterations = 0;

@@ -89,6 +89,7 @@ std::string rig_to_json(const CalibrationResult& rig) {
                    {{"reprojection_rms_px", rig.reprojection_rms_px},
                     {"reprojection_rms_2d_px", rig.reprojection_rms_2d_px},
                     {"wand_length_error_mm", rig.wand_length_error_mm},
+                    {"time_offset_ms", rig.time_offset_us * 1e-3},
                     {"observations_used", rig.observations_used},
                     {"observations_rejected", rig.observations_rejected},
                     {"iterations", rig.iterations}}}};
@@ -126,6 +127,12 @@ Result<CalibrationResult> rig_from_json(std::string_view text, const std::string
     const Result<double> v = number(cal, stat_names[i], cw);
     if (!v) return R::failure(v.error());
     *stats[i] = *v;
+  }
+  if (cal.contains("time_offset_ms")) {  // absent from rigs written before it was kept
+    const Result<double> v = number(cal, "time_offset_ms", cw);
+    if (!v) return R::failure(v.error());
+    if (!(std::abs(*v) < 1e6)) return R::failure(cw + ".time_offset_ms: out of range");
+    rig.time_offset_us = *v * 1e3;
   }
   int* counts[] = {&rig.observations_used, &rig.observations_rejected, &rig.iterations};
   const char* count_names[] = {"observations_used", "observations_rejected", "iterations"};

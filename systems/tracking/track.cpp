@@ -11,12 +11,7 @@ namespace fire::tracking {
 namespace {
 
 constexpr double kMatchGatePx = 60.0;     // farthest a blob moves between two frames (about 2 m/s at 0.8 m)
-constexpr double kMaxFrameGap = 2.5;      // interpolate across one lost report, not across more
 constexpr double kEpipolarCapPx = 5.0;    // a blob farther than this from its epipolar line counts as this far
-constexpr double kJumpGate_m = 0.02;      // pen positions this far apart are different things
-constexpr double kMaxPenSpeed_m_s = 5.0;  // a hand moves the pen no faster
-constexpr double kBridgeSpeed_m_s = 1.0;  // a drawing hand, while both cameras lose the pen, moves it no faster
-constexpr double kMovingPx = 1.5;         // a blob moving less per frame says little about timing
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
@@ -25,82 +20,79 @@ double median(std::vector<double> v) {
   return *mid;
 }
 
-// Typical spacing of a camera's frames on its fitted clock.
+}  // namespace
+
 double frame_period_us(const CameraFrames& f) {
   std::vector<double> d;
   for (size_t k = 1; k < f.size(); ++k) d.push_back(f.t_frame_us[k] - f.t_frame_us[k - 1]);
   return median(std::move(d));
 }
 
-// For each frame, the blob of the next frame each of its blobs continues as (-1: none).
-// A match must be mutual, within the gate, and clearly nearer than any other candidate.
-using BlobLinks = std::vector<std::array<int8_t, kIrSlots>>;
-
-BlobLinks link_blobs(const CameraFrames& f) {
-  BlobLinks links(f.size());
-  for (size_t k = 0; k < f.size(); ++k) {
-    links[k].fill(-1);
-    if (k + 1 == f.size()) break;
-    const int na = f.blob_count[k], nb = f.blob_count[k + 1];
-    auto nearest = [](const std::array<Vec2, kIrSlots>& from, int n, const Vec2& p, double& d1, double& d2) {
-      int best = -1;
-      d1 = d2 = std::numeric_limits<double>::infinity();
-      for (int j = 0; j < n; ++j) {
-        const double d = (from[j] - p).norm();
-        if (d < d1) {
-          d2 = d1;
-          d1 = d;
-          best = j;
-        } else if (d < d2) {
-          d2 = d;
-        }
+std::array<int8_t, kIrSlots> link_to_next(const CameraFrames& f, size_t k) {
+  std::array<int8_t, kIrSlots> links;
+  links.fill(-1);
+  if (k + 1 >= f.size()) return links;
+  const int na = f.blob_count[k], nb = f.blob_count[k + 1];
+  auto nearest = [](const std::array<Vec2, kIrSlots>& from, int n, const Vec2& p, double& d1, double& d2) {
+    int best = -1;
+    d1 = d2 = std::numeric_limits<double>::infinity();
+    for (int j = 0; j < n; ++j) {
+      const double d = (from[j] - p).norm();
+      if (d < d1) {
+        d2 = d1;
+        d1 = d;
+        best = j;
+      } else if (d < d2) {
+        d2 = d;
       }
-      return best;
-    };
-    for (int i = 0; i < na; ++i) {
-      double d1, d2, e1, e2;
-      const int j = nearest(f.blobs[k + 1], nb, f.blobs[k][i], d1, d2);
-      if (j < 0 || d1 > kMatchGatePx || !(d1 < 0.5 * d2)) continue;
-      if (nearest(f.blobs[k], na, f.blobs[k + 1][j], e1, e2) != i || !(e1 < 0.5 * e2)) continue;
-      links[k][i] = static_cast<int8_t>(j);
     }
+    return best;
+  };
+  for (int i = 0; i < na; ++i) {
+    double d1, d2, e1, e2;
+    const int j = nearest(f.blobs[k + 1], nb, f.blobs[k][i], d1, d2);
+    if (j < 0 || d1 > kMatchGatePx || !(d1 < 0.5 * d2)) continue;
+    if (nearest(f.blobs[k], na, f.blobs[k + 1][j], e1, e2) != i || !(e1 < 0.5 * e2)) continue;
+    links[i] = static_cast<int8_t>(j);
   }
   return links;
 }
 
-// Camera 1's blobs at instant t, interpolated between the frames that bracket it.
-struct Interpolated {
-  int count = 0;
-  std::array<Vec2, kIrSlots> px;
-  std::array<int, kIrSlots> source;  // blob index in the earlier frame
-  size_t frame = 0;                  // the earlier frame
-  double s = 0;                      // fraction of the way to the later frame
-};
+bool interpolate_blobs(const CameraFrames& f, const BlobLinks& links, double max_gap_us, double t, Interpolated& out) {
+  out.count = 0;
+  const auto it = std::upper_bound(f.t_frame_us.begin(), f.t_frame_us.end(), t);
+  if (it == f.t_frame_us.begin() || it == f.t_frame_us.end()) return false;
+  const size_t j = static_cast<size_t>(it - f.t_frame_us.begin()) - 1;
+  const double t0 = f.t_frame_us[j], t1 = f.t_frame_us[j + 1];
+  if (t1 - t0 > max_gap_us || j >= links.size()) return false;
+  out.frame = j;
+  out.s = (t - t0) / (t1 - t0);
+  for (int i = 0; i < f.blob_count[j]; ++i) {
+    const int8_t next = links[j][i];
+    if (next < 0) continue;
+    const Vec2& a = f.blobs[j][i];
+    const Vec2& b = f.blobs[j + 1][next];
+    out.px[out.count] = a + out.s * (b - a);
+    out.source[out.count] = i;
+    ++out.count;
+  }
+  return out.count > 0;
+}
 
+namespace {
+
+BlobLinks link_all(const CameraFrames& f) {
+  BlobLinks links(f.size());
+  for (size_t k = 0; k < f.size(); ++k) links[k] = link_to_next(f, k);
+  return links;
+}
+
+// A whole camera's frames with their links, for the batch (calibration) paths.
 class Interpolator {
  public:
-  explicit Interpolator(const CameraFrames& f) : f_(f), links_(link_blobs(f)), max_gap_us_(kMaxFrameGap * frame_period_us(f)) {}
-
-  bool at(double t, Interpolated& out) const {
-    out.count = 0;
-    const auto it = std::upper_bound(f_.t_frame_us.begin(), f_.t_frame_us.end(), t);
-    if (it == f_.t_frame_us.begin() || it == f_.t_frame_us.end()) return false;
-    const size_t j = static_cast<size_t>(it - f_.t_frame_us.begin()) - 1;
-    const double t0 = f_.t_frame_us[j], t1 = f_.t_frame_us[j + 1];
-    if (t1 - t0 > max_gap_us_) return false;
-    out.frame = j;
-    out.s = (t - t0) / (t1 - t0);
-    for (int i = 0; i < f_.blob_count[j]; ++i) {
-      const int8_t next = links_[j][i];
-      if (next < 0) continue;
-      const Vec2& a = f_.blobs[j][i];
-      const Vec2& b = f_.blobs[j + 1][next];
-      out.px[out.count] = a + out.s * (b - a);
-      out.source[out.count] = i;
-      ++out.count;
-    }
-    return out.count > 0;
-  }
+  explicit Interpolator(const CameraFrames& f)
+      : f_(f), links_(link_all(f)), max_gap_us_(kMaxInterpolationGap * frame_period_us(f)) {}
+  bool at(double t, Interpolated& out) const { return interpolate_blobs(f_, links_, max_gap_us_, t, out); }
   const BlobLinks& links() const { return links_; }
   double max_gap_us() const { return max_gap_us_; }
 
@@ -144,68 +136,77 @@ std::optional<std::pair<int, int>> device_record(const std::string& text, std::s
 
 }  // namespace
 
+std::optional<CameraReport> DeviceDecoder::read(const InputEvent& e) {
+  ReportCounts& c = counts;
+  if (e.kind == EventKind::Meta && e.name == "device") {
+    std::string address;
+    const auto record = device_record(e.text, address);
+    if (!record) {
+      ++c.bad_device_records;
+      return std::nullopt;
+    }
+    has_records_ = true;
+    const auto [device, role] = *record;
+    // A device number now taken by another role, or a role now held by another device, is given up.
+    for (auto& [d, r] : role_of_)
+      if (d != device && r == role) r = kNoRole;
+    role_of_[device] = role;
+    std::string& known = role >= 0 ? camera_address[size_t(role)] : pad_address;
+    if (known.empty()) known = address;
+    return std::nullopt;
+  }
+  if (e.kind != EventKind::Hid) return std::nullopt;
+  if (!e.hid_ok) {
+    ++c.garbled;
+    return std::nullopt;
+  }
+  int camera = e.device == 0 || e.device == 1 ? e.device : kNoRole;
+  if (has_records_) {
+    const auto it = role_of_.find(e.device);
+    camera = it == role_of_.end() ? kNoRole : it->second;
+  }
+  if (camera == kPad) {
+    ++c.pad_reports;
+    return std::nullopt;
+  }
+  if (camera == kNoRole) {
+    ++c.unknown_device;
+    return std::nullopt;
+  }
+  const DecodedReport r = decode_ir_report(e.bytes);
+  switch (r.status) {
+    case ReportStatus::Empty: ++c.garbled; return std::nullopt;
+    case ReportStatus::NotIr: ++c.not_ir; return std::nullopt;
+    case ReportStatus::BadLength: ++c.bad_length; return std::nullopt;
+    case ReportStatus::UnknownId: ++c.unknown_id; return std::nullopt;
+    case ReportStatus::Ok: break;
+  }
+  ++c.ir_reports;
+  c.out_of_range_slots += static_cast<size_t>(r.out_of_range_slots);
+  CameraReport out;
+  out.camera = camera;
+  out.t_us = e.t_us;
+  out.blobs.fill(Vec2::Zero());
+  for (const IrSlot& s : r.report.slots)
+    if (s.seen) out.blobs[out.blob_count++] = Vec2(s.x, s.y);
+  return out;
+}
+
 DeviceStreams decode_device_streams(std::span<const InputEvent> events) {
   DeviceStreams out;
-  ReportCounts& c = out.counts;
-  std::map<int, int> role_of;  // device -> camera index or kPad, once the log has device records
-  bool has_records = false;
+  DeviceDecoder decoder;
   for (const InputEvent& e : events) {
-    if (e.kind == EventKind::Meta && e.name == "device") {
-      std::string address;
-      const auto record = device_record(e.text, address);
-      if (!record) {
-        ++c.bad_device_records;
-        continue;
-      }
-      has_records = true;
-      const auto [device, role] = *record;
-      // A device number now taken by another role, or a role now held by another device, is given up.
-      for (auto& [d, r] : role_of)
-        if (d != device && r == role) r = kNoRole;
-      role_of[device] = role;
-      std::string& known = role >= 0 ? out.camera_address[size_t(role)] : out.pad_address;
-      if (known.empty()) known = address;
-      continue;
-    }
-    if (e.kind != EventKind::Hid) continue;
-    if (!e.hid_ok) {
-      ++c.garbled;
-      continue;
-    }
-    int camera = e.device == 0 || e.device == 1 ? e.device : kNoRole;
-    if (has_records) {
-      const auto it = role_of.find(e.device);
-      camera = it == role_of.end() ? kNoRole : it->second;
-    }
-    if (camera == kPad) {
-      ++c.pad_reports;
-      continue;
-    }
-    if (camera == kNoRole) {
-      ++c.unknown_device;
-      continue;
-    }
-    const DecodedReport r = decode_ir_report(e.bytes);
-    switch (r.status) {
-      case ReportStatus::Empty: ++c.garbled; continue;
-      case ReportStatus::NotIr: ++c.not_ir; continue;
-      case ReportStatus::BadLength: ++c.bad_length; continue;
-      case ReportStatus::UnknownId: ++c.unknown_id; continue;
-      case ReportStatus::Ok: break;
-    }
-    ++c.ir_reports;
-    c.out_of_range_slots += static_cast<size_t>(r.out_of_range_slots);
-    CameraFrames& f = out.cameras[size_t(camera)];
-    std::array<Vec2, kIrSlots> blobs;
-    blobs.fill(Vec2::Zero());
-    uint8_t n = 0;
-    for (const IrSlot& s : r.report.slots)
-      if (s.seen) blobs[n++] = Vec2(s.x, s.y);
-    f.t_us.push_back(e.t_us);
-    f.t_frame_us.push_back(static_cast<double>(e.t_us));
-    f.blob_count.push_back(n);
-    f.blobs.push_back(blobs);
+    const std::optional<CameraReport> r = decoder.read(e);
+    if (!r) continue;
+    CameraFrames& f = out.cameras[size_t(r->camera)];
+    f.t_us.push_back(r->t_us);
+    f.t_frame_us.push_back(static_cast<double>(r->t_us));
+    f.blob_count.push_back(r->blob_count);
+    f.blobs.push_back(r->blobs);
   }
+  out.camera_address = decoder.camera_address;
+  out.pad_address = decoder.pad_address;
+  out.counts = decoder.counts;
   return out;
 }
 
@@ -335,57 +336,37 @@ size_t remove_static_blobs(CameraFrames& f, double radius_px, int min_frames) {
   return removed;
 }
 
-TimeOffsetEstimate estimate_time_offset(const DeviceStreams& streams, const Camera& c0, const Camera& c1,
-                                        double search_us) {
+TimeOffsetEstimate search_time_offset(std::span<const MovingBlob> moving, const CameraFrames& f1, const BlobLinks& links1,
+                                      double max_gap1_us, const Camera& c0, const Camera& c1, double centre_us,
+                                      double search_us) {
   TimeOffsetEstimate out;
-  const CameraFrames& f0 = streams.cameras[0];
-  const CameraFrames& f1 = streams.cameras[1];
-  if (f0.size() < 3 || f1.size() < 3 || !(search_us > 0)) return out;
+  out.samples = moving.size();
+  if (moving.size() < 30 || f1.size() < 3 || !(search_us > 0)) return out;
   const Eigen::Matrix3d R = c1.R * c0.R.transpose();
   const Vec3 t = c1.t - R * c0.t;
   const Eigen::Matrix3d E = skew(t) * R;
   const double focal = 0.25 * (c0.K.fx + c0.K.fy + c1.K.fx + c1.K.fy);
-
-  // Moving camera 0 blobs carry the timing; resting ones fit every offset alike.
-  const Interpolator cam1(f1);
-  const Interpolator cam0(f0);
-  struct Sample {
-    double t;
-    Vec2 n0;
-  };
-  std::vector<Sample> samples;
-  for (size_t k = 0; k + 1 < f0.size(); ++k) {
-    if (f0.t_frame_us[k + 1] - f0.t_frame_us[k] > cam0.max_gap_us()) continue;
-    for (int i = 0; i < f0.blob_count[k]; ++i) {
-      const int8_t next = cam0.links()[k][i];
-      if (next < 0 || (f0.blobs[k + 1][next] - f0.blobs[k][i]).norm() < kMovingPx) continue;
-      samples.push_back({f0.t_frame_us[k], c0.undistort_normalized(f0.blobs[k][i])});
-    }
-  }
-  out.samples = samples.size();
-  if (samples.size() < 30) return out;
-
   auto cost = [&](double offset) {
     double sum = 0;
     Interpolated ip;
-    for (const Sample& s : samples) {
+    for (const MovingBlob& s : moving) {
       double best = kEpipolarCapPx;
-      if (cam1.at(s.t + offset, ip))
+      if (interpolate_blobs(f1, links1, max_gap1_us, s.t_us + offset, ip))
         for (int j = 0; j < ip.count; ++j)
-          best = std::min(best, focal * sampson(E, s.n0, c1.undistort_normalized(ip.px[j])));
+          best = std::min(best, focal * sampson(E, s.normalized, c1.undistort_normalized(ip.px[j])));
       sum += best;
     }
-    return sum / static_cast<double>(samples.size());
+    return sum / static_cast<double>(moving.size());
   };
   constexpr double kStep = 1000.0;
   std::vector<double> grid;
-  double best_offset = 0, best_cost = std::numeric_limits<double>::infinity();
+  double best_offset = centre_us, best_cost = std::numeric_limits<double>::infinity();
   for (double d = -std::floor(search_us / kStep) * kStep; d <= search_us; d += kStep) {
-    const double c = cost(d);
+    const double c = cost(centre_us + d);
     grid.push_back(c);
     if (c < best_cost) {
       best_cost = c;
-      best_offset = d;
+      best_offset = centre_us + d;
     }
   }
   // Golden-section refinement within one grid step either side.
@@ -419,6 +400,26 @@ TimeOffsetEstimate estimate_time_offset(const DeviceStreams& streams, const Came
   out.cost_at_zero_px = cost(0.0);
   out.observable = best_cost < 0.7 * median(grid);
   return out;
+}
+
+TimeOffsetEstimate estimate_time_offset(const DeviceStreams& streams, const Camera& c0, const Camera& c1,
+                                        double search_us) {
+  const CameraFrames& f0 = streams.cameras[0];
+  const CameraFrames& f1 = streams.cameras[1];
+  if (f0.size() < 3 || f1.size() < 3) return {};
+  // Moving camera 0 blobs carry the timing; resting ones fit every offset alike.
+  const Interpolator cam1(f1);
+  const Interpolator cam0(f0);
+  std::vector<MovingBlob> moving;
+  for (size_t k = 0; k + 1 < f0.size(); ++k) {
+    if (f0.t_frame_us[k + 1] - f0.t_frame_us[k] > cam0.max_gap_us()) continue;
+    for (int i = 0; i < f0.blob_count[k]; ++i) {
+      const int8_t next = cam0.links()[k][i];
+      if (next < 0 || (f0.blobs[k + 1][next] - f0.blobs[k][i]).norm() < kMovingPx) continue;
+      moving.push_back({f0.t_frame_us[k], c0.undistort_normalized(f0.blobs[k][i])});
+    }
+  }
+  return search_time_offset(moving, f1, cam1.links(), cam1.max_gap_us(), c0, c1, 0.0, search_us);
 }
 
 WandExtraction extract_wand_observations(const DeviceStreams& streams, double cam1_offset_us) {
@@ -472,165 +473,10 @@ Result<WandCalibration> calibrate_wand_streams(DeviceStreams streams, const Cali
     out.rig = *rig;
     out.calibrations = round;
     out.time_offset_used_us = offset;
+    out.rig.time_offset_us = offset;
     out.time_offset = estimate_time_offset(streams, rig->cam0, rig->cam1);
     if (!out.time_offset.observable || std::abs(out.time_offset.offset_us - offset) < kSettled_us) break;
     offset = out.time_offset.offset_us;
-  }
-  return out;
-}
-
-namespace {
-
-// The camera frame whose instant is the last at or before t (none before the first).
-std::optional<size_t> frame_at_or_before(const CameraFrames& f, double t) {
-  const auto it = std::upper_bound(f.t_frame_us.begin(), f.t_frame_us.end(), t);
-  if (it == f.t_frame_us.begin()) return std::nullopt;
-  return static_cast<size_t>(it - f.t_frame_us.begin()) - 1;
-}
-
-constexpr double kFollowStep_px = 40;  // the pen's blob moves less than this between two frames of a camera
-
-struct Followed {
-  Vec3 position;
-  Vec2 px;
-};
-
-// While only one camera sees the pen, the pen lies on that camera's ray through its blob: the point of
-// the ray nearest the pen's last position, if within `gate` of it, from the blob nearest the pen's last
-// pixel in that camera. A stray reflection elsewhere in the image is never taken for the pen.
-std::optional<Followed> follow_on_ray(const Camera& cam, std::span<const Vec2> blobs, const Vec2& last_px,
-                                      const Vec3& last, double gate) {
-  std::optional<Followed> best;
-  double best_step = kFollowStep_px;
-  for (const Vec2& px : blobs) {
-    const double step = (px - last_px).norm();
-    if (step > best_step) continue;
-    const Vec3 c = cam.centre(), d = cam.ray(px);
-    const Vec3 x = c + d * std::max(0.0, d.dot(last - c));
-    if ((x - last).norm() > gate) continue;
-    best_step = step;
-    best = Followed{x, px};
-  }
-  return best;
-}
-
-// How far the pen may be from where it was last seen after `dt_us`: a hand's fastest flick over a short
-// gap; over a longer one the pen was hidden while a drawing hand went on, which is slower.
-double reach_m(double dt_us, int64_t short_gap_us) {
-  const double speed = dt_us <= static_cast<double>(short_gap_us) ? kMaxPenSpeed_m_s : kBridgeSpeed_m_s;
-  return kJumpGate_m + speed * dt_us * 1e-6;
-}
-
-}  // namespace
-
-PenTrack track_pen(const DeviceStreams& streams, const Camera& c0, const Camera& c1, double cam1_offset_us,
-                   const PenTrackOptions& options) {
-  PenTrack out;
-  const CameraFrames& f0 = streams.cameras[0];
-  const CameraFrames& f1 = streams.cameras[1];
-  if (f0.size() == 0 || f1.size() < 2) return out;
-  const Interpolator cam1(f1);
-  Interpolated ip;
-  OneEuroState filter;
-  bool down = false;
-  double last_sample_t = -std::numeric_limits<double>::infinity();
-  double last_seen_t = last_sample_t;  // last instant some camera saw the pen (both, or one on the followed ray)
-  Vec3 last_position = Vec3::Zero();   // of the last sample, or of the ray point a single camera gave
-  std::array<Vec2, 2> pen_px{Vec2::Zero(), Vec2::Zero()};  // the pen's last pixel in each camera
-  for (size_t k = 0; k < f0.size(); ++k) {
-    const double t = f0.t_frame_us[k];
-    // A stroke ends when no camera has seen the pen for max_gap_us, or when only one has for longer than
-    // a hand takes to pass in front of the other (max_bridge_us).
-    if (down && (t - last_seen_t > static_cast<double>(options.max_gap_us) ||
-                 t - last_sample_t > static_cast<double>(options.max_bridge_us)))
-      down = false;
-    // Keeps the pen followed through a frame without a stereo sample, from whichever camera still sees it.
-    auto follow_one_camera = [&] {
-      if (!down) return;
-      const double gate = reach_m(t - last_seen_t, options.short_gap_us);
-      std::optional<Followed> x =
-          follow_on_ray(c0, std::span<const Vec2>(f0.blobs[k].data(), f0.blob_count[k]), pen_px[0], last_position, gate);
-      int camera = 0;
-      if (!x) {
-        if (const auto j = frame_at_or_before(f1, t + cam1_offset_us)) {
-          x = follow_on_ray(c1, std::span<const Vec2>(f1.blobs[*j].data(), f1.blob_count[*j]), pen_px[1], last_position, gate);
-          camera = 1;
-        }
-      }
-      if (!x) return;
-      last_seen_t = t;
-      last_position = x->position;
-      pen_px[camera] = x->px;
-      ++out.bridged_frames;
-    };
-    if (f0.blob_count[k] == 0 || !cam1.at(t + cam1_offset_us, ip)) {
-      follow_one_camera();
-      continue;
-    }
-    ++out.frames_seen_by_both;
-    // Epipolar lines run along the baseline, so a stray blob level with the LED in the other
-    // camera also fits the geometry. While the pen is down the candidate nearest its last
-    // position wins; a stroke only starts from a frame where every fitting pair agrees.
-    std::array<Triangulation, kIrSlots * kIrSlots> fits;
-    std::array<std::array<int, 2>, kIrSlots * kIrSlots> fit_blobs;
-    int fit_count = 0;
-    for (int i = 0; i < f0.blob_count[k]; ++i)
-      for (int j = 0; j < ip.count; ++j) {
-        const Triangulation tri =
-            triangulate(c0, c1, f0.blobs[k][i], ip.px[j], options.method, options.max_reprojection_px);
-        if (!tri.accepted) continue;
-        fit_blobs[fit_count] = {i, j};
-        fits[fit_count++] = tri;
-      }
-    if (fit_count == 0) {
-      ++out.rejected_reprojection;
-      follow_one_camera();
-      continue;
-    }
-    int best = -1;
-    if (down) {
-      const double gate = reach_m(t - last_seen_t, options.short_gap_us);
-      for (int c = 0; c < fit_count; ++c)
-        if ((fits[c].X - last_position).norm() <= gate &&
-            (best < 0 || (fits[c].X - last_position).norm() < (fits[best].X - last_position).norm()))
-          best = c;
-      // Seen again after a longer gap, but not where the pen could have got to: it was lifted and put
-      // down elsewhere, so a new stroke starts here.
-      if (best < 0 && t - last_seen_t > static_cast<double>(options.short_gap_us)) down = false;
-      if (best < 0 && down) {
-        ++out.rejected_jump;
-        continue;
-      }
-    }
-    if (!down) {
-      best = 0;
-      for (int c = 1; c < fit_count; ++c) {
-        if ((fits[c].X - fits[best].X).norm() > kJumpGate_m) best = -1;
-        if (best < 0) break;
-        if (fits[c].reprojection_error_px < fits[best].reprojection_error_px) best = c;
-      }
-      if (best < 0) {
-        ++out.ambiguous;
-        continue;
-      }
-    }
-    if (!down) {
-      down = true;
-      ++out.strokes;
-      filter = OneEuroState{};
-    }
-    const int64_t t_us = std::llround(t);
-    const Triangulation& tri = fits[best];
-    const std::optional<Vec3> smooth = one_euro_step(filter, options.filter, t_us, tri.X);
-    if (!smooth) {
-      ++out.rejected_filter;
-      continue;
-    }
-    out.samples.push_back({t_us, out.strokes - 1, static_cast<uint32_t>(k), tri.X, *smooth, tri.reprojection_error_px});
-    last_sample_t = t;
-    last_seen_t = t;
-    last_position = tri.X;
-    pen_px = {f0.blobs[k][fit_blobs[best][0]], ip.px[fit_blobs[best][1]]};
   }
   return out;
 }

@@ -9,6 +9,8 @@
 // only satisfy the epipolar constraint when camera 1's track is read at the right instant.
 // Camera 1's blob tracks are then interpolated to camera 0's instants before triangulating.
 #include <array>
+#include <map>
+#include <string>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -42,10 +44,34 @@ struct DeviceStreams {
   ReportCounts counts;
 };
 
-// Decodes every camera's `hid` events. Which device is which camera comes from the log's `meta device`
+// One camera's IR report as the systems use it.
+struct CameraReport {
+  int camera = 0;
+  int64_t t_us = 0;  // host arrival time, as logged
+  uint8_t blob_count = 0;
+  std::array<Vec2, kIrSlots> blobs;  // the seen blobs first, in slot order
+};
+
+// Reads logged events one at a time. Which device is which camera comes from the log's `meta device`
 // records (D ADDRESS ROLE PRODUCT, roles camera0, camera1, pad), in log order; a log without them (the
-// simulator's) has cameras 0 and 1 as devices 0 and 1. Garbled, truncated, unknown and out-of-range
-// input is counted in `counts` and skipped, never fatal. t_frame_us starts as the arrival time.
+// simulator's) has cameras 0 and 1 as devices 0 and 1. Garbled, truncated, unknown and out-of-range input
+// is counted in `counts` and skipped, never fatal.
+struct DeviceDecoder {
+  ReportCounts counts;
+  // The Bluetooth address of each camera's remote, from the device records; empty when the log does not
+  // say. A camera whose remote changed mid-log keeps the first.
+  std::array<std::string, 2> camera_address;
+  std::string pad_address;
+
+  // A camera's IR report, or nothing (a record, another kind of event, or input counted and skipped).
+  std::optional<CameraReport> read(const InputEvent& event);
+
+ private:
+  std::map<int, int> role_of_;  // device -> camera index or pad, once the log has device records
+  bool has_records_ = false;
+};
+
+// Decodes every camera's `hid` events (DeviceDecoder). t_frame_us starts as the arrival time.
 DeviceStreams decode_device_streams(std::span<const InputEvent> events);
 
 // Replaces arrival jitter by the remote's regular clock: frame numbers follow from the gaps
@@ -99,6 +125,44 @@ struct WandCalibration {
 // then the time offset from the calibrated rig and calibration again until it settles.
 Result<WandCalibration> calibrate_wand_streams(DeviceStreams streams, const CalibrationOptions& options);
 
+// --- what the live triangulation system (systems/triangulate) shares with calibration ---
+
+// For each frame, the blob of the next frame each of its blobs continues as (-1: none).
+using BlobLinks = std::vector<std::array<int8_t, kIrSlots>>;
+// Frame k's links to frame k + 1: a match is mutual, within the gate, and clearly nearer than any other
+// candidate. All -1 for the last frame.
+std::array<int8_t, kIrSlots> link_to_next(const CameraFrames& frames, size_t k);
+// Typical spacing of a camera's frames on its fitted clock (median).
+double frame_period_us(const CameraFrames& frames);
+// Interpolating across one lost report, not across more.
+inline constexpr double kMaxInterpolationGap = 2.5;  // frame periods
+
+// A camera's blobs at instant t, interpolated between the frames that bracket it.
+struct Interpolated {
+  int count = 0;
+  std::array<Vec2, kIrSlots> px;
+  std::array<int, kIrSlots> source;  // blob index in the earlier frame
+  size_t frame = 0;                  // the earlier frame
+  double s = 0;                      // fraction of the way to the later frame
+};
+// False when t is outside the frames, the bracketing frames are more than max_gap_us apart, or no blob
+// of the earlier frame continues into the later one. `links` holds link_to_next of every frame but the last.
+bool interpolate_blobs(const CameraFrames& frames, const BlobLinks& links, double max_gap_us, double t, Interpolated& out);
+
+// A camera 0 blob that moved between two frames: what the time offset is read from.
+struct MovingBlob {
+  double t_us = 0;   // camera 0's frame instant
+  Vec2 normalized;   // undistorted, normalized image coordinates
+};
+inline constexpr double kMovingPx = 1.5;  // a blob moving less per frame says little about timing
+
+// The offset within centre_us +- search_us that makes the moving camera 0 blobs fit the rig's epipolar
+// geometry best against camera 1's interpolated blobs (each against the nearest); the cost is a mean
+// capped epipolar distance. Needs 30 moving blobs to be observable.
+TimeOffsetEstimate search_time_offset(std::span<const MovingBlob> moving, const CameraFrames& cam1, const BlobLinks& links1,
+                                      double max_gap1_us, const Camera& c0, const Camera& c1, double centre_us,
+                                      double search_us);
+
 // --- the pen ---
 
 struct PenTrackOptions {
@@ -126,8 +190,7 @@ struct PenSample {
   double reprojection_px = 0;
 };
 
-struct PenTrack {
-  std::vector<PenSample> samples;
+struct PenCounts {
   uint32_t strokes = 0;
   size_t frames_seen_by_both = 0;    // camera 0 frames with a blob in both cameras
   size_t rejected_reprojection = 0;  // of those, no blob pair within the reprojection threshold
@@ -137,14 +200,10 @@ struct PenTrack {
   size_t bridged_frames = 0;         // pen down and seen by one camera only: followed on its ray, no sample
 };
 
-// The pen is down while both cameras see its LED; it stays down through gaps of both cameras shorter
-// than max_gap_us, and through gaps of one camera shorter than max_bridge_us while the other camera's
-// ray keeps passing near the pen (the stroke's polyline then joins the samples on either side).
-// Each camera 0 blob is paired with each interpolated camera 1 blob and triangulated; pairs
-// beyond the reprojection threshold are rejected, and of the rest the one nearest the pen's last
-// position is the pen, so a stray reflection in one camera is ignored. Samples are filtered per stroke.
-PenTrack track_pen(const DeviceStreams& streams, const Camera& c0, const Camera& c1, double cam1_offset_us,
-                   const PenTrackOptions& options);
+// What the triangulation system (systems/triangulate) produced over a whole log.
+struct PenTrack : PenCounts {
+  std::vector<PenSample> samples;
+};
 
 struct StrokeShaping {
   double simplify_tolerance = 0;  // Ramer-Douglas-Peucker, metres; 0 keeps every sample

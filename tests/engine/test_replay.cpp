@@ -51,7 +51,7 @@ TEST_CASE("the demo log replays to the same pools every time", "[replay]") {
     REQUIRE(w->mesh.validate() == "");
     CHECK(w->mesh.face_count() == 14);
     CHECK(w->rejections.size() == 1);
-    CHECK(s.timings().size() == 6);  // input, sketch, split, refine, subdivide, snap
+    CHECK(s.timings().size() == 7);  // input, triangulate, sketch, split, refine, subdivide, snap
     CHECK(w->surface.quad_count() > 0);
     CHECK(w->surface_build.problem == "");
     hash = world_hash(*w);
@@ -164,8 +164,8 @@ TEST_CASE("the demo log exercises every split case, an undo, a redo and a delete
     return end.point == 0 || end.point + 1 == count ? std::string("vertex") : std::string("edge");
   };
   std::vector<SystemSpec> systems = session_systems(*w);
-  REQUIRE(systems[1].name == "sketch");
-  systems.insert(systems.begin() + 2, SystemSpec{"probe", {"requests"}, {}, {"mesh"}, [&] {
+  REQUIRE(systems[2].name == "sketch");
+  systems.insert(systems.begin() + 3, SystemSpec{"probe", {"requests"}, {}, {"mesh"}, [&] {
                                                    for (const EditRequest& r : w->requests) {
                                                      if (r.kind == RequestKind::Undo) ++seen["undo"];
                                                      else if (r.kind == RequestKind::Redo) ++seen["redo"];

@@ -54,6 +54,23 @@ static=$(static_of "$out")
 awk -v x="$static" -v c="$clear" 'BEGIN { exit !(x <= 1.1 * c) }' ||
   fail "occluded sketch: static_rms_mm $static, more than 10 % above the unoccluded $clear"
 
+# The whole frame from device bytes: fire replay --rig runs the same triangulation system as fire track, so
+# its strokes are the same pen log's; the same replay twice gives the same hash.
+h1=$("$fire" replay occluded.log --rig rig.json --hash -o occluded.fnet)
+h2=$("$fire" replay occluded.log --rig rig.json --hash)
+[ "$h1" = "$h2" ] || fail "fire replay --rig: two replays of one log differ: $h1 vs $h2"
+tracked=$("$fire" replay pen3.log --hash)
+[ "$tracked" = "$h1" ] || fail "fire replay --rig ($h1) and fire replay of fire track's pen log ($tracked) disagree"
+expect_replay_error() { # what, pattern, arguments...
+  local what="$1" pattern="$2"; shift 2
+  if "$fire" replay "$@" >out.txt 2>err.txt; then fail "$what: succeeded"; fi
+  grep -q "$pattern" err.txt || fail "$what: message lacks '$pattern': $(cat err.txt)"
+}
+expect_replay_error "replay of device reports without a rig" "give the rig they were drawn with: --rig" occluded.log
+{ head -1 occluded.log; echo "0 meta device 0 00:1F:32:AA:BB:07 camera0 0306"; tail -n +2 occluded.log; } > other.log
+sed '0,/{/s//{"remotes": [{"address": "00:1f:32:aa:bb:01", "role": "camera0"}],/' rig.json > other_rig.json
+expect_replay_error "replay with the rig of other remotes" "was calibrated with 00:1F:32:AA:BB:01 as camera 0" other.log --rig other_rig.json
+
 # Damage some reports: an odd hex digit count, a truncated report, an unknown id, a NaN truth line.
 awk 'BEGIN{n=0} / hid /{n++; if (n==100) $4=$4"f"; if (n==200) $4=substr($4,1,10); if (n==300) $4="99" substr($4,3)}
      {print} / hid 0 /{if (!done && n>400) {print $1" truth pen 0 nan 0 0 0 1 0 0"; done=1}}' s.log > damaged.log

@@ -9,6 +9,7 @@
 #include "platform/obj.hpp"
 #include "systems/tracking/simulate.hpp"
 #include "systems/tracking/track.hpp"
+#include "systems/triangulate/triangulate.hpp"
 
 using namespace fire;
 using namespace fire::tracking;
@@ -166,7 +167,13 @@ TEST_CASE("a short sketch session tracks within a millimetre or two") {
   const TimeOffsetEstimate offset = estimate_time_offset(streams, c.cal.rig.cam0, c.cal.rig.cam1);
   REQUIRE(offset.observable);
   CHECK(std::abs(offset.offset_us - 5000.0) < 300.0);
-  const PenTrack track = track_pen(streams, c.cal.rig.cam0, c.cal.rig.cam1, offset.offset_us, PenTrackOptions{});
+  // The triangulation system, started from no offset at all, finds it from the pen's motion as it goes.
+  TrackingRig rig{c.cal.rig.cam0, c.cal.rig.cam1, 0.0, true, PenTrackOptions{}};
+  PenTrack track;
+  TriangulateState state;
+  track_log(log.events, rig, track, &state);
+  CHECK(state.offset_estimates > 0);
+  CHECK(std::abs(state.time_offset_us - 5000.0) < 300.0);
   CHECK(track.strokes == 3);
   const Result<PenAccuracy> acc = evaluate_pen_accuracy(track, streams.cameras[0], read_session_truth(log.events), 0.25);
   REQUIRE(acc.ok());
@@ -221,8 +228,9 @@ TEST_CASE("a damaged log: bad reports and NaN lines are counted, the rest still 
   CHECK(streams.counts.unknown_device == stranger);
   CHECK(streams.counts.out_of_range_slots == out_of_range);
   CHECK(streams.counts.rejected_reports() == garbled + truncated + foreign + stranger);
-  for (CameraFrames& f : streams.cameras) fit_frame_clock(f);
-  const PenTrack track = track_pen(streams, c.cal.rig.cam0, c.cal.rig.cam1, c.cal.time_offset_used_us, PenTrackOptions{});
+  TrackingRig rig{c.cal.rig.cam0, c.cal.rig.cam1, c.cal.time_offset_used_us, true, PenTrackOptions{}};
+  PenTrack track;
+  track_log(log->events, rig, track);
   CHECK(track.strokes == 3);
   for (const InputEvent& e : pen_events(track))
     if (e.kind == EventKind::Pen) REQUIRE(e.p.allFinite());

@@ -17,7 +17,7 @@ namespace fire::cli {
 namespace {
 
 struct ReplayOptions {
-  std::string log_path, out_path, obj_path, surface_path, session_dir;
+  std::string log_path, out_path, obj_path, surface_path, session_dir, rig_path;
   uint64_t snapshot_every = 0;
   bool hash = false, timings = false, no_surface = false;
   bool settings_given = false;  // --snap, --levels, --fairness or --no-surface on the command line
@@ -50,6 +50,11 @@ int run_replay(const ReplayOptions& o) {
   }
   if (session_in && !o.session_dir.empty()) {
     std::cerr << "fire replay: --session writes a new session from a log; " << o.log_path << " is a session already\n";
+    return 1;
+  }
+  if (!o.rig_path.empty() && (session_in || !o.session_dir.empty())) {
+    std::cerr << "fire replay: --rig with a session folder is not supported yet: a snapshot does not hold the "
+                 "triangulation system's state, so a reopened session could not continue bit for bit\n";
     return 1;
   }
   if (o.snapshot_every > 0 && o.session_dir.empty()) {
@@ -90,6 +95,18 @@ int run_replay(const ReplayOptions& o) {
       return 1;
     }
     world = std::make_unique<World>();
+    if (!o.rig_path.empty()) {
+      Result<TrackingRig> rig = load_tracking_rig(o.rig_path, *log, o.log_path);
+      if (!rig) {
+        std::cerr << "fire replay: " << rig.error() << "\n";
+        return 1;
+      }
+      world->rig = *rig;
+    } else if (has_device_reports(*log)) {
+      std::cerr << "fire replay: " << o.log_path << " holds Wii Remote reports; give the rig they were drawn with: "
+                << "--rig RIG.json (from fire calibrate)\n";
+      return 1;
+    }
     world->log = std::move(*log);
     world->sketch_settings.snap_distance = o.snap;
     world->build_surface = !o.no_surface;
@@ -181,6 +198,9 @@ void add_network_commands(CLI::App& app, Registry& registry) {
   replay->add_option("--snapshot-every", o->snapshot_every,
                      "with --session: write a snapshot every N frames and one at the end (0: none)")
       ->capture_default_str();
+  replay->add_option("--rig", o->rig_path,
+                     "rig file from fire calibrate: the log's Wii Remote reports go through the triangulation system "
+                     "(pen samples in the rig's frame, camera 0's, metres); needed when the log holds reports");
   replay->add_option("-o,--output", o->out_path, "write the final curve network here (format: engine/NETWORK_FORMAT.md)");
   replay->add_option("--export-obj", o->obj_path, "also write the network's polylines as OBJ lines");
   replay->add_option("--surface", o->surface_path,

@@ -1,5 +1,6 @@
 // fire simulate wand|sketch, fire calibrate, fire track: the stereo rig from device reports to pen
 // strokes, and the simulated rig that proves its accuracy (systems/tracking).
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -15,6 +16,7 @@
 #include "systems/tracking/rig_io.hpp"
 #include "systems/tracking/simulate.hpp"
 #include "systems/tracking/track.hpp"
+#include "systems/triangulate/triangulate.hpp"
 #include "tools/fire/commands.hpp"
 
 #ifndef FIRE_DEFAULT_MESH
@@ -156,6 +158,31 @@ std::string other_remotes(const DeviceStreams& streams, const std::vector<wiimot
   return "";
 }
 
+}  // namespace
+
+Result<TrackingRig> load_tracking_rig(const std::string& rig_path, const InputLog& log, const std::string& log_path) {
+  using R = Result<TrackingRig>;
+  Result<std::string> rig_text = read_text_file(rig_path);
+  if (!rig_text) return R::failure(rig_text.error());
+  Result<CalibrationResult> rig = rig_from_json(*rig_text, rig_path);
+  if (!rig) return R::failure(rig.error());
+  const auto rig_remotes = wiimote::remotes_from_rig_json(*rig_text, rig_path);
+  if (!rig_remotes) return R::failure(rig_remotes.error());
+  const DeviceStreams streams = decode_device_streams(log.events);
+  if (const std::string why = other_remotes(streams, *rig_remotes, log_path, rig_path); !why.empty()) return R::failure(why);
+  TrackingRig out;
+  out.cam0 = rig->cam0;
+  out.cam1 = rig->cam1;
+  out.time_offset_us = rig->time_offset_us;
+  return out;
+}
+
+bool has_device_reports(const InputLog& log) {
+  return std::any_of(log.events.begin(), log.events.end(), [](const InputEvent& e) { return e.kind == EventKind::Hid; });
+}
+
+namespace {
+
 struct CalibrateArgs {
   std::string log_path, out_path;
   std::optional<double> wand_length_m;
@@ -260,31 +287,21 @@ int run_track(const TrackArgs& a) {
   args.options.max_gap_us = std::llround(args.max_gap_ms * 1e3);
   args.options.max_bridge_us = std::llround(args.max_bridge_ms * 1e3);
 
-  Result<std::string> rig_text = read_text_file(args.rig_path);
-  if (!rig_text) return fail(command, rig_text.error());
-  Result<CalibrationResult> rig = rig_from_json(*rig_text, args.rig_path);
-  if (!rig) return fail(command, rig.error());
   Result<InputLog> log = read_input_log(args.log_path);
   if (!log) return fail(command, log.error());
   const SessionTruth truth = read_session_truth(log->events);
   if (args.truth && !truth.has_cameras)
     return fail(command, args.log_path + ": --truth needs the simulator's truth lines (truth camera 0 and 1), and the log has none");
-
-  const auto rig_remotes = wiimote::remotes_from_rig_json(*rig_text, args.rig_path);
-  if (!rig_remotes) return fail(command, rig_remotes.error());
-
-  DeviceStreams streams = decode_device_streams(log->events);
-  if (const std::string why = other_remotes(streams, *rig_remotes, args.log_path, args.rig_path); !why.empty())
-    return fail(command, why);
-  for (CameraFrames& f : streams.cameras) fit_frame_clock(f);
-  TimeOffsetEstimate offset;
-  if (args.time_offset_ms) {
-    offset.offset_us = *args.time_offset_ms * 1e3;
-  } else {
-    offset = estimate_time_offset(streams, rig->cam0, rig->cam1);
-    if (!offset.observable) offset.offset_us = 0;  // a pen that never moved: no offset to see, none that matters
-  }
-  const PenTrack track = track_pen(streams, rig->cam0, rig->cam1, offset.offset_us, args.options);
+  Result<TrackingRig> loaded = load_tracking_rig(args.rig_path, *log, args.log_path);
+  if (!loaded) return fail(command, loaded.error());
+  const DeviceStreams streams = decode_device_streams(log->events);
+  TrackingRig live = *loaded;
+  if (args.time_offset_ms) live.time_offset_us = *args.time_offset_ms * 1e3;
+  live.estimate_time_offset = !args.time_offset_ms;
+  live.options = args.options;
+  PenTrack track;
+  TriangulateState state;
+  track_log(log->events, live, track, &state);
   std::vector<InputEvent> events =
       pen_events(track, StrokeShaping{.simplify_tolerance = args.simplify_mm * 1e-3, .resample_spacing = args.resample_mm * 1e-3});
   InputEvent source;
@@ -300,10 +317,12 @@ int run_track(const TrackArgs& a) {
   out["method"] = args.method;
   out["samples"] = track.samples.size();
   out["strokes"] = track.strokes;
-  out["time_offset_ms"] = offset.offset_us * 1e-3;
+  out["time_offset_ms"] = state.time_offset_us * 1e-3;
   out["time_offset_estimated"] = !args.time_offset_ms.has_value();
-  out["time_offset_observable"] = offset.observable;
-  out["time_offset_samples"] = offset.samples;
+  out["time_offset_estimates"] = state.offset_estimates;
+  out["time_offset_observable"] = state.last_estimate.observable;
+  out["time_offset_samples"] = state.last_estimate.samples;
+  out["out_of_order_reports"] = state.out_of_order;
   double reprojection = 0;
   for (const PenSample& p : track.samples) reprojection += p.reprojection_px;
   out["mean_reprojection_px"] = number_or_null(reprojection / static_cast<double>(track.samples.size()), !track.samples.empty());
@@ -399,7 +418,7 @@ void add_tracking_commands(CLI::App& app, Registry& registry) {
   t->add_option("--method", tr->method, "triangulation: thesis, dlt or optimal")->capture_default_str();
   t->add_option("--max-reprojection-px", tr->options.max_reprojection_px, "reject a pen sample beyond this reprojection error")
       ->capture_default_str();
-  t->add_option("--time-offset-ms", tr->time_offset_ms, "camera 1's latency minus camera 0's (default: estimated from the log)");
+  t->add_option("--time-offset-ms", tr->time_offset_ms, "camera 1's latency minus camera 0's, held fixed (default: the rig's, then estimated from the pen's motion every 2 s)");
   t->add_option("--min-cutoff", tr->options.filter.min_cutoff_hz, "One Euro filter: cutoff at rest, Hz")->capture_default_str();
   t->add_option("--beta", tr->options.filter.beta, "One Euro filter: cutoff increase per m/s")->capture_default_str();
   t->add_option("--dcutoff", tr->options.filter.derivative_cutoff_hz, "One Euro filter: cutoff of the speed estimate, Hz")
@@ -414,7 +433,9 @@ void add_tracking_commands(CLI::App& app, Registry& registry) {
       ->capture_default_str();
   t->add_option("--settle-s", tr->settle_s, "--truth: a resting pen counts as static after this many seconds")->capture_default_str();
   t->footer(
-      "Prints one JSON line: samples, strokes, time_offset_ms, rejected counts; with --truth static_rms_mm and "
+      "The reports go through the triangulation system frame by frame (systems/triangulate), as in a live session "
+      "and in fire replay --rig: no report is used before it arrived. "
+      "Prints one JSON line: samples, strokes, time_offset_ms (the last in use), rejected counts; with --truth static_rms_mm and "
       "dynamic_rms_mm (filtered samples against the truth moved into camera 0's frame by camera 0's true pose), "
       "the same before the filter (raw_*), while the pen settles (settling_*), and registered_* after registering "
       "the hold points to the truth (register_rigid), as a user registers the object.");

@@ -15,6 +15,9 @@ std::vector<SystemSpec> session_systems(World& w) {
   systems.push_back({"input", {"log", "frame"}, {"frame_events"}, {}, [&w] {
                        input_system(w.log, w.frame, w.cursor, w.frame_events);
                      }});
+  systems.push_back({"triangulate", {"frame_events", "rig"}, {"frame_events"}, {}, [&w] {
+                       if (w.rig) triangulate_system(w.frame, *w.rig, w.triangulate, w.frame_events);
+                     }});
   systems.push_back({"sketch", {"frame_events", "sketch_settings"}, {"requests", "rejections"}, {"mesh", "snap"}, [&w] {
                        sketch_system(w.frame_events, w.mesh, w.snap, w.sketch_settings, w.sketch, w.requests,
                                      w.rejections);
@@ -55,9 +58,10 @@ void replay_headless(World& w, Scheduler& scheduler, const ReplayHooks& hooks) {
 }
 
 void continue_replay(World& w, Scheduler& scheduler, const ReplayHooks& hooks) {
-  while (w.cursor.next < w.log.events.size() || !w.sketch.pending.empty()) {
+  auto waiting = [&] { return !w.sketch.pending.empty() || (w.rig && w.triangulate.busy()); };
+  while (w.cursor.next < w.log.events.size() || waiting()) {
     // Skip stretches with nothing to do: the frames still count, so frame numbers match a live session.
-    if (w.sketch.pending.empty() && w.log.events[w.cursor.next].t_us >= w.frame.end_us) {
+    if (!waiting() && w.log.events[w.cursor.next].t_us >= w.frame.end_us) {
       const int64_t steps = (w.log.events[w.cursor.next].t_us - w.frame.begin_us) / kFrameStepUs;
       begin_frame(w, w.frame.index + uint64_t(steps), w.frame.begin_us + steps * kFrameStepUs);
     }

@@ -2,12 +2,13 @@
 // A drawing session: the world's data and the per-frame system order of the design card, used by
 // `fire replay` headless (and by the live app).
 //
-//   input -> sketch -> split -> refine -> subdivide -> snap (the sync point: the snapping index)
+//   input -> triangulate -> sketch -> split -> refine -> subdivide -> snap (the sync point: the snapping index)
 //
 // Each system is declared with the world data it reads and writes (names below), so the scheduler can
 // refuse an order in which a system reads what a later one writes in the same frame.
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #include "systems/reconstruct/reconstruct.hpp"
 #include "systems/sketch/sketch.hpp"
 #include "systems/split/edit.hpp"
+#include "systems/triangulate/triangulate.hpp"
 
 namespace fire {
 
@@ -29,6 +31,9 @@ struct World {
   InputCursor cursor;
   FrameTime frame;
   std::vector<InputEvent> frame_events;
+  // triangulate: only with a rig (logs of device reports); it appends the pen's events to frame_events
+  std::optional<TrackingRig> rig;
+  TriangulateState triangulate;
   // sketch
   SketchState sketch;
   SketchSettings sketch_settings;

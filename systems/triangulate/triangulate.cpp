@@ -1,0 +1,441 @@
+#include "systems/triangulate/triangulate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace fire {
+namespace {
+
+using tracking::CameraFrames;
+using tracking::CameraReport;
+using tracking::Interpolated;
+using tracking::PenSample;
+
+constexpr double kNominalPeriodUs = 10'000;  // the remotes report at 100 Hz; the gaps say it better once seen
+constexpr size_t kPeriodGaps = 63;           // arrival gaps the period is the median of
+constexpr size_t kMinPeriodGaps = 8;
+constexpr size_t kClockWindow = 400;         // reports the frame clock's line is fitted through (4 s)
+constexpr double kPendingTimeout = 1.5;      // periods after which no later report can renumber the newest
+// Camera 1 has not reported an instant this long after it (a lost report, latency and the wait for the
+// next report included): triangulate without it.
+constexpr double kCameraHorizonUs = 60'000;
+constexpr int64_t kKeepUs = 30'000'000;      // trailing reports kept per camera (the offset's window)
+constexpr size_t kTrimChunk = 512;           // reports dropped from a window at once
+constexpr uint64_t kOffsetEvery = 200;       // camera 0 reports between two estimates of the time offset
+constexpr size_t kMaxMoving = 600;           // moving blobs the estimate uses (the newest)
+constexpr double kFirstSearchUs = 50'000;    // the first estimate looks this far either side of zero...
+constexpr double kNextSearchUs = 10'000;     // ... later ones this far either side of the value in use
+
+constexpr double kJumpGate_m = 0.02;      // pen positions this far apart are different things
+constexpr double kMaxPenSpeed_m_s = 5.0;  // a hand moves the pen no faster
+constexpr double kBridgeSpeed_m_s = 1.0;  // a drawing hand, while both cameras lose the pen, moves it no faster
+constexpr double kFollowStep_px = 40;     // the pen's blob moves less than this between two frames of a camera
+
+double period_of(const CameraWindow& w) {
+  if (w.gaps_us.size() < kMinPeriodGaps) return kNominalPeriodUs;
+  std::vector<double> g(w.gaps_us.begin(), w.gaps_us.end());
+  const auto mid = g.begin() + static_cast<std::ptrdiff_t>(g.size() / 2);
+  std::nth_element(g.begin(), mid, g.end());
+  return *mid;
+}
+
+void erase_front(CameraWindow& w, size_t n) {
+  CameraFrames& f = w.frames;
+  const auto d = static_cast<std::ptrdiff_t>(n);
+  f.t_us.erase(f.t_us.begin(), f.t_us.begin() + d);
+  f.t_frame_us.erase(f.t_frame_us.begin(), f.t_frame_us.begin() + d);
+  f.blob_count.erase(f.blob_count.begin(), f.blob_count.begin() + d);
+  f.blobs.erase(f.blobs.begin(), f.blobs.begin() + d);
+  w.links.erase(w.links.begin(), w.links.begin() + d);
+  w.first_index += n;
+}
+
+// Least-squares line t = a + b (n - mean_n) through the trailing (number, arrival) pairs.
+struct ClockLine {
+  double mean_n = 0, mean_t = 0, slope = 0;
+  double at(double n) const { return mean_t + slope * (n - mean_n); }
+  double number_at(double t) const { return mean_n + (t - mean_t) / slope; }
+};
+
+ClockLine fit_line(const CameraWindow& w) {
+  ClockLine line;
+  for (const auto& [n, t] : w.fitted) {
+    line.mean_n += n;
+    line.mean_t += t;
+  }
+  const double count = static_cast<double>(w.fitted.size());
+  line.mean_n /= count;
+  line.mean_t /= count;
+  double snn = 0, snt = 0;
+  for (const auto& [n, t] : w.fitted) {
+    snn += (n - line.mean_n) * (n - line.mean_n);
+    snt += (n - line.mean_n) * (t - line.mean_t);
+  }
+  line.slope = snn > 0 ? snt / snn : period_of(w);
+  return line;
+}
+
+constexpr size_t kLineNumbering = 50;  // fitted reports after which the line, not the loop, numbers reports
+
+// The pending report's instant is fixed: on the line through the trailing (number, arrival) pairs.
+// Until that line is established, the phase-locked loop's number stands. After, the line numbers the
+// report itself, as the whole-log fit does with its second pass: of the two whole numbers around where
+// the line puts its arrival, the one that with the next report's (if one has arrived) leaves the smaller
+// squared misfit, the numbers increasing. A late report then gives its slot back to an on-time successor,
+// and the loop's occasional miscount never lasts.
+void fix_pending(CameraWindow& w, int camera, TriangulateState& state, const TrackingRig& rig,
+                 std::optional<int64_t> next_arrival_us) {
+  const CameraReport& r = *w.pending;
+  const double arrival = static_cast<double>(r.t_us - w.origin_us);
+  const double previous = w.fitted.empty() ? -std::numeric_limits<double>::infinity() : w.fitted.back()[0];
+  if (w.fitted.size() >= kLineNumbering) {
+    const ClockLine line = fit_line(w);
+    const double x = line.number_at(arrival);
+    double best = std::max(previous + 1, std::round(x)), best_cost = std::numeric_limits<double>::infinity();
+    for (const double n : {std::floor(x), std::floor(x) + 1}) {
+      if (!(n > previous)) continue;
+      double cost = (x - n) * (x - n);
+      if (next_arrival_us) {
+        const double x_next = line.number_at(static_cast<double>(*next_arrival_us - w.origin_us));
+        const double n_next = std::max(n + 1, std::round(x_next));
+        cost += (x_next - n_next) * (x_next - n_next);
+      }
+      if (cost < best_cost) {
+        best_cost = cost;
+        best = n;
+      }
+    }
+    w.pending_number = best;
+  } else {
+    w.pending_number = std::max(w.pending_number, previous + 1);
+  }
+  w.fitted.push_back({w.pending_number, arrival});
+  if (w.fitted.size() > kClockWindow) w.fitted.pop_front();
+  const ClockLine line = fit_line(w);
+  double t_frame = static_cast<double>(w.origin_us) + line.at(w.pending_number);
+  CameraFrames& f = w.frames;
+  if (f.size() > 0) t_frame = std::max(t_frame, f.t_frame_us.back() + 1.0);
+  f.t_us.push_back(r.t_us);
+  f.t_frame_us.push_back(t_frame);
+  f.blob_count.push_back(r.blob_count);
+  f.blobs.push_back(r.blobs);
+  w.links.emplace_back();
+  w.links.back().fill(-1);
+  w.pending.reset();
+  if (f.size() < 2) return;
+  const size_t k = f.size() - 2;
+  w.links[k] = tracking::link_to_next(f, k);
+  if (camera != 0) return;
+  // Camera 0's moving blobs carry the time offset; resting ones fit every offset alike.
+  ++state.cam0_fixed;
+  if (f.t_frame_us[k + 1] - f.t_frame_us[k] > tracking::kMaxInterpolationGap * period_of(w)) return;
+  for (int i = 0; i < f.blob_count[k]; ++i) {
+    const int8_t next = w.links[k][i];
+    if (next < 0 || (f.blobs[k + 1][next] - f.blobs[k][i]).norm() < tracking::kMovingPx) continue;
+    state.moving.push_back({f.t_frame_us[k], rig.cam0.undistort_normalized(f.blobs[k][i])});
+    if (state.moving.size() > kMaxMoving) state.moving.pop_front();
+  }
+  // Older than camera 1's window: nothing left to compare them with.
+  while (!state.moving.empty() && f.t_frame_us[k] - state.moving.front().t_us > static_cast<double>(kKeepUs))
+    state.moving.pop_front();
+}
+
+// The camera frame whose instant is the last at or before t (none before the first).
+std::optional<size_t> frame_at_or_before(const CameraFrames& f, double t) {
+  const auto it = std::upper_bound(f.t_frame_us.begin(), f.t_frame_us.end(), t);
+  if (it == f.t_frame_us.begin()) return std::nullopt;
+  return static_cast<size_t>(it - f.t_frame_us.begin()) - 1;
+}
+
+struct Followed {
+  Vec3 position;
+  Vec2 px;
+};
+
+// While only one camera sees the pen, the pen lies on that camera's ray through its blob: the point of
+// the ray nearest the pen's last position, if within `gate` of it, from the blob nearest the pen's last
+// pixel in that camera. A stray reflection elsewhere in the image is never taken for the pen.
+std::optional<Followed> follow_on_ray(const tracking::Camera& cam, std::span<const Vec2> blobs, const Vec2& last_px,
+                                      const Vec3& last, double gate) {
+  std::optional<Followed> best;
+  double best_step = kFollowStep_px;
+  for (const Vec2& px : blobs) {
+    const double step = (px - last_px).norm();
+    if (step > best_step) continue;
+    const Vec3 c = cam.centre(), d = cam.ray(px);
+    const Vec3 x = c + d * std::max(0.0, d.dot(last - c));
+    if ((x - last).norm() > gate) continue;
+    best_step = step;
+    best = Followed{x, px};
+  }
+  return best;
+}
+
+// How far the pen may be from where it was last seen after `dt_us`: a hand's fastest flick over a short
+// gap; over a longer one the pen was hidden while a drawing hand went on, which is slower.
+double reach_m(double dt_us, int64_t short_gap_us) {
+  const double speed = dt_us <= static_cast<double>(short_gap_us) ? kMaxPenSpeed_m_s : kBridgeSpeed_m_s;
+  return kJumpGate_m + speed * dt_us * 1e-6;
+}
+
+InputEvent pen_event(int64_t t_us, EventKind kind, const Vec3& p = Vec3::Zero()) {
+  InputEvent e;
+  e.t_us = t_us;
+  e.kind = kind;
+  e.p = p;
+  return e;
+}
+
+void end_stroke(TriangulateState& s, std::vector<InputEvent>& out) {
+  if (s.stroke_open) out.push_back(pen_event(s.last_sample_t_us, EventKind::Up));
+  s.down = false;
+  s.stroke_open = false;
+}
+
+// One camera 0 report (index k in its window): the pen's state machine of PenTrackOptions.
+void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vector<InputEvent>& out,
+                 std::vector<PenSample>* samples) {
+  const tracking::PenTrackOptions& options = rig.options;
+  const CameraFrames& f0 = s.cameras[0].frames;
+  const CameraWindow& w1 = s.cameras[1];
+  const CameraFrames& f1 = w1.frames;
+  const double t = f0.t_frame_us[k];
+  const double t1 = t + s.time_offset_us;
+  // A stroke ends when no camera has seen the pen for max_gap_us, or when only one has for longer than
+  // a hand takes to pass in front of the other (max_bridge_us).
+  if (s.down && (t - s.last_seen_t > static_cast<double>(options.max_gap_us) ||
+                 t - s.last_sample_t > static_cast<double>(options.max_bridge_us)))
+    end_stroke(s, out);
+  // Keeps the pen followed through a frame without a stereo sample, from whichever camera still sees it.
+  auto follow_one_camera = [&] {
+    if (!s.down) return;
+    const double gate = reach_m(t - s.last_seen_t, options.short_gap_us);
+    std::optional<Followed> x = follow_on_ray(rig.cam0, std::span<const Vec2>(f0.blobs[k].data(), f0.blob_count[k]),
+                                              s.pen_px[0], s.last_position, gate);
+    int camera = 0;
+    if (!x) {
+      if (const auto j = frame_at_or_before(f1, t1)) {
+        x = follow_on_ray(rig.cam1, std::span<const Vec2>(f1.blobs[*j].data(), f1.blob_count[*j]), s.pen_px[1],
+                          s.last_position, gate);
+        camera = 1;
+      }
+    }
+    if (!x) return;
+    s.last_seen_t = t;
+    s.last_position = x->position;
+    s.pen_px[size_t(camera)] = x->px;
+    ++s.counts.bridged_frames;
+  };
+  Interpolated ip;
+  if (f0.blob_count[k] == 0 ||
+      !tracking::interpolate_blobs(f1, w1.links, tracking::kMaxInterpolationGap * period_of(w1), t1, ip)) {
+    follow_one_camera();
+    return;
+  }
+  ++s.counts.frames_seen_by_both;
+  // Epipolar lines run along the baseline, so a stray blob level with the LED in the other camera also
+  // fits the geometry. While the pen is down the candidate nearest its last position wins; a stroke only
+  // starts from a frame where every fitting pair agrees.
+  std::array<tracking::Triangulation, tracking::kIrSlots * tracking::kIrSlots> fits;
+  std::array<std::array<int, 2>, tracking::kIrSlots * tracking::kIrSlots> fit_blobs;
+  int fit_count = 0;
+  for (int i = 0; i < f0.blob_count[k]; ++i)
+    for (int j = 0; j < ip.count; ++j) {
+      const tracking::Triangulation tri =
+          tracking::triangulate(rig.cam0, rig.cam1, f0.blobs[k][i], ip.px[j], options.method, options.max_reprojection_px);
+      if (!tri.accepted) continue;
+      fit_blobs[fit_count] = {i, j};
+      fits[fit_count++] = tri;
+    }
+  if (fit_count == 0) {
+    ++s.counts.rejected_reprojection;
+    follow_one_camera();
+    return;
+  }
+  int best = -1;
+  if (s.down) {
+    const double gate = reach_m(t - s.last_seen_t, options.short_gap_us);
+    for (int c = 0; c < fit_count; ++c)
+      if ((fits[c].X - s.last_position).norm() <= gate &&
+          (best < 0 || (fits[c].X - s.last_position).norm() < (fits[best].X - s.last_position).norm()))
+        best = c;
+    // Seen again after a longer gap, but not where the pen could have got to: it was lifted and put down
+    // elsewhere, so a new stroke starts here.
+    if (best < 0 && t - s.last_seen_t > static_cast<double>(options.short_gap_us)) end_stroke(s, out);
+    if (best < 0 && s.down) {
+      ++s.counts.rejected_jump;
+      return;
+    }
+  }
+  if (!s.down) {
+    best = 0;
+    for (int c = 1; c < fit_count; ++c) {
+      if ((fits[c].X - fits[best].X).norm() > kJumpGate_m) best = -1;
+      if (best < 0) break;
+      if (fits[c].reprojection_error_px < fits[best].reprojection_error_px) best = c;
+    }
+    if (best < 0) {
+      ++s.counts.ambiguous;
+      return;
+    }
+    s.down = true;
+    ++s.counts.strokes;
+    s.filter = tracking::OneEuroState{};
+  }
+  const int64_t t_us = std::llround(t);
+  const tracking::Triangulation& tri = fits[best];
+  const std::optional<Vec3> smooth = tracking::one_euro_step(s.filter, options.filter, t_us, tri.X);
+  if (!smooth) {
+    ++s.counts.rejected_filter;
+    return;
+  }
+  if (!s.stroke_open) {
+    out.push_back(pen_event(t_us, EventKind::Down));
+    s.stroke_open = true;
+  }
+  out.push_back(pen_event(t_us, EventKind::Pen, *smooth));
+  if (samples)
+    samples->push_back({t_us, s.counts.strokes - 1, static_cast<uint32_t>(s.cameras[0].first_index + k), tri.X, *smooth,
+                        tri.reprojection_error_px});
+  s.last_sample_t = t;
+  s.last_sample_t_us = t_us;
+  s.last_seen_t = t;
+  s.last_position = tri.X;
+  s.pen_px = {f0.blobs[k][fit_blobs[best][0]], ip.px[fit_blobs[best][1]]};
+}
+
+void trim(CameraWindow& w, uint64_t keep_from_index) {
+  const CameraFrames& f = w.frames;
+  if (f.size() == 0) return;
+  size_t drop = 0;
+  const double newest = f.t_frame_us.back();
+  while (drop < f.size() && w.first_index + drop < keep_from_index &&
+         newest - f.t_frame_us[drop] > static_cast<double>(kKeepUs))
+    ++drop;
+  if (drop >= kTrimChunk) erase_front(w, drop);
+}
+
+}  // namespace
+
+bool TriangulateState::busy() const {
+  return cameras[0].pending || cameras[1].pending || next_cam0 < cameras[0].end_index() || down;
+}
+
+void triangulate_report(const TrackingRig& rig, TriangulateState& s, const CameraReport& r) {
+  CameraWindow& w = s.cameras[size_t(r.camera)];
+  if (w.reports > 0 && r.t_us < w.last_arrival_us) {
+    ++s.out_of_order;
+    return;
+  }
+  const double t = static_cast<double>(r.t_us);
+  if (w.reports++ == 0) {
+    w.origin_us = r.t_us;
+    w.predicted_us = t;
+    w.last_arrival_us = r.t_us;
+    w.pending = r;
+    w.pending_number = 0;
+    return;
+  }
+  if (r.t_us > w.last_arrival_us) {
+    w.gaps_us.push_back(t - static_cast<double>(w.last_arrival_us));
+    if (w.gaps_us.size() > kPeriodGaps) w.gaps_us.pop_front();
+  }
+  w.last_arrival_us = r.t_us;
+  // Frame numbers: a phase-locked loop on the regular clock tolerates jitter up to half a period in any
+  // one report. A report later than that looks like one after a lost report; when the next one then
+  // falls in the same slot, the earlier one was late, and it gets its slot back (while still pending).
+  const double period = period_of(w);
+  double gap = std::round((t - w.predicted_us) / period);
+  if (gap <= 0 && w.last_gap >= 2 && w.pending) {
+    w.pending_number -= 1;
+    w.predicted_us -= period;
+    gap = std::round((t - w.predicted_us) / period);
+  }
+  gap = std::max(1.0, gap);
+  const double number = (w.pending ? w.pending_number : w.last_number) + gap;
+  w.predicted_us += gap * period;
+  w.predicted_us += 0.1 * (t - w.predicted_us);
+  w.last_gap = gap;
+  if (w.pending) fix_pending(w, r.camera, s, rig, r.t_us);
+  w.pending = r;
+  w.pending_number = number;
+  w.last_number = number;
+}
+
+void triangulate_advance(int64_t now_us, const TrackingRig& rig, TriangulateState& s, std::vector<InputEvent>& out,
+                         std::vector<PenSample>* samples) {
+  const double now = static_cast<double>(now_us);
+  for (int c = 0; c < 2; ++c) {
+    CameraWindow& w = s.cameras[size_t(c)];
+    if (w.pending && now - static_cast<double>(w.pending->t_us) > kPendingTimeout * period_of(w)) fix_pending(w, c, s, rig, std::nullopt);
+  }
+  if (!s.time_offset_started) {
+    s.time_offset_us = rig.time_offset_us;
+    s.time_offset_started = true;
+  }
+  if (rig.estimate_time_offset && s.cam0_fixed >= kOffsetEvery * (s.offset_attempts + 1)) {
+    const CameraWindow& w1 = s.cameras[1];
+    const std::vector<tracking::MovingBlob> moving(s.moving.begin(), s.moving.end());
+    const bool first = s.offset_estimates == 0;  // none observable yet: search the whole range
+    ++s.offset_attempts;
+    s.last_estimate = tracking::search_time_offset(moving, w1.frames, w1.links, tracking::kMaxInterpolationGap * period_of(w1),
+                                                   rig.cam0, rig.cam1, first ? 0.0 : s.time_offset_us,
+                                                   first ? kFirstSearchUs : kNextSearchUs);
+    if (s.last_estimate.observable) {
+      s.time_offset_us = s.last_estimate.offset_us;
+      ++s.offset_estimates;
+    }
+  }
+  CameraWindow& w0 = s.cameras[0];
+  const CameraWindow& w1 = s.cameras[1];
+  while (s.next_cam0 < w0.end_index()) {
+    const size_t k = static_cast<size_t>(s.next_cam0 - w0.first_index);
+    const double t1 = w0.frames.t_frame_us[k] + s.time_offset_us;
+    const bool camera1_past = w1.frames.size() > 0 && w1.frames.t_frame_us.back() > t1;
+    if (!camera1_past && now - t1 <= kCameraHorizonUs) break;
+    track_frame(k, rig, s, out, samples);
+    ++s.next_cam0;
+  }
+  // Camera 0 has gone silent with the pen down: the stroke ends by the same rules, a little later.
+  const tracking::PenTrackOptions& o = rig.options;
+  if (s.down && s.next_cam0 == w0.end_index() && !w0.pending &&
+      (now - s.last_seen_t > static_cast<double>(o.max_gap_us) + 2 * kCameraHorizonUs ||
+       now - s.last_sample_t > static_cast<double>(o.max_bridge_us) + 2 * kCameraHorizonUs))
+    end_stroke(s, out);
+  trim(w0, s.next_cam0 > 0 ? s.next_cam0 - 1 : 0);
+  // Camera 1's window reaches back as far as camera 0's moving blobs and the next report to triangulate.
+  trim(s.cameras[1], std::numeric_limits<uint64_t>::max());
+}
+
+void triangulate_system(const FrameTime& frame, const TrackingRig& rig, TriangulateState& state,
+                        std::vector<InputEvent>& frame_events, std::vector<PenSample>* samples) {
+  const size_t logged = frame_events.size();
+  for (size_t i = 0; i < logged; ++i)
+    if (const std::optional<CameraReport> r = state.decoder.read(frame_events[i])) triangulate_report(rig, state, *r);
+  triangulate_advance(frame.end_us, rig, state, frame_events, samples);
+}
+
+std::vector<InputEvent> track_log(std::span<const InputEvent> events, const TrackingRig& rig, tracking::PenTrack& track,
+                                  TriangulateState* final_state) {
+  constexpr int64_t kStepUs = 10'000;
+  TriangulateState state;
+  std::vector<InputEvent> out, frame_events;
+  track.samples.clear();
+  if (events.empty()) return out;
+  FrameTime frame{0, events.front().t_us, events.front().t_us + kStepUs};
+  size_t next = 0;
+  while (next < events.size() || state.busy()) {
+    frame_events.clear();
+    while (next < events.size() && events[next].t_us < frame.end_us) frame_events.push_back(events[next++]);
+    const size_t logged = frame_events.size();
+    triangulate_system(frame, rig, state, frame_events, &track.samples);
+    out.insert(out.end(), frame_events.begin() + static_cast<std::ptrdiff_t>(logged), frame_events.end());
+    frame = {frame.index + 1, frame.end_us, frame.end_us + kStepUs};
+  }
+  static_cast<tracking::PenCounts&>(track) = state.counts;
+  if (final_state) *final_state = std::move(state);
+  return out;
+}
+
+}  // namespace fire

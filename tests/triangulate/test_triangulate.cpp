@@ -1,0 +1,208 @@
+// The triangulation system: pen samples from exactly observed reports, fed frame by frame as they would
+// arrive; strokes through occlusions; the pen's events as the system emits them.
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "systems/triangulate/triangulate.hpp"
+#include "tests/triangulate/exact_pen.hpp"
+
+using namespace fire;
+using namespace fire::tracking;
+using namespace fire::tracking::test;
+
+namespace {
+
+// The system over two cameras' reports, fed per 10 ms frame in arrival order, until it is no longer busy.
+// The reports' instants are exact, so the frame clock the system fits has nothing to correct.
+struct SystemRun {
+  PenTrack track;
+  std::vector<InputEvent> events;
+  TriangulateState state;
+};
+
+SystemRun run_system_full(const DeviceStreams& s, const Rig& rig, double offset_us, bool estimate = false) {
+  const TrackingRig live{rig.c0, rig.c1, offset_us, estimate, PenTrackOptions{}};
+  SystemRun run;
+  std::array<size_t, 2> next{0, 0};
+  int64_t end = 10'000;
+  auto pending = [&] { return next[0] < s.cameras[0].size() || next[1] < s.cameras[1].size(); };
+  while (pending() || run.state.busy()) {
+    for (int c = 0; c < 2; ++c) {
+      const CameraFrames& f = s.cameras[c];
+      for (; next[c] < f.size() && f.t_us[next[c]] < end; ++next[c]) {
+        CameraReport r;
+        r.camera = c;
+        r.t_us = f.t_us[next[c]];
+        r.blob_count = f.blob_count[next[c]];
+        r.blobs = f.blobs[next[c]];
+        triangulate_report(live, run.state, r);
+      }
+    }
+    triangulate_advance(end, live, run.state, run.events, &run.track.samples);
+    end += 10'000;
+    REQUIRE(end < 1'000'000'000);
+  }
+  static_cast<PenCounts&>(run.track) = run.state.counts;
+  return run;
+}
+
+PenTrack run_system(const DeviceStreams& s, const Rig& rig, double offset_us) {
+  return run_system_full(s, rig, offset_us).track;
+}
+
+}  // namespace
+
+TEST_CASE("time offset, interpolation and triangulation recover an exactly observed pen") {
+  const Rig rig;
+  const DeviceStreams s = exact_streams(rig, 6.0, 5000.0, 1e9);
+  const TimeOffsetEstimate offset = estimate_time_offset(s, rig.c0, rig.c1);
+  REQUIRE(offset.observable);
+  CHECK(std::abs(offset.offset_us - 5000.0) < 20.0);
+  CHECK(offset.cost_px < 0.05);
+  CHECK(offset.cost_at_zero_px > 10 * offset.cost_px);
+
+  const PenTrack track = run_system(s, rig, 5000.0);
+  CHECK(track.strokes == 1);
+  CHECK(track.rejected_reprojection == 0);
+  REQUIRE(track.samples.size() > 550);
+  double worst = 0;
+  for (const PenSample& p : track.samples) {
+    const double t = static_cast<double>(p.t_us) * 1e-6;
+    worst = std::max(worst, (p.raw - pen_path(t)).norm());
+  }
+  // What remains is the linear interpolation of camera 1 over 10 ms of a curved path.
+  CHECK(worst < 1e-4);
+}
+
+TEST_CASE("a stray blob on the pen's epipolar line in one camera is never taken for the pen") {
+  const Rig rig;
+  SECTION("it appears while the pen is down: the pair nearest the last position wins") {
+    const DeviceStreams s = exact_streams(rig, 3.0, 0.0, 0.5);
+    const PenTrack track = run_system(s, rig, 0.0);
+    CHECK(track.strokes == 1);
+    REQUIRE(track.samples.size() > 290);
+    for (const PenSample& p : track.samples)
+      CHECK((p.raw - pen_path(static_cast<double>(p.t_us) * 1e-6)).norm() < 1e-4);
+  }
+  SECTION("it is there from the start: no stroke starts while two points fit") {
+    const DeviceStreams s = exact_streams(rig, 1.0, 0.0, 0.0);
+    const PenTrack track = run_system(s, rig, 0.0);
+    CHECK(track.samples.empty());
+    CHECK(track.ambiguous > 90);
+  }
+}
+
+TEST_CASE("the pen goes up when the LED is gone longer than the gap, and pen_events writes strokes") {
+  const Rig rig;
+  DeviceStreams s;
+  // Both cameras dark for 40 ms (bridged), camera 0 alone for 300 ms (a hand passing: followed on camera
+  // 1's ray), both for 500 ms (the pen lifted).
+  auto dark_both = [](double t) { return (t >= 1.0 && t < 1.04) || (t >= 2.0 && t < 2.5); };
+  auto dark_0 = [&](double t) { return dark_both(t) || (t >= 1.5 && t < 1.8); };
+  for (double t = 0.0; t < 3.0; t += 0.010) {
+    if (!dark_0(t))
+      push_frame(s.cameras[0], t * 1e6, {rig.c0.project(pen_path(t))});
+    else
+      push_frame(s.cameras[0], t * 1e6, {});
+  }
+  for (double t = 0.005; t < 3.0; t += 0.010) {
+    if (!dark_both(t))
+      push_frame(s.cameras[1], t * 1e6, {rig.c1.project(pen_path(t))});
+    else
+      push_frame(s.cameras[1], t * 1e6, {});
+  }
+  const PenTrack track = run_system(s, rig, 0.0);
+  CHECK(track.strokes == 2);
+  CHECK(track.bridged_frames >= 25);
+  const std::vector<InputEvent> ev = pen_events(track);
+  REQUIRE(ev.size() == track.samples.size() + 4);
+  CHECK(ev.front().kind == EventKind::Down);
+  CHECK(ev.back().kind == EventKind::Up);
+  int downs = 0, ups = 0;
+  for (size_t k = 0; k < ev.size(); ++k) {
+    downs += ev[k].kind == EventKind::Down;
+    ups += ev[k].kind == EventKind::Up;
+    if (k > 0) CHECK(ev[k].t_us >= ev[k - 1].t_us);
+    if (ev[k].kind == EventKind::Pen) CHECK(ev[k].p.allFinite());
+  }
+  CHECK(downs == 2);
+  CHECK(ups == 2);
+
+  const std::vector<InputEvent> shaped = pen_events(track, StrokeShaping{.simplify_tolerance = 0, .resample_spacing = 0.005});
+  std::vector<Vec3> stroke;
+  for (const InputEvent& e : shaped) {
+    if (e.kind == EventKind::Up) break;
+    if (e.kind == EventKind::Pen) stroke.push_back(e.p);
+  }
+  REQUIRE(stroke.size() > 10);
+  for (size_t k = 1; k + 1 < stroke.size(); ++k) CHECK(std::abs((stroke[k] - stroke[k - 1]).norm() - 0.005) < 1e-4);
+}
+
+TEST_CASE("after both cameras lose the pen, it continues the stroke only where a hand could have moved it") {
+  const Rig rig;
+  for (const double jump_m : {0.0, 0.3}) {
+    INFO("jump " << jump_m);
+    // Both cameras dark for 200 ms; then the pen is seen on its path again, or 30 cm away from it.
+    auto where = [&](double t) -> Vec3 { return pen_path(t) + Vec3(t >= 1.2 ? jump_m : 0.0, 0, 0); };
+    auto dark = [](double t) { return t >= 1.0 && t < 1.2; };
+    DeviceStreams s;
+    for (double t = 0.0; t < 2.0; t += 0.010) {
+      if (dark(t)) push_frame(s.cameras[0], t * 1e6, {});
+      else push_frame(s.cameras[0], t * 1e6, {rig.c0.project(where(t))});
+    }
+    for (double t = 0.005; t < 2.0; t += 0.010) {
+      if (dark(t)) push_frame(s.cameras[1], t * 1e6, {});
+      else push_frame(s.cameras[1], t * 1e6, {rig.c1.project(where(t))});
+    }
+    const PenTrack track = run_system(s, rig, 0.0);
+    CHECK(track.strokes == (jump_m > 0 ? 2u : 1u));
+    CHECK(track.rejected_jump == 0);
+  }
+}
+
+
+TEST_CASE("the system's own pen events are the strokes of its samples, and it is causal") {
+  const Rig rig;
+  DeviceStreams s;
+  // Two strokes: the pen lifted (both cameras dark) for half a second in between.
+  auto dark = [](double t) { return t >= 1.5 && t < 2.0; };
+  for (double t = 0.0; t < 3.0; t += 0.010) push_frame(s.cameras[0], t * 1e6, dark(t) ? std::initializer_list<Vec2>{} : std::initializer_list<Vec2>{rig.c0.project(pen_path(t))});
+  for (double t = 0.004; t < 3.0; t += 0.010) push_frame(s.cameras[1], t * 1e6, dark(t) ? std::initializer_list<Vec2>{} : std::initializer_list<Vec2>{rig.c1.project(pen_path(t))});
+  const SystemRun run = run_system_full(s, rig, 0.0);
+  CHECK(run.track.strokes == 2);
+  const std::vector<InputEvent> batch = pen_events(run.track);
+  REQUIRE(run.events.size() == batch.size());
+  for (size_t k = 0; k < batch.size(); ++k) {
+    CHECK(run.events[k].kind == batch[k].kind);
+    CHECK(run.events[k].t_us == batch[k].t_us);
+    CHECK(run.events[k].p == batch[k].p);
+  }
+  // Causality: the same reports cut at 1.2 s give the same samples up to the cut, less the last frames'
+  // worth the system was still waiting on.
+  DeviceStreams cut;
+  for (int c = 0; c < 2; ++c)
+    for (size_t k = 0; k < s.cameras[c].size() && s.cameras[c].t_us[k] < 1'200'000; ++k)
+      push_frame(cut.cameras[c], static_cast<double>(s.cameras[c].t_us[k]), {});
+  for (int c = 0; c < 2; ++c) {
+    cut.cameras[c].blob_count.assign(s.cameras[c].blob_count.begin(), s.cameras[c].blob_count.begin() + static_cast<std::ptrdiff_t>(cut.cameras[c].size()));
+    cut.cameras[c].blobs.assign(s.cameras[c].blobs.begin(), s.cameras[c].blobs.begin() + static_cast<std::ptrdiff_t>(cut.cameras[c].size()));
+  }
+  const PenTrack early = run_system(cut, rig, 0.0);
+  REQUIRE(early.samples.size() > 100);
+  for (size_t k = 0; k < early.samples.size(); ++k) {
+    CHECK(early.samples[k].t_us == run.track.samples[k].t_us);
+    CHECK(early.samples[k].filtered == run.track.samples[k].filtered);
+  }
+}
+
+TEST_CASE("the time offset is found from the pen's motion, and reports arriving out of order are dropped") {
+  const Rig rig;
+  DeviceStreams s = exact_streams(rig, 6.0, 5000.0, 1e9);
+  // One camera 1 report logged earlier than the one before it (a clock going backwards).
+  std::swap(s.cameras[1].t_us[300], s.cameras[1].t_us[301]);
+  const SystemRun run = run_system_full(s, rig, 0.0, /*estimate=*/true);
+  CHECK(run.state.offset_estimates > 0);
+  CHECK(std::abs(run.state.time_offset_us - 5000.0) < 20.0);
+  CHECK(run.state.out_of_order == 1);
+  CHECK(run.track.strokes == 1);
+}
