@@ -85,9 +85,16 @@ Result<InputLog> parse_input_log(std::string_view text, const std::string& sourc
     e.line = line_no;
     if (f.size() < 2) return fail(line_no, "expected '<t_us> <kind> ...'");
     if (!parse_int64(f[0], e.t_us)) return fail(line_no, "bad timestamp '" + std::string(f[0]) + "'");
-    if (e.t_us < last_t) return fail(line_no, "timestamp goes back in time (" + std::to_string(e.t_us) + " after " + std::to_string(last_t) + ")");
-    last_t = e.t_us;
     std::string_view kind = f[1];
+    // A device report stamped before the line above it is the device's problem, not the file's: kept and
+    // counted, for the triangulation system to drop. Any other line must keep the log's time order.
+    if (e.t_us < last_t && kind == "hid") {
+      ++log.hid_back_in_time;
+    } else if (e.t_us < last_t) {
+      return fail(line_no, "timestamp goes back in time (" + std::to_string(e.t_us) + " after " + std::to_string(last_t) + ")");
+    } else {
+      last_t = e.t_us;
+    }
     if (kind == "pen") {
       e.kind = EventKind::Pen;
       // An optional fourth number: the snap radius the sample was drawn with (a mouse's, from screen pixels).

@@ -30,6 +30,7 @@ struct InputEvent {
 struct InputLog {
   std::vector<InputEvent> events;
   size_t rejected_hid_lines = 0;      // garbled hid payloads, kept as events with hid_ok = false
+  size_t hid_back_in_time = 0;        // hid lines stamped before the line above them, kept
 };
 
 inline constexpr std::string_view kInputLogHeader = "FIRE-LOG 1";

@@ -186,6 +186,7 @@ std::optional<CameraReport> DeviceDecoder::read(const InputEvent& e) {
   CameraReport out;
   out.camera = camera;
   out.t_us = e.t_us;
+  out.line = e.line;
   out.blobs.fill(Vec2::Zero());
   for (const IrSlot& s : r.report.slots)
     if (s.seen) out.blobs[out.blob_count++] = Vec2(s.x, s.y);
@@ -200,6 +201,7 @@ DeviceStreams decode_device_streams(std::span<const InputEvent> events) {
     if (!r) continue;
     CameraFrames& f = out.cameras[size_t(r->camera)];
     f.t_us.push_back(r->t_us);
+    f.line.push_back(r->line);
     f.t_frame_us.push_back(static_cast<double>(r->t_us));
     f.blob_count.push_back(r->blob_count);
     f.blobs.push_back(r->blobs);

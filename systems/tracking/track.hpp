@@ -29,6 +29,7 @@ namespace fire::tracking {
 // The IR reports of one camera, one entry per report (structure of arrays).
 struct CameraFrames {
   std::vector<int64_t> t_us;       // host arrival time, as logged (the key to the report's line)
+  std::vector<uint32_t> line;      // the report's line in the log (0: not from a file)
   std::vector<double> t_frame_us;  // the remote's frame clock on the host's time axis (fit_frame_clock)
   std::vector<uint8_t> blob_count;
   std::vector<std::array<Vec2, kIrSlots>> blobs;  // the seen blobs first, in slot order
@@ -48,6 +49,7 @@ struct DeviceStreams {
 struct CameraReport {
   int camera = 0;
   int64_t t_us = 0;  // host arrival time, as logged
+  uint32_t line = 0; // in the log (0: not from a file)
   uint8_t blob_count = 0;
   std::array<Vec2, kIrSlots> blobs;  // the seen blobs first, in slot order
 };

@@ -20,6 +20,7 @@ constexpr double kPendingTimeout = 1.5;      // periods after which no later rep
 // Camera 1 has not reported an instant this long after it (a lost report, latency and the wait for the
 // next report included): triangulate without it.
 constexpr double kCameraHorizonUs = 60'000;
+constexpr int64_t kSilenceUs = 500'000;     // a remote this long without a report has stopped (a 100 Hz stream)
 constexpr int64_t kKeepUs = 30'000'000;      // trailing reports kept per camera (the offset's window)
 constexpr size_t kTrimChunk = 512;           // reports dropped from a window at once
 constexpr uint64_t kOffsetEvery = 200;       // camera 0 reports between two estimates of the time offset
@@ -44,6 +45,7 @@ void erase_front(CameraWindow& w, size_t n) {
   CameraFrames& f = w.frames;
   const auto d = static_cast<std::ptrdiff_t>(n);
   f.t_us.erase(f.t_us.begin(), f.t_us.begin() + d);
+  f.line.erase(f.line.begin(), f.line.begin() + d);
   f.t_frame_us.erase(f.t_frame_us.begin(), f.t_frame_us.begin() + d);
   f.blob_count.erase(f.blob_count.begin(), f.blob_count.begin() + d);
   f.blobs.erase(f.blobs.begin(), f.blobs.begin() + d);
@@ -117,6 +119,7 @@ void fix_pending(CameraWindow& w, int camera, TriangulateState& state, const Tra
   CameraFrames& f = w.frames;
   if (f.size() > 0) t_frame = std::max(t_frame, f.t_frame_us.back() + 1.0);
   f.t_us.push_back(r.t_us);
+  f.line.push_back(r.line);
   f.t_frame_us.push_back(t_frame);
   f.blob_count.push_back(r.blob_count);
   f.blobs.push_back(r.blobs);
@@ -179,18 +182,21 @@ double reach_m(double dt_us, int64_t short_gap_us) {
   return kJumpGate_m + speed * dt_us * 1e-6;
 }
 
-InputEvent pen_event(int64_t t_us, EventKind kind, const Vec3& p = Vec3::Zero()) {
+// Stamped with the line of camera 0's report it came from, so a rejection names a line of the log.
+InputEvent pen_event(int64_t t_us, uint32_t line, EventKind kind, const Vec3& p = Vec3::Zero()) {
   InputEvent e;
   e.t_us = t_us;
+  e.line = line;
   e.kind = kind;
   e.p = p;
   return e;
 }
 
 void end_stroke(TriangulateState& s, std::vector<InputEvent>& out) {
-  if (s.stroke_open) out.push_back(pen_event(s.last_sample_t_us, EventKind::Up));
+  if (s.stroke_open) out.push_back(pen_event(s.last_sample_t_us, s.last_sample_line, EventKind::Up));
   s.down = false;
   s.stroke_open = false;
+  s.lost_now = false;
 }
 
 // One camera 0 report (index k in its window): the pen's state machine of PenTrackOptions.
@@ -221,7 +227,12 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
         camera = 1;
       }
     }
-    if (!x) return;
+    if (!x) {
+      s.lost_now = true;
+      return;
+    }
+    s.both_lost += s.lost_now;
+    s.lost_now = false;
     s.last_seen_t = t;
     s.last_position = x->position;
     s.pen_px[size_t(camera)] = x->px;
@@ -290,16 +301,20 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
     ++s.counts.rejected_filter;
     return;
   }
+  if (f0.blob_count[k] > 1 || ip.count > 1) ++s.stray_frames;
   if (!s.stroke_open) {
-    out.push_back(pen_event(t_us, EventKind::Down));
+    out.push_back(pen_event(t_us, f0.line[k], EventKind::Down));
     s.stroke_open = true;
   }
-  out.push_back(pen_event(t_us, EventKind::Pen, *smooth));
+  out.push_back(pen_event(t_us, f0.line[k], EventKind::Pen, *smooth));
   if (samples)
     samples->push_back({t_us, s.counts.strokes - 1, static_cast<uint32_t>(s.cameras[0].first_index + k), tri.X, *smooth,
                         tri.reprojection_error_px});
+  s.both_lost += s.lost_now;
+  s.lost_now = false;
   s.last_sample_t = t;
   s.last_sample_t_us = t_us;
+  s.last_sample_line = f0.line[k];
   s.last_seen_t = t;
   s.last_position = tri.X;
   s.pen_px = {f0.blobs[k][fit_blobs[best][0]], ip.px[fit_blobs[best][1]]};
@@ -328,6 +343,14 @@ void triangulate_report(const TrackingRig& rig, TriangulateState& s, const Camer
     ++s.out_of_order;
     return;
   }
+  const bool same_as_last = w.pending ? w.pending->blob_count == r.blob_count && w.pending->blobs == r.blobs
+                                      : w.frames.size() > 0 && w.frames.blob_count.back() == r.blob_count &&
+                                            w.frames.blobs.back() == r.blobs;
+  if (w.reports > 0 && r.t_us == w.last_arrival_us && same_as_last) {
+    ++s.duplicated;
+    return;
+  }
+  s.silent[size_t(r.camera)] = false;
   const double t = static_cast<double>(r.t_us);
   if (w.reports++ == 0) {
     w.origin_us = r.t_us;
@@ -368,6 +391,10 @@ void triangulate_advance(int64_t now_us, const TrackingRig& rig, TriangulateStat
   const double now = static_cast<double>(now_us);
   for (int c = 0; c < 2; ++c) {
     CameraWindow& w = s.cameras[size_t(c)];
+    if (w.reports > 0 && !s.silent[size_t(c)] && now_us - w.last_arrival_us > kSilenceUs) {
+      s.silent[size_t(c)] = true;
+      ++s.silences[size_t(c)];
+    }
     if (w.pending && now - static_cast<double>(w.pending->t_us) > kPendingTimeout * period_of(w)) fix_pending(w, c, s, rig, std::nullopt);
   }
   if (!s.time_offset_started) {
@@ -406,6 +433,32 @@ void triangulate_advance(int64_t now_us, const TrackingRig& rig, TriangulateStat
   trim(w0, s.next_cam0 > 0 ? s.next_cam0 - 1 : 0);
   // Camera 1's window reaches back as far as camera 0's moving blobs and the next report to triangulate.
   trim(s.cameras[1], std::numeric_limits<uint64_t>::max());
+}
+
+std::vector<std::string> describe_device_problems(const TriangulateState& s) {
+  std::vector<std::string> out;
+  const tracking::ReportCounts& c = s.decoder.counts;
+  auto say = [&](size_t n, const std::string& what) {
+    if (n > 0) out.push_back(std::to_string(n) + " " + what);
+  };
+  say(c.garbled, "device report(s) garbled (not hexadecimal, or empty): skipped");
+  say(c.bad_length, "device report(s) cut short or too long for their report id: skipped");
+  say(c.unknown_id, "device report(s) with an unknown report id: skipped");
+  say(c.unknown_device, "report(s) from a device the log names as no camera: skipped");
+  say(c.out_of_range_slots, "IR blob(s) outside the camera's 1024 x 768 pixels: dropped");
+  say(c.bad_device_records, "device record(s) that do not read: ignored");
+  say(s.out_of_order, "report(s) stamped earlier than their remote's previous report (time going backwards): dropped");
+  say(s.duplicated, "report(s) repeating their remote's previous report at the same instant: dropped");
+  for (int k = 0; k < 2; ++k)
+    say(s.silences[size_t(k)], std::string("time(s) camera ") + char('0' + k) + " stopped reporting for more than 0.5 s" +
+                                   (s.silent[size_t(k)] ? " (silent at the end)" : ""));
+  say(s.both_lost, "time(s) neither camera saw the pen for a moment in the middle of a stroke (a hand over both): "
+                  "the stroke went on where it was seen again");
+  say(s.stray_frames, "pen sample(s) from frames that also showed another light (a reflection): the pen told apart by the other camera");
+  say(s.counts.ambiguous, "frame(s) where two points fitted both cameras (a reflection in line with the pen): no stroke started");
+  say(s.counts.rejected_jump, "frame(s) where the pen was seen farther than a hand moves it: not taken");
+  say(s.counts.rejected_filter, "pen sample(s) not finite or not later than the one before: rejected");
+  return out;
 }
 
 void triangulate_system(const FrameTime& frame, const TrackingRig& rig, TriangulateState& state,

@@ -59,6 +59,12 @@ struct TriangulateState {
   tracking::DeviceDecoder decoder;
   std::array<CameraWindow, 2> cameras;
   size_t out_of_order = 0;       // reports that arrived earlier than their camera's previous one: dropped
+  size_t duplicated = 0;         // reports equal to their camera's previous one, at the same instant: dropped
+  size_t both_lost = 0;          // times neither camera saw the pen in the middle of a stroke that went on after
+  bool lost_now = false;
+  size_t stray_frames = 0;       // pen samples taken from a frame that also showed another blob (a reflection)
+  std::array<size_t, 2> silences{};  // times each camera stopped reporting for more than half a second
+  std::array<bool, 2> silent{};      // ... and is silent now
   uint64_t next_cam0 = 0;        // index of the next camera 0 report to triangulate
   // Time offset: the value in use, and the moving camera 0 blobs it is re-estimated from.
   double time_offset_us = 0;
@@ -75,6 +81,7 @@ struct TriangulateState {
   tracking::OneEuroState filter;
   double last_sample_t = 0, last_seen_t = 0;
   int64_t last_sample_t_us = 0;
+  uint32_t last_sample_line = 0;
   Vec3 last_position = Vec3::Zero();
   std::array<Vec2, 2> pen_px{Vec2::Zero(), Vec2::Zero()};
 
@@ -88,6 +95,9 @@ struct TriangulateState {
 // `samples`, when given, receives every pen sample too (what `fire track --truth` measures).
 void triangulate_system(const FrameTime& frame, const TrackingRig& rig, TriangulateState& state,
                         std::vector<InputEvent>& frame_events, std::vector<tracking::PenSample>* samples = nullptr);
+
+// What went wrong with the device input so far, one sentence per kind of problem (none: empty).
+std::vector<std::string> describe_device_problems(const TriangulateState& state);
 
 // The two halves of triangulate_system, for reports that do not come from a log (exact pixels in tests):
 // takes one report, then triangulates what the reports taken so far allow at `now_us` (the frame's end).

@@ -97,6 +97,7 @@ TEST_CASE("input log: truncated, unknown version and malformed lines are refused
   refuse("FIRE-LOG 1\n10 pen 1 2 3 4 5\n", "pen needs three numbers");
   refuse("FIRE-LOG 1\n10 fly\n", "unknown event kind 'fly'");
   refuse("FIRE-LOG 1\n10 down\n5 up\n", "back in time");
+  refuse("FIRE-LOG 1\n10 hid 0 3300\n5 up\n", "back in time");
   refuse("FIRE-LOG 1\nabc down\n", "bad timestamp");
   refuse("FIRE-LOG 1\n10 cmd jump\n", "unknown command");
 }
@@ -107,6 +108,16 @@ TEST_CASE("input log: a garbled device report is counted, not fatal", "[files]")
   CHECK(log->rejected_hid_lines == 2);
   CHECK_FALSE(log->events[0].hid_ok);
   CHECK(log->events.size() == 3);
+}
+
+TEST_CASE("input log: a device report stamped back in time is kept and counted; the order stays the later lines'", "[files]") {
+  auto log = parse_input_log("FIRE-LOG 1\n10 hid 0 3300\n20 hid 1 3300\n15 hid 0 3300\n20 down\n", "b.log");
+  REQUIRE(log.ok());
+  CHECK(log->hid_back_in_time == 1);
+  REQUIRE(log->events.size() == 4);
+  CHECK(log->events[2].t_us == 15);
+  // The next line is checked against the last in-order line (20), not the late report.
+  CHECK_FALSE(parse_input_log("FIRE-LOG 1\n20 hid 0 3300\n15 hid 0 3300\n17 down\n", "c.log").ok());
 }
 
 TEST_CASE("OBJ reader: faces with texture/normal indices, and refusals", "[files]") {

@@ -28,6 +28,7 @@ TEST_CASE("the frame clock is recovered from jittered arrival times with lost re
     if (k == 5 || k == 50 || k == 51 || k == 300) continue;  // lost reports
     exposure.push_back(e);
     f.t_us.push_back(std::llround(arrival));
+    f.line.push_back(0);
     f.t_frame_us.push_back(arrival);
     f.blob_count.push_back(0);
     f.blobs.emplace_back();

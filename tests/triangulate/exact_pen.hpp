@@ -33,6 +33,7 @@ inline Vec3 pen_path(double t) {
 
 inline void push_frame(CameraFrames& f, double t_us, std::initializer_list<Vec2> blobs) {
   f.t_us.push_back(std::llround(t_us));
+  f.line.push_back(0);
   f.t_frame_us.push_back(t_us);
   std::array<Vec2, kIrSlots> b;
   b.fill(Vec2::Zero());

@@ -133,8 +133,14 @@ int run_replay(const ReplayOptions& o) {
 
   for (const Rejection& r : world->rejections)
     std::cerr << lines_of << ":" << r.line << ": rejected: " << r.reason << "\n";
-  if (world->log.rejected_hid_lines)
+  if (world->log.rejected_hid_lines && !world->rig)  // with a rig, the triangulation system's words say it
     std::cerr << lines_of << ": " << world->log.rejected_hid_lines << " garbled device report line(s) skipped\n";
+  if (world->log.hid_back_in_time)
+    std::cerr << lines_of << ": " << world->log.hid_back_in_time
+              << " device report line(s) stamped before the line above them (kept for the triangulation system)\n";
+  if (world->rig)
+    for (const std::string& problem : describe_device_problems(world->triangulate))
+      std::cerr << lines_of << ": device input: " << problem << "\n";
   std::string problem = world->mesh.validate();
   if (!problem.empty()) {
     std::cerr << "fire replay: internal error, the replayed network is invalid: " << problem << "\n";
