@@ -403,7 +403,10 @@ void add_app_commands(CLI::App& app, Registry& registry) {
       "session bit for bit. Needs a display (DISPLAY or WAYLAND_DISPLAY); without one it exits 1 and points "
       "to `fire render`. On exit prints one JSON line: display_frames, system_frames, events, edges, faces, "
       "surface_quads, hash (as `fire replay --hash`), device, validation. FIRE_VK_VALIDATION=1 turns the "
-      "validation layer on; any message then fails the command.\n\nKeys:\n" + keys);
+      "validation layer on; any message then fails the command. While a stroke is drawn, the face it would split "
+      "is tinted magenta and the point its end would snap to is marked cyan; on an open border, its first vertex "
+      "is marked green when the stroke would close it there."
+      "\n\nKeys:\n" + keys);
   cmd->add_option("NET", a->input_path, "curve network (.fnet) or input log to start from");
   cmd->add_option("--reference", a->reference_path,
                   "OBJ mesh drawn see-through; a left drag draws on it (ray casts through a BVH): a pen sample at "

@@ -15,9 +15,9 @@ std::vector<SystemSpec> session_systems(World& w) {
   systems.push_back({"input", {"log", "frame"}, {"frame_events"}, {}, [&w] {
                        input_system(w.log, w.frame, w.cursor, w.frame_events);
                      }});
-  systems.push_back({"sketch", {"frame_events", "sketch_settings"}, {"requests", "rejections"}, {"mesh", "snap"}, [&w] {
+  systems.push_back({"sketch", {"frame_events", "sketch_settings"}, {"requests", "rejections", "pen_feedback"}, {"mesh", "snap"}, [&w] {
                        sketch_system(w.frame_events, w.mesh, w.snap, w.sketch_settings, w.sketch, w.requests,
-                                     w.rejections);
+                                     w.rejections, w.pen_feedback);
                      }});
   systems.push_back({"split", {"requests"}, {"mesh", "rejections"}, {}, [&w] {
                        split_system(w.requests, w.mesh, w.history, w.rejections);

@@ -2,7 +2,7 @@
 // validation layer on: a scripted interaction through the window's GLFW callbacks (an orbit drag, a zoom, the
 // help overlay, an undo, a resize, a close), a screenshot of the presented frame checked by pixel statistics,
 // the recorded input log replayed to the same hash; strokes drawn with the mouse on pawn.obj, replayed bit for
-// bit; and no display: a clear message, no crash.
+// bit; the pen's feedback (closing vertex, tinted face, snap target); and no display: a clear message, no crash.
 #include <catch2/catch.hpp>
 #include <cstdlib>
 #include <filesystem>
@@ -253,6 +253,68 @@ TEST_CASE("fire app: the stroke in progress is drawn before it becomes a curve",
   CHECK(outside < 10);
   CHECK(curve_pixels(*image) < 20);
   fs::remove_all(dir);
+}
+
+// Pixels with `test`, inside the rectangle [x0, x1] x [y0, y1] and outside it.
+template <class Test>
+std::pair<size_t, size_t> count_in_and_out(const Image& im, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1, Test test) {
+  size_t inside = 0, outside = 0;
+  for (uint32_t y = 0; y < im.height; ++y)
+    for (uint32_t x = 0; x < im.width; ++x)
+      if (test(im.pixel(x, y))) (x >= x0 && x <= x1 && y >= y0 && y <= y1 ? inside : outside)++;
+  return {inside, outside};
+}
+
+// fire app on pawn.obj in a 960x720 window, driven by `script` of this folder.
+Run app_on_pawn(int display, const std::string& script, const std::string& args, const fs::path& dir) {
+  return run(app_command(display, "--reference " + quote(FIRE_PAWN) + " --size 960x720 --script " +
+                                      quote(std::string(FIRE_WINDOW_TEST_DIR "/") + script) + " " + args),
+             dir);
+}
+
+// The screenshot of app_on_pawn(script) and the app's JSON line.
+std::pair<Image, nlohmann::json> pawn_screenshot(int display, const std::string& script) {
+  const fs::path dir = scratch(script);
+  const std::string shot = (dir / "shot.png").string();
+  const Run app = app_on_pawn(display, script, "--screenshot " + quote(shot), dir);
+  INFO("stdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  auto image = fire::render::read_png(shot);
+  REQUIRE(image);
+  fs::remove_all(dir);
+  return {std::move(*image), nlohmann::json::parse(app.out)};
+}
+
+TEST_CASE("fire app: the border's first vertex is marked when the stroke's end would close it", "[app][window][feedback]") {
+  REQUIRE(has_xvfb());
+  const auto [image, json] = pawn_screenshot(240, "feedback_close.script");
+  CHECK(json["edges"] == 3);  // three sides, the fourth still being drawn
+  const auto [inside, outside] = count_in_and_out(image, 418, 168, 442, 192, [](const uint8_t* p) {
+    return near(p, Palette::close_border, 40);
+  });
+  INFO("closing-vertex pixels by the first corner " << inside << ", elsewhere " << outside);
+  CHECK(inside > 40);
+  CHECK(outside < 10);
+}
+
+TEST_CASE("fire app: the face a stroke would split is tinted and its end's snap target marked", "[app][window][feedback]") {
+  REQUIRE(has_xvfb());
+  const auto [image, json] = pawn_screenshot(260, "feedback_split.script");
+  CHECK(json["faces"] == 1);  // the stroke is still being drawn
+  // Magenta: red and blue well above green, which neither the grey surface nor the blue reference have.
+  const auto [tinted, tinted_outside] = count_in_and_out(image, 425, 175, 535, 265, [](const uint8_t* p) {
+    return int(p[0]) - int(p[1]) > 40 && int(p[2]) - int(p[1]) > 20;
+  });
+  INFO("tinted pixels in the square " << tinted << ", outside " << tinted_outside);
+  CHECK(tinted > 3000);  // of about 8000 in the square
+  CHECK(tinted_outside < 50);
+  // The target: on the bottom side below the pen, where the stroke would end.
+  const auto [target, target_outside] = count_in_and_out(image, 468, 248, 492, 272, [](const uint8_t* p) {
+    return near(p, Palette::snap_target, 40);
+  });
+  INFO("snap-target pixels below the pen " << target << ", elsewhere " << target_outside);
+  CHECK(target > 30);
+  CHECK(target_outside < 10);
 }
 
 TEST_CASE("fire app without a display: a clear message, exit 1, no crash", "[app][window]") {
