@@ -240,13 +240,15 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           }
           r.command.kind = EditKind::CloseBorder;
           r.command.snap_distance = settings.snap_distance;
-        } else {
+        } else {  // delete or sharp: the curve nearest to the picked point
+          const bool remove = ev.command == CommandKind::Delete;
           uint32_t e = pick_edge(snap, ev.p, settings.snap_distance);
           if (e == kNone) {
-            reject("delete: no curve within " + std::to_string(settings.snap_distance) + " of the picked point");
+            reject(std::string(remove ? "delete" : "sharp") + ": no curve within " +
+                   std::to_string(settings.snap_distance) + " of the picked point");
             break;
           }
-          r.command.kind = EditKind::DeleteCurve;
+          r.command.kind = remove ? EditKind::DeleteCurve : EditKind::ToggleSharp;
           r.command.edge = e;
         }
         requests.push_back(std::move(r));

@@ -56,6 +56,7 @@ const std::vector<std::string> kKeys = {
     "Ctrl+Shift+Z    redo (logged; also Ctrl+Y)",
     "C               close the border to its first vertex (logged)",
     "Delete          delete the curve under the cursor (logged)",
+    "K               make the curve under the cursor sharp (a crease) or smooth (logged)",
     "1 / 2 / 3       surface / curves / wireframe on or off",
     "F               frame everything",
     "Ctrl+S          save the network (-o, or the default path)",
@@ -145,11 +146,12 @@ Result<std::vector<ScriptEvent>> read_script(const std::string& path) {
   return events;
 }
 
-// The polyline point nearest to the cursor on screen, within `radius` pixels: what Delete picks.
-bool curve_point_under(const Mesh& mesh, const render::Camera& camera, uint32_t width, uint32_t height, glm::vec2 cursor,
-                       float radius, Vec3& out) {
+// The polyline point nearest to the cursor on screen, within `radius` pixels, and its edge (kNone: none):
+// what Delete and K pick.
+uint32_t curve_point_under(const Mesh& mesh, const render::Camera& camera, uint32_t width, uint32_t height,
+                           glm::vec2 cursor, float radius, Vec3& out) {
   float best = radius * radius;
-  bool found = false;
+  uint32_t found = kNone;
   for (uint32_t e = 0; e < mesh.edge_slots(); ++e) {
     if (!mesh.edge_alive(e)) continue;
     for (const Vec3& p : mesh.polyline(e)) {
@@ -159,7 +161,7 @@ bool curve_point_under(const Mesh& mesh, const render::Camera& camera, uint32_t 
       if (glm::dot(d, d) < best) {
         best = glm::dot(d, d);
         out = p;
-        found = true;
+        found = e;
       }
     }
   }
@@ -324,8 +326,17 @@ int run_app(const AppArgs& a) {
         else if (e.key == GLFW_KEY_C) log_command(CommandKind::Close, Vec3::Zero());
         else if (e.key == GLFW_KEY_DELETE) {
           Vec3 p;
-          if (curve_point_under(w.mesh, app.camera(), app.width(), app.height(), cursor, 12.0f, p)) log_command(CommandKind::Delete, p);
+          if (curve_point_under(w.mesh, app.camera(), app.width(), app.height(), cursor, 12.0f, p) != kNone)
+            log_command(CommandKind::Delete, p);
           else hud_data.status = "no curve under the cursor to delete";
+        } else if (e.key == GLFW_KEY_K) {
+          Vec3 p;
+          const uint32_t edge = curve_point_under(w.mesh, app.camera(), app.width(), app.height(), cursor, 12.0f, p);
+          if (edge == kNone) hud_data.status = "no curve under the cursor to mark sharp";
+          else {
+            log_command(CommandKind::Sharp, p);
+            hud_data.status = w.mesh.edges.flags[edge] & kSharpEdge ? "making the curve smooth" : "marking the curve sharp";
+          }
         } else if (e.key == GLFW_KEY_1) hud_data.view.surface = !hud_data.view.surface;
         else if (e.key == GLFW_KEY_2) hud_data.view.curves = !hud_data.view.curves;
         else if (e.key == GLFW_KEY_3) hud_data.view.wireframe = !hud_data.view.wireframe;
