@@ -9,7 +9,7 @@
 namespace fire {
 
 struct PenFeedback {
-  bool pen_seen = false;  // a pen sample has arrived; nothing below means anything before
+  bool pen_seen = false;  // a pen sample has arrived since the last pen up; nothing below means anything before
   bool pen_down = false;
   Vec3 pen = Vec3::Zero();  // the last pen sample
   double radius = 0;        // the snap radius at that sample (model units)

@@ -178,6 +178,9 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
         state.stroke.push_back(ev.p);
         break;
       case EventKind::Up: {
+        // Where a lifted pen is stays unknown until its next sample: the mouse sends none until the next drag,
+        // and a face left tinted after the stroke would show what no longer is.
+        feedback.pen_seen = false;
         if (!state.pen_down) {
           reject("pen up without pen down");
           break;

@@ -120,8 +120,15 @@ TEST_CASE("while drawing: the face the stroke would split and where its end woul
   REQUIRE(w->mesh.valid(fb.target_edge));
   CHECK(fb.target == Vec3(0.05, 0.1, 0));  // the top curve's middle point
 
-  // The pen goes up: the stroke splits the square, and the pen over each half names a different face.
-  log.event("up").pen(0.02, 0.05);
+  // The pen goes up: the stroke splits the square, and nothing is shown until the pen is seen again.
+  log.event("up");
+  w = replay(log);
+  REQUIRE(w->mesh.face_count() == 2);
+  CHECK_FALSE(w->pen_feedback.pen_seen);
+  CHECK_FALSE(w->pen_feedback.face.valid());
+  CHECK_FALSE(w->pen_feedback.has_target());
+  // Then the pen over each half names a different face.
+  log.pen(0.02, 0.05);
   w = replay(log);
   REQUIRE(w->mesh.face_count() == 2);
   const FaceId left = w->pen_feedback.face;
