@@ -58,11 +58,10 @@ const std::vector<std::string> kKeys = {
     "Ctrl+Shift+Z    redo (logged; also Ctrl+Y)",
     "C               close the border to its first vertex (logged)",
     "Delete          delete the curve under the cursor (logged)",
-    "K               make the curve under the cursor sharp (a crease) or smooth (logged)",
+    "K               the curve under the cursor sharp / smooth (logged)",
     "1 / 2 / 3       surface / curves / wireframe on or off",
     "F               frame everything",
-    "Ctrl+S          save the network (-o, or the default path)",
-    "E               export the surface (--export: .obj .ply .stl .glb)",
+    "Ctrl+S / E      save the network (-o) / export the surface (--export)",
     "H or F1         this help",
     "Esc             quit",
 };
