@@ -15,14 +15,14 @@ struct CurveEnd {
   uint32_t point = 0;
 };
 
-enum class EditKind : uint8_t { StartBorder, AppendBorder, CloseBorder, SplitFace, DeleteCurve };
+enum class EditKind : uint8_t { StartBorder, AppendBorder, CloseBorder, SplitFace, DeleteCurve, ToggleSharp };
 
 struct EditCommand {
   EditKind kind = EditKind::StartBorder;
-  std::vector<Vec3> points;  // the new curve's polyline (all kinds but DeleteCurve)
+  std::vector<Vec3> points;  // the new curve's polyline (the border and split kinds)
   uint32_t face = kNone;     // SplitFace: the face the curve crosses
   CurveEnd start, end;       // SplitFace: where the curve starts and ends on that face's boundary
-  uint32_t edge = kNone;     // DeleteCurve
+  uint32_t edge = kNone;     // DeleteCurve, ToggleSharp (sharp becomes smooth, smooth sharp)
   double snap_distance = 0;  // CloseBorder: how far the last point may lie from the first vertex
 };
 

@@ -110,14 +110,14 @@ Result<InputLog> parse_input_log(std::string_view text, const std::string& sourc
       if (f.size() != 2) return fail(line_no, std::string(kind) + " takes no fields");
     } else if (kind == "cmd") {
       e.kind = EventKind::Command;
-      if (f.size() < 3) return fail(line_no, "cmd needs a command: undo, redo, close or delete x y z");
+      if (f.size() < 3) return fail(line_no, "cmd needs a command: undo, redo, close, delete x y z or sharp x y z");
       std::string_view c = f[2];
       if (c == "undo" || c == "redo" || c == "close") {
         e.command = c == "undo" ? CommandKind::Undo : c == "redo" ? CommandKind::Redo : CommandKind::Close;
         if (f.size() != 3) return fail(line_no, "cmd " + std::string(c) + " takes no fields");
-      } else if (c == "delete") {
-        e.command = CommandKind::Delete;
-        if (!parse_point(f, 3, e.p)) return fail(line_no, "cmd delete needs three numbers x y z");
+      } else if (c == "delete" || c == "sharp") {
+        e.command = c == "delete" ? CommandKind::Delete : CommandKind::Sharp;
+        if (!parse_point(f, 3, e.p)) return fail(line_no, "cmd " + std::string(c) + " needs three numbers x y z");
       } else {
         return fail(line_no, "unknown command '" + std::string(c) + "'");
       }
@@ -185,6 +185,7 @@ std::string format_event(const InputEvent& e) {
         case CommandKind::Redo: s += "cmd redo"; break;
         case CommandKind::Close: s += "cmd close"; break;
         case CommandKind::Delete: s += "cmd delete " + point(e.p); break;
+        case CommandKind::Sharp: s += "cmd sharp " + point(e.p); break;
       }
       break;
     case EventKind::Hid: {

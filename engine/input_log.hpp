@@ -10,12 +10,12 @@
 namespace fire {
 
 enum class EventKind : uint8_t { Pen, Down, Up, Command, Hid, Truth, Meta };
-enum class CommandKind : uint8_t { Undo, Redo, Close, Delete };
+enum class CommandKind : uint8_t { Undo, Redo, Close, Delete, Sharp };
 
 struct InputEvent {
   int64_t t_us = 0;
   EventKind kind = EventKind::Pen;
-  Vec3 p = Vec3::Zero();              // Pen sample; Delete command's pick point
+  Vec3 p = Vec3::Zero();              // Pen sample; Delete and Sharp commands' pick point
   double snap = 0;                    // Pen: snap radius for a stroke end at this sample; 0: the session's setting
   CommandKind command = CommandKind::Undo;
   int device = 0;                     // Hid

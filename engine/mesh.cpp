@@ -3,6 +3,7 @@
 #include "engine/hash.hpp"
 #include "engine/session_dir.hpp"
 
+#include <Eigen/Geometry>  // cross products
 #include <algorithm>
 #include <cstring>
 #include <type_traits>
@@ -88,6 +89,27 @@ uint32_t Mesh::loop_position(uint32_t f, uint32_t e) const {
   for (uint32_t k = 0; k < loop.size(); ++k)
     if (edge_of(loop[k]) == e) return k;
   return kNone;
+}
+
+LoopPlane loop_plane(std::span<const Vec3> loop) {
+  LoopPlane plane;
+  for (size_t i = 0; i < loop.size(); ++i) {
+    plane.centroid += loop[i];
+    plane.normal += loop[i].cross(loop[(i + 1) % loop.size()]);
+  }
+  if (!loop.empty()) plane.centroid /= double(loop.size());
+  if (plane.normal.norm() > 0) plane.normal.normalize();
+  return plane;
+}
+
+std::vector<Vec3> Mesh::face_boundary(uint32_t f) const {
+  std::vector<Vec3> out;
+  for (uint32_t oe : face_loop(f)) {
+    auto line = polyline(edge_of(oe));
+    if (is_reversed(oe)) out.insert(out.end(), line.rbegin(), line.rend() - 1);
+    else out.insert(out.end(), line.begin(), line.end() - 1);
+  }
+  return out;
 }
 
 uint32_t Mesh::allocate(Column<uint32_t>& free_list, Column<uint32_t>& generation, Column<uint8_t>& flags,

@@ -77,6 +77,12 @@ struct FacePool {
   ChangeStamps changes;
 };
 
+// A closed polyline's centroid and unit mean normal (Newell's; zero for a loop that encloses no area).
+struct LoopPlane {
+  Vec3 centroid = Vec3::Zero(), normal = Vec3::Zero();
+};
+LoopPlane loop_plane(std::span<const Vec3> loop);
+
 struct MeshMark;
 class SnapshotWriter;
 class SnapshotReader;
@@ -143,6 +149,8 @@ class Mesh {
   bool is_border_edge(uint32_t e) const { return edges.face[e][0] == kNone || edges.face[e][1] == kNone; }
   // Index of edge e in f's loop, or kNone.
   uint32_t loop_position(uint32_t f, uint32_t e) const;
+  // Face f's boundary as one closed polyline in loop order, each corner once (the last point is not the first).
+  std::vector<Vec3> face_boundary(uint32_t f) const;
 
   // ---- frames and change stamps
   // Every write from now on is stamped `f`; frames never go back.

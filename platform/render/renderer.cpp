@@ -184,10 +184,10 @@ Renderer::~Renderer() {
   VkDevice device = context_.device();
   vkDeviceWaitIdle(device);  // nothing else to do on failure: everything is destroyed either way
   for (Buffer* b : {&readback_, &points_, &vertices_, &surface_vertices_, &surface_indices_, &reference_vertices_,
-                    &reference_indices_, &stroke_})
+                    &reference_indices_, &stroke_, &pen_})
     destroy(*b);
   for (Target* t : {&color_, &resolve_, &depth_}) destroy(*t);
-  for (VkPipeline p : {background_, surface_, reference_pipeline_, curves_, markers_, wireframe_})
+  for (VkPipeline p : {background_, surface_, reference_pipeline_, curves_, markers_, wireframe_, pen_face_})
     if (p) vkDestroyPipeline(device, p, nullptr);
   if (layout_) vkDestroyPipelineLayout(device, layout_, nullptr);
   if (fence_) vkDestroyFence(device, fence_, nullptr);
@@ -296,6 +296,9 @@ Status Renderer::create_pipelines() {
   PipelineDesc reference = surface;
   reference.depth_write = false;
   reference.blend = true;
+  // The face under the pen shows through whatever is in front of it: the pen is over it, so it faces the view.
+  PipelineDesc pen_face = reference;
+  pen_face.depth_test = false;
   // A segment is two consecutive points: one binding read per instance at offsets 0 and 12.
   PipelineDesc curves{curve_vert, flat_frag, {{0, 12, instance}},
                       {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}, {1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12}}};
@@ -303,6 +306,7 @@ Status Renderer::create_pipelines() {
   FIRE_TRY(build(background, background_));
   FIRE_TRY(build(surface, surface_));
   FIRE_TRY(build(reference, reference_pipeline_));
+  FIRE_TRY(build(pen_face, pen_face_));
   FIRE_TRY(build(curves, curves_));
   if (context_.wireframe_supported()) {
     PipelineDesc wireframe = surface;
@@ -435,6 +439,38 @@ Status Renderer::set_stroke(std::span<const Vec3> points) {
   for (const Vec3& p : points) floats.push_back(to_float(p));
   copy_into(stroke_, 0, floats.data(), floats.size() * sizeof(glm::vec3));
   stroke_count_ = uint32_t(points.size());
+  return Status::success();
+}
+
+Status Renderer::set_pen_feedback(const Mesh& network, const PenFeedback& feedback) {
+  std::vector<glm::vec3> data;
+  uint32_t fan = 0;
+  if (network.valid(feedback.face)) {  // a fan around the boundary's centroid, lit by the boundary's normal
+    const std::vector<Vec3> loop = network.face_boundary(feedback.face.index);
+    const LoopPlane plane = loop_plane(loop);
+    const glm::vec3 n = plane.normal.norm() > 0 ? to_float(plane.normal) : glm::vec3(0.0f, 0.0f, 1.0f);
+    for (size_t i = 0; i < loop.size(); ++i)
+      for (const Vec3* p : {&plane.centroid, &loop[i], &loop[(i + 1) % loop.size()]}) {
+        data.push_back(to_float(*p));
+        data.push_back(n);
+      }
+    fan = uint32_t(3 * loop.size());
+  }
+  const bool closes = feedback.closes_border && network.valid(feedback.first_vertex);
+  const bool marker = closes || network.valid(feedback.target_edge);
+  if (marker) data.push_back(to_float(feedback.target));
+  pen_face_vertices_ = fan;
+  pen_marker_ = marker;
+  pen_closes_ = closes;
+  if (data == pen_copy_ || data.empty()) return Status::success();
+  bool grown = false;
+  FIRE_TRY(reserve(pen_, data.size() * sizeof(glm::vec3), kVertex, grown));
+  // The marker comes last: a pen moving along a curve over the same face copies only the marker.
+  size_t first = 0;
+  if (!grown && data.size() == pen_copy_.size())
+    first = size_t(std::mismatch(data.begin(), data.end(), pen_copy_.begin()).first - data.begin());
+  copy_into(pen_, first * sizeof(glm::vec3), data.data() + first, (data.size() - first) * sizeof(glm::vec3));
+  pen_copy_ = std::move(data);
   return Status::success();
 }
 
@@ -581,6 +617,13 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
     vkCmdBindIndexBuffer(cmd, reference_indices_.buffer, 0, VK_INDEX_TYPE_UINT32);
     vkCmdDrawIndexed(cmd, reference_index_count_, 1, 0, 0, 0);
   }
+  if (pen_face_vertices_) {  // over the see-through reference, which would wash it out
+    pc.color = linear(Palette::pen_face, Palette::pen_face_alpha);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pen_face_);
+    push();
+    vkCmdBindVertexBuffers(cmd, 0, 1, &pen_.buffer, &zero);
+    vkCmdDraw(cmd, pen_face_vertices_, 1, 0, 0);
+  }
   if (stroke_count_) {  // after the see-through reference, so the pen's trace shows in full
     pc.color = linear(Palette::stroke);
     pc.params.x = std::max(1.0f, 2.0f * scale);
@@ -589,6 +632,16 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
     push();
     vkCmdBindVertexBuffers(cmd, 0, 1, &stroke_.buffer, &zero);
     vkCmdDraw(cmd, 6, stroke_count_ - 1, 0, 0);
+  }
+  if (pen_marker_) {  // last: the marker says where the stroke will end, over the stroke itself
+    pc.color = linear(pen_closes_ ? Palette::close_border : Palette::snap_target);
+    pc.params.x = std::max(4.0f, (pen_closes_ ? 10.0f : 7.5f) * scale);
+    pc.params.w = camera.line_depth_pull * 3.0f;
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, markers_);
+    push();
+    const VkDeviceSize at = VkDeviceSize(2 * pen_face_vertices_) * sizeof(glm::vec3);
+    vkCmdBindVertexBuffers(cmd, 0, 1, &pen_.buffer, &at);
+    vkCmdDraw(cmd, 6, 1, 0, 0);
   }
   vkCmdEndRendering(cmd);
 

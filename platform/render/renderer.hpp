@@ -5,7 +5,9 @@
 // What it draws, back to front: a neutral gradient background; the surface, lit (two-sided Blinn-Phong)
 // and tinted while it is provisional (SurfaceLevels::settled false); every live edge's polyline as a
 // screen-space line pulled slightly towards the camera so it shows on the surface it lies on; the
-// network's vertices as round markers; an optional see-through reference mesh.
+// network's vertices as round markers; an optional see-through reference mesh; the pen's feedback
+// (engine/pen_feedback.hpp): the face under the pen tinted see-through over everything but the stroke, the snap target as a
+// large marker, and the border's first vertex as a larger one when a stroke ending at the pen would close it.
 //
 // Uploads copy only what changed and count the bytes (UploadStats, per upload() call, i.e. per frame):
 // - points: the GPU keeps a float copy of the point pool at the pool's indices. An edge's points are
@@ -21,6 +23,7 @@
 #include <vector>
 
 #include "engine/mesh.hpp"
+#include "engine/pen_feedback.hpp"
 #include "engine/surface.hpp"
 #include "platform/render/camera.hpp"
 #include "platform/render/context.hpp"
@@ -43,6 +46,10 @@ struct Palette {
   static constexpr uint8_t reference[3] = {120, 170, 255};
   static constexpr uint8_t wireframe[3] = {40, 44, 52};
   static constexpr uint8_t stroke[3] = {255, 220, 60};  // the stroke being drawn, not yet a curve
+  static constexpr uint8_t pen_face[3] = {255, 70, 200};       // tint of the face under the pen
+  static constexpr uint8_t snap_target[3] = {40, 225, 255};    // where a stroke end at the pen snaps
+  static constexpr uint8_t close_border[3] = {70, 235, 110};   // the first vertex, when a stroke end closes the border
+  static constexpr float pen_face_alpha = 0.4f;
 };
 
 // What a frame shows: the app's toggles. The wireframe (the surface's quads as lines) needs the device's
@@ -73,6 +80,10 @@ class Renderer {
   // Its points are copied whole each call, after upload() so they count in last_upload(): a stroke is short
   // next to the scene.
   Status set_stroke(std::span<const Vec3> points);
+  // The pen's feedback as the sketch system published it for `network`; elements whose handle no longer
+  // holds are not drawn. Copies from the first value that changed since the last call (the marker alone while the
+  // pen moves over one face), counted in last_upload().
+  Status set_pen_feedback(const Mesh& network, const PenFeedback& feedback);
   // A mesh drawn see-through over the scene (triangles: 3 indices each); empty triangles removes it.
   Status set_reference(std::span<const Vec3> positions, std::span<const uint32_t> triangles);
 
@@ -130,7 +141,8 @@ class Renderer {
   VkFence fence_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkPipeline background_ = VK_NULL_HANDLE, surface_ = VK_NULL_HANDLE, reference_pipeline_ = VK_NULL_HANDLE,
-             curves_ = VK_NULL_HANDLE, markers_ = VK_NULL_HANDLE, wireframe_ = VK_NULL_HANDLE;
+             curves_ = VK_NULL_HANDLE, markers_ = VK_NULL_HANDLE, wireframe_ = VK_NULL_HANDLE,
+             pen_face_ = VK_NULL_HANDLE;
 
   // Network: float points at pool indices, and what was uploaded per edge slot.
   struct EdgeRecord {
@@ -155,6 +167,11 @@ class Renderer {
 
   Buffer stroke_;
   uint32_t stroke_count_ = 0;
+  // Pen feedback: the face's triangle fan (position and normal per vertex), then the marker's position.
+  Buffer pen_;
+  std::vector<glm::vec3> pen_copy_;  // what pen_ holds
+  uint32_t pen_face_vertices_ = 0;
+  bool pen_marker_ = false, pen_closes_ = false;
   Buffer reference_vertices_, reference_indices_;
   uint32_t reference_index_count_ = 0;
 

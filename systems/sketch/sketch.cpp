@@ -1,5 +1,6 @@
 #include "systems/sketch/sketch.hpp"
 
+#include <Eigen/Geometry>  // cross products
 #include <algorithm>
 #include <iterator>
 #include <limits>
@@ -74,19 +75,90 @@ Snap snap_to_face(const Mesh& m, const SnapIndex& index, const Vec3& start, cons
 
 uint32_t pick_edge(const SnapIndex& index, const Vec3& p, double limit) { return index.nearest(p, limit).edge; }
 
+uint32_t face_under(const Mesh& m, const Vec3& p) {
+  uint32_t best = kNone;
+  double best_height = std::numeric_limits<double>::infinity();
+  for (uint32_t f = 0; f < m.face_slots(); ++f) {
+    if (!m.face_alive(f)) continue;
+    const std::vector<Vec3> loop = m.face_boundary(f);
+    const LoopPlane lp = loop_plane(loop);
+    const Vec3 &centroid = lp.centroid, &normal = lp.normal;
+    if (normal.norm() == 0) continue;  // a degenerate loop has no inside
+    double extent = 0;
+    for (const Vec3& q : loop) extent = std::max(extent, (q - centroid).norm());
+    const double height = std::abs((p - centroid).dot(normal));
+    if (height > extent || height >= best_height) continue;
+    // Crossing test in the plane, on a basis (u, v) of it.
+    const Vec3 u = normal.unitOrthogonal(), v = normal.cross(u);
+    auto plane = [&](const Vec3& q) { return std::pair{(q - centroid).dot(u), (q - centroid).dot(v)}; };
+    const auto [px, py] = plane(p);
+    bool inside = false;
+    for (size_t i = 0, j = loop.size() - 1; i < loop.size(); j = i++) {
+      const auto [xi, yi] = plane(loop[i]);
+      const auto [xj, yj] = plane(loop[j]);
+      if ((yi > py) != (yj > py) && px < xj + (py - yj) * (xi - xj) / (yi - yj)) inside = !inside;
+    }
+    if (inside) {
+      best = f;
+      best_height = height;
+    }
+  }
+  return best;
+}
+
+namespace {
+
+// What the pen would do now, against the mesh as the frame found it.
+void publish_feedback(const Mesh& mesh, const SnapIndex& snap, const SketchState& state, double start_radius,
+                      PenFeedback& fb) {
+  fb.pen_down = state.pen_down;
+  fb.target_edge = {};
+  fb.face = {};
+  fb.first_vertex = {};
+  fb.closes_border = false;
+  if (!fb.pen_seen || mesh.edge_count() == 0) return;
+  if (border_open(mesh)) {
+    const uint32_t first = border_ends(mesh).first;
+    if (first == kNone) return;
+    fb.first_vertex = mesh.vertex_id(first);
+    fb.closes_border = (fb.pen - mesh.vertices.position[first]).norm() <= fb.radius;
+    if (fb.closes_border) fb.target = mesh.vertices.position[first];
+    return;
+  }
+  if (state.pen_down && !state.stroke.empty()) {  // where the stroke would end, as the pen going up would place it
+    const Snap s = snap_to_face(mesh, snap, state.stroke.front(), fb.pen, std::max(start_radius, fb.radius));
+    if (s.face != kNone) {
+      fb.face = mesh.face_id(s.face);
+      fb.target_edge = mesh.edge_id(s.end.edge);
+      fb.target_point = s.end.point;
+      fb.target = mesh.polyline(s.end.edge)[s.end.point];
+      return;
+    }
+  }
+  if (const SnapHit h = snap.nearest(fb.pen, fb.radius); h.found()) {
+    fb.target_edge = mesh.edge_id(h.edge);
+    fb.target_point = h.point;
+    fb.target = mesh.polyline(h.edge)[h.point];
+  }
+  if (const uint32_t f = face_under(mesh, fb.pen); f != kNone) fb.face = mesh.face_id(f);
+}
+
+}  // namespace
+
 void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh, const SnapIndex& snap,
                    const SketchSettings& settings, SketchState& state, std::vector<EditRequest>& requests,
-                   std::vector<Rejection>& rejections) {
+                   std::vector<Rejection>& rejections, PenFeedback& feedback) {
   requests.clear();
   // At most one request per frame, so every request is placed on the mesh as the previous one left it;
   // events after it wait in `pending` for the next frame.
+  auto radius = [&](double logged) { return logged > 0 ? logged : settings.snap_distance; };
   std::vector<InputEvent> events = std::move(state.pending);
   state.pending.clear();
   events.insert(events.end(), frame_events.begin(), frame_events.end());
   for (size_t i = 0; i < events.size(); ++i) {
     if (!requests.empty()) {
       state.pending.assign(events.begin() + i, events.end());
-      return;
+      break;
     }
     const InputEvent& ev = events[i];
     auto reject = [&](std::string why) { rejections.push_back({ev.t_us, ev.line, std::move(why)}); };
@@ -97,12 +169,18 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
         state.stroke.clear();
         break;
       case EventKind::Pen:
+        feedback.pen_seen = true;
+        feedback.pen = ev.p;
+        feedback.radius = radius(ev.snap);
         if (!state.pen_down) break;
         if (state.stroke.empty()) state.start_snap = ev.snap;
         state.end_snap = ev.snap;
         state.stroke.push_back(ev.p);
         break;
       case EventKind::Up: {
+        // Where a lifted pen is stays unknown until its next sample: the mouse sends none until the next drag,
+        // and a face left tinted after the stroke would show what no longer is.
+        feedback.pen_seen = false;
         if (!state.pen_down) {
           reject("pen up without pen down");
           break;
@@ -121,7 +199,6 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           reject("the stroke has a pen sample that is not finite (NaN or infinity)");
           break;
         }
-        auto radius = [&](double logged) { return logged > 0 ? logged : settings.snap_distance; };
         const double end_snap = radius(state.end_snap), both_snap = std::max(radius(state.start_snap), end_snap);
         if (mesh.edge_count() == 0) {
           r.command.kind = EditKind::StartBorder;
@@ -166,13 +243,15 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           }
           r.command.kind = EditKind::CloseBorder;
           r.command.snap_distance = settings.snap_distance;
-        } else {
+        } else {  // delete or sharp: the curve nearest to the picked point
+          const bool remove = ev.command == CommandKind::Delete;
           uint32_t e = pick_edge(snap, ev.p, settings.snap_distance);
           if (e == kNone) {
-            reject("delete: no curve within " + std::to_string(settings.snap_distance) + " of the picked point");
+            reject(std::string(remove ? "delete" : "sharp") + ": no curve within " +
+                   std::to_string(settings.snap_distance) + " of the picked point");
             break;
           }
-          r.command.kind = EditKind::DeleteCurve;
+          r.command.kind = remove ? EditKind::DeleteCurve : EditKind::ToggleSharp;
           r.command.edge = e;
         }
         requests.push_back(std::move(r));
@@ -184,6 +263,7 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
         break;  // device reports are the triangulate system's; truth and meta are not for replay
     }
   }
+  publish_feedback(mesh, snap, state, radius(state.start_snap), feedback);
 }
 
 }  // namespace fire

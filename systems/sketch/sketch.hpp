@@ -9,9 +9,10 @@
 #include <vector>
 
 #include "engine/input_log.hpp"
-#include "engine/mesh.hpp"
-#include "engine/snap_index.hpp"
 #include "engine/edit_command.hpp"
+#include "engine/mesh.hpp"
+#include "engine/pen_feedback.hpp"
+#include "engine/snap_index.hpp"
 
 namespace fire {
 
@@ -41,9 +42,15 @@ Snap snap_to_face(const Mesh& mesh, const SnapIndex& index, const Vec3& start, c
 // The live edge with a polyline point nearest to p within `limit` (the lowest slot on ties), or kNone.
 uint32_t pick_edge(const SnapIndex& index, const Vec3& p, double limit);
 
-// Emits at most one request per frame (see `pending`). `snap` is in step with `mesh`.
+// The live face the pen is over: the pen projects inside its boundary, seen along the boundary's mean normal
+// (Newell), and lies off that plane by at most the boundary's distance from its centroid; of several, the one
+// nearest its plane (the lowest slot on ties). kNone when there is none.
+uint32_t face_under(const Mesh& mesh, const Vec3& p);
+
+// Emits at most one request per frame (see `pending`). `snap` is in step with `mesh`. Publishes `feedback`
+// (engine/pen_feedback.hpp) for the mesh as this frame found it, from the last pen sample handled.
 void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh, const SnapIndex& snap,
                    const SketchSettings& settings, SketchState& state, std::vector<EditRequest>& requests,
-                   std::vector<Rejection>& rejections);
+                   std::vector<Rejection>& rejections, PenFeedback& feedback);
 
 }  // namespace fire

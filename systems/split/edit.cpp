@@ -225,6 +225,16 @@ EditOutcome delete_curve(Mesh& m, const EditCommand& c) {
   return EditOutcome::success();
 }
 
+// A crease for subdivision along an inner curve; the border is a crease already.
+EditOutcome toggle_sharp(Mesh& m, const EditCommand& c) {
+  const uint32_t e = c.edge;
+  if (!m.edge_alive(e)) return EditOutcome::reject("edge " + str(e) + " does not exist");
+  if (m.is_border_edge(e))
+    return EditOutcome::reject("edge " + str(e) + " is on the border polygon, which is always a crease; only curves inside it can be marked sharp");
+  m.set_edge_flag(e, kSharpEdge, !(m.edges.flags[e] & kSharpEdge));
+  return EditOutcome::success();
+}
+
 }  // namespace
 
 uint32_t split_edge(Mesh& m, uint32_t e, uint32_t point) {
@@ -254,6 +264,7 @@ EditOutcome execute_edit(Mesh& mesh, const EditCommand& c) {
     case EditKind::CloseBorder: return close_border(mesh, c);
     case EditKind::SplitFace: return split_face(mesh, c);
     case EditKind::DeleteCurve: return delete_curve(mesh, c);
+    case EditKind::ToggleSharp: return toggle_sharp(mesh, c);
   }
   return EditOutcome::reject("unknown edit command");
 }
@@ -315,7 +326,7 @@ bool load_command(SnapshotReader& in, EditCommand& c) {
   in.get(c.end.point);
   in.get(c.edge);
   in.get(c.snap_distance);
-  if (kind > uint8_t(EditKind::DeleteCurve)) in.fail();
+  if (kind > uint8_t(EditKind::ToggleSharp)) in.fail();
   c.kind = EditKind(kind);
   return in.ok();
 }

@@ -1,6 +1,6 @@
 #pragma once
 // The editing operations a person performs while drawing (thesis 5.4): the border polygon, face
-// splitting by a new curve, deleting a curve, and undo/redo of all of them.
+// splitting by a new curve, deleting a curve, marking a curve sharp (or smooth again), and undo/redo of all of them.
 //
 // Every operation checks its whole input before it changes anything: a rejected command leaves the
 // pools exactly as they were and says why.
@@ -15,7 +15,8 @@ namespace fire {
 // AppendBorder starts the new edge at the last vertex of the open border (its first point is moved
 // there, as thesis 5.4.1 prescribes); CloseBorder adds the last edge, whose last point must lie within
 // snap_distance of the first vertex, and creates the first face. SplitFace and DeleteCurve need a
-// closed border.
+// closed border. ToggleSharp flips an inner curve's sharp flag (a crease of the surface); border curves are
+// creases already and are refused.
 EditOutcome execute_edit(Mesh& mesh, const EditCommand& command);
 
 // Splits edge e at interior polyline point `point` (0 < point < count-1): a new vertex and two edges

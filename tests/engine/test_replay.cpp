@@ -37,6 +37,16 @@ std::string stroke(int64_t& t, std::initializer_list<Vec3> pts) {
   return s;
 }
 
+// A 10 cm square border in four strokes; the last closes it, ending within 1 cm of the start.
+std::string square_log(int64_t& t) {
+  std::string text = "FIRE-LOG 1\n";
+  text += stroke(t, {{0, 0, 0}, {0.05, 0, 0}, {0.1, 0, 0}});
+  text += stroke(t, {{0.1, 0, 0}, {0.1, 0.05, 0}, {0.1, 0.1, 0}});
+  text += stroke(t, {{0.1, 0.1, 0}, {0.05, 0.1, 0}, {0, 0.1, 0}});
+  text += stroke(t, {{0, 0.1, 0}, {0, 0.05, 0}, {0.002, 0.001, 0}});
+  return text;
+}
+
 }  // namespace
 
 TEST_CASE("the demo log replays to the same pools every time", "[replay]") {
@@ -61,11 +71,7 @@ TEST_CASE("the demo log replays to the same pools every time", "[replay]") {
 
 TEST_CASE("strokes become a border, a split, and an undo", "[replay]") {
   int64_t t = 0;
-  std::string text = "FIRE-LOG 1\n";
-  text += stroke(t, {{0, 0, 0}, {0.05, 0, 0}, {0.1, 0, 0}});
-  text += stroke(t, {{0.1, 0, 0}, {0.1, 0.05, 0}, {0.1, 0.1, 0}});
-  text += stroke(t, {{0.1, 0.1, 0}, {0.05, 0.1, 0}, {0, 0.1, 0}});
-  text += stroke(t, {{0, 0.1, 0}, {0, 0.05, 0}, {0.002, 0.001, 0}});  // closes: within 1 cm of the start
+  std::string text = square_log(t);
   auto w = replay_text(text);
   CHECK(w->mesh.face_count() == 1);
   CHECK(w->mesh.edge_count() == 4);
@@ -81,6 +87,37 @@ TEST_CASE("strokes become a border, a split, and an undo", "[replay]") {
   w = replay_text(deleted);
   CHECK(w->mesh.face_count() == 1);
   CHECK(w->mesh.vertex_count() == 4);
+}
+
+TEST_CASE("a curve marked sharp creases the surface; undo, redo and a replay of the log reproduce it bit for bit",
+          "[replay][sharp]") {
+  int64_t t = 0;
+  std::string text = square_log(t);
+  text += stroke(t, {{0.051, 0.001, 0}, {0.05, 0.05, 0.01}, {0.049, 0.099, 0}});
+  const auto smooth = replay_text(text);
+  const std::string marked = text + std::to_string(t) + " cmd sharp 0.05 0.05 0.01\n";
+  const auto sharp = replay_text(marked);
+  CHECK(sharp->rejections.empty());
+  uint32_t middle = kNone;
+  for (uint32_t e = 0; e < sharp->mesh.edge_slots(); ++e)
+    if (sharp->mesh.edge_alive(e) && !sharp->mesh.is_border_edge(e)) middle = e;
+  REQUIRE(middle != kNone);
+  CHECK((sharp->mesh.edges.flags[middle] & kSharpEdge) != 0);
+  // The live surface creased along it, as a reconstruction from scratch of the marked network does.
+  REQUIRE(sharp->surface.quad_count() == smooth->surface.quad_count());
+  CHECK(surface_hash(sharp->surface) != surface_hash(smooth->surface));
+  auto fresh = reconstruct::reconstruct_surface(sharp->mesh, sharp->surface_options);
+  REQUIRE(fresh);
+  CHECK(fresh->positions == sharp->surface.positions);
+
+  const std::string undone = marked + std::to_string(t + 10000) + " cmd undo\n";
+  CHECK(world_hash(*replay_text(undone)) == world_hash(*smooth));
+  CHECK(world_hash(*replay_text(undone + std::to_string(t + 20000) + " cmd redo\n")) == world_hash(*sharp));
+  // The log as the app records it (format_input_log) replays to the same pools and surface.
+  CHECK(world_hash(*replay_text(format_input_log(sharp->log.events))) == world_hash(*sharp));
+  const auto missed = replay_text(text + std::to_string(t) + " cmd sharp 0.05 0.5 0\n");
+  REQUIRE(missed->rejections.size() == 1);
+  CHECK_THAT(missed->rejections[0].reason, Catch::Matchers::Contains("sharp: no curve within"));
 }
 
 TEST_CASE("a stroke with NaN or ends on two faces is rejected and nothing drawn is lost", "[replay][reject]") {

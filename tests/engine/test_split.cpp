@@ -25,6 +25,16 @@ void apply_undo_redo(Mesh& m, EditHistory& h, const EditCommand& cmd) {
   CHECK(m.same_pools(after));
 }
 
+// The square split in half by a vertical curve (through `h`); returns that curve's edge.
+uint32_t split_square(Mesh& m, EditHistory& h) {
+  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok);
+  uint32_t middle = kNone;
+  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e) && !m.is_border_edge(e)) middle = e;
+  REQUIRE(middle != kNone);
+  return middle;
+}
+
 size_t border_edges(const Mesh& m) {
   size_t n = 0;
   for (uint32_t e = 0; e < m.edge_slots(); ++e)
@@ -211,10 +221,7 @@ TEST_CASE("deleting a curve merges its faces and joins the edge splits it needed
   EditHistory h;
   Mesh m = square(&h);
   std::vector<Vec3> bottom(m.polyline(0).begin(), m.polyline(0).end());
-  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok);
-  uint32_t middle = kNone;
-  for (uint32_t e = 0; e < m.edge_slots(); ++e)
-    if (m.edge_alive(e) && !m.is_border_edge(e)) middle = e;
+  const uint32_t middle = split_square(m, h);
   EditCommand del = make(EditKind::DeleteCurve);
   del.edge = middle;
   apply_undo_redo(m, h, del);
@@ -255,6 +262,36 @@ TEST_CASE("deleting a curve keeps a vertex other curves still need", "[split][de
   CHECK(m.vertex_alive(a));  // still holds the second curve
   CHECK(m.valence(a) == 3);
   CHECK(face_sizes(m) == std::vector<uint32_t>{3, 4});
+}
+
+TEST_CASE("marking a curve sharp flips its flag, undoes and redoes bit for bit; the border is refused", "[split][sharp]") {
+  EditHistory h;
+  Mesh m = square(&h);
+  const uint32_t middle = split_square(m, h);
+  EditCommand sharp = make(EditKind::ToggleSharp);
+  sharp.edge = middle;
+  const size_t depth = h.undo_depth();
+  m.begin_frame(7);
+  apply_undo_redo(m, h, sharp);
+  CHECK((m.edges.flags[middle] & kSharpEdge) != 0);
+  CHECK(m.edges.changes.stamp[middle] == 7);  // stamped: refine sees the crease
+  CHECK(h.undo_depth() == depth + 1);
+  apply_undo_redo(m, h, sharp);  // again: smooth
+  CHECK((m.edges.flags[middle] & kSharpEdge) == 0);
+  CHECK(m.validate() == "");
+
+  const Mesh before = m;
+  EditCommand border = make(EditKind::ToggleSharp);
+  border.edge = edge_between(m, 1, 2);
+  REQUIRE(border.edge != kNone);
+  const EditOutcome refused = h.apply(m, border);
+  CHECK_FALSE(refused.ok);
+  CHECK_THAT(refused.reason, Catch::Contains("border"));
+  EditCommand missing = make(EditKind::ToggleSharp);
+  missing.edge = 999;
+  CHECK_THAT(h.apply(m, missing).reason, Catch::Contains("does not exist"));
+  CHECK(m.same_pools(before));
+  CHECK(h.undo_depth() == depth + 2);
 }
 
 TEST_CASE("compaction squeezes tombstones and keeps the network", "[pools]") {

@@ -103,6 +103,7 @@ bool AppWindow::display(const render::Orbit& orbit, render::Image* capture) {
   if (status_ = renderer_->upload(w.mesh, w.surface); !status_) return false;
   const std::span<const Vec3> stroke = w.sketch.pen_down ? std::span<const Vec3>(w.sketch.stroke) : std::span<const Vec3>();
   if (status_ = renderer_->set_stroke(stroke); !status_) return false;
+  if (status_ = renderer_->set_pen_feedback(w.mesh, w.pen_feedback); !status_) return false;
   stages_.upload = ms_since(mark);
   const auto wall_now = WallClock::now();
   hud_data.frame_ms = std::chrono::duration<double, std::milli>(wall_now - last_frame_).count();

@@ -3,7 +3,7 @@
 // the benchmark measures the frame a person sees.
 //
 // One displayed frame (display()): the session's systems for every fixed step the wall clock has passed,
-// the renderer's uploads (changed ranges only) and the stroke in progress, the HUD, the present (vsync).
+// the renderer's uploads (changed ranges only), the stroke in progress and the pen's feedback, the HUD, the present (vsync).
 #include <chrono>
 #include <memory>
 #include <span>
@@ -22,7 +22,7 @@ render::Box scene_box(const Mesh& mesh, const SurfaceLevels& surface, std::span<
 struct FrameStages {
   double systems = 0;  // the fixed steps the wall clock has passed
   double wait = 0;     // the previous frame's commands (on lavapipe: its rasterization)
-  double upload = 0;   // changed ranges of the pools and the surface, and the stroke
+  double upload = 0;   // changed ranges of the pools and the surface, the stroke, the pen's feedback
   double hud = 0;      // the HUD's layout
   double present = 0;  // acquire, record, submit and present
 };

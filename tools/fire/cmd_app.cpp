@@ -21,6 +21,7 @@
 #include "platform/files.hpp"
 #include "platform/network_file.hpp"
 #include "platform/obj.hpp"
+#include "platform/surface_io.hpp"
 #include "systems/evaluate/evaluate.hpp"
 #include "tools/fire/app_window.hpp"
 #include "tools/fire/commands.hpp"
@@ -31,7 +32,8 @@ namespace fire::cli {
 namespace {
 
 struct AppArgs {
-  std::string input_path, reference_path, out_path, record_path, script_path, screenshot_path, size = "1280x720";
+  std::string input_path, reference_path, out_path, export_path, record_path, script_path, screenshot_path,
+      size = "1280x720";
   uint32_t levels = 3;
   int reference_levels = 3;
   double snap_pixels = 12;
@@ -56,9 +58,10 @@ const std::vector<std::string> kKeys = {
     "Ctrl+Shift+Z    redo (logged; also Ctrl+Y)",
     "C               close the border to its first vertex (logged)",
     "Delete          delete the curve under the cursor (logged)",
+    "K               the curve under the cursor sharp / smooth (logged)",
     "1 / 2 / 3       surface / curves / wireframe on or off",
     "F               frame everything",
-    "Ctrl+S          save the network (-o, or the default path)",
+    "Ctrl+S / E      save the network (-o) / export the surface (--export)",
     "H or F1         this help",
     "Esc             quit",
 };
@@ -145,11 +148,12 @@ Result<std::vector<ScriptEvent>> read_script(const std::string& path) {
   return events;
 }
 
-// The polyline point nearest to the cursor on screen, within `radius` pixels: what Delete picks.
-bool curve_point_under(const Mesh& mesh, const render::Camera& camera, uint32_t width, uint32_t height, glm::vec2 cursor,
-                       float radius, Vec3& out) {
+// The polyline point nearest to the cursor on screen, within `radius` pixels, and its edge (kNone: none):
+// what Delete and K pick.
+uint32_t curve_point_under(const Mesh& mesh, const render::Camera& camera, uint32_t width, uint32_t height,
+                           glm::vec2 cursor, float radius, Vec3& out) {
   float best = radius * radius;
-  bool found = false;
+  uint32_t found = kNone;
   for (uint32_t e = 0; e < mesh.edge_slots(); ++e) {
     if (!mesh.edge_alive(e)) continue;
     for (const Vec3& p : mesh.polyline(e)) {
@@ -159,7 +163,7 @@ bool curve_point_under(const Mesh& mesh, const render::Camera& camera, uint32_t 
       if (glm::dot(d, d) < best) {
         best = glm::dot(d, d);
         out = p;
-        found = true;
+        found = e;
       }
     }
   }
@@ -170,6 +174,11 @@ std::string default_output(const std::string& input) {
   if (input.empty()) return "fire-app.fnet";
   std::filesystem::path p(input);
   return (p.parent_path() / (p.stem().string() + "-app.fnet")).string();
+}
+
+// Beside the network Ctrl+S saves: its name with .obj.
+std::string default_export(const std::string& network_path) {
+  return std::filesystem::path(network_path).replace_extension(".obj").string();
 }
 
 int run_app(const AppArgs& a) {
@@ -192,6 +201,8 @@ int run_app(const AppArgs& a) {
     if (!s) return fail("--script: " + s.error());
     script = std::move(*s);
   }
+  if (!a.export_path.empty())
+    if (auto format = surface_format_of(a.export_path); !format) return fail("--export: " + format.error());
   if (a.reference_levels < 0 || a.reference_levels > 5) return fail("--reference-levels must be 0 to 5");
   if (!(a.snap_pixels > 0) || a.snap_pixels > 200) return fail("--snap-pixels must be above 0 and at most 200");
   // The reference as drawn on: its Catmull-Clark limit surface (a control mesh), or its faces as fans (level 0).
@@ -242,6 +253,11 @@ int run_app(const AppArgs& a) {
   window::HudData& hud_data = app.hud_data;
   hud_data.keys = kKeys;
   const std::string out_path = a.out_path.empty() ? default_output(a.input_path) : a.out_path;
+  const std::string export_path = a.export_path.empty() ? default_export(out_path) : a.export_path;
+  auto report = [&](std::string message) {
+    hud_data.status = std::move(message);
+    std::cerr << "fire app: " << hud_data.status << "\n";
+  };
   auto log_command = [&](CommandKind command, const Vec3& p) {
     InputEvent e;
     e.kind = EventKind::Command;
@@ -318,14 +334,29 @@ int run_app(const AppArgs& a) {
         else if (ctrl && e.key == GLFW_KEY_Y) log_command(CommandKind::Redo, Vec3::Zero());
         else if (ctrl && e.key == GLFW_KEY_S) {
           const Status saved = save_network(w.mesh, out_path);
-          hud_data.status = saved ? "saved " + std::to_string(w.mesh.edge_count()) + " curves to " + out_path : saved.error;
-          std::cerr << "fire app: " << hud_data.status << "\n";
+          report(saved ? "saved " + std::to_string(w.mesh.edge_count()) + " curves to " + out_path : saved.error);
         } else if (ctrl) break;
         else if (e.key == GLFW_KEY_C) log_command(CommandKind::Close, Vec3::Zero());
         else if (e.key == GLFW_KEY_DELETE) {
           Vec3 p;
-          if (curve_point_under(w.mesh, app.camera(), app.width(), app.height(), cursor, 12.0f, p)) log_command(CommandKind::Delete, p);
+          if (curve_point_under(w.mesh, app.camera(), app.width(), app.height(), cursor, 12.0f, p) != kNone)
+            log_command(CommandKind::Delete, p);
           else hud_data.status = "no curve under the cursor to delete";
+        } else if (e.key == GLFW_KEY_K) {
+          Vec3 p;
+          const uint32_t edge = curve_point_under(w.mesh, app.camera(), app.width(), app.height(), cursor, 12.0f, p);
+          if (edge == kNone) hud_data.status = "no curve under the cursor to mark sharp";
+          else {
+            log_command(CommandKind::Sharp, p);
+            hud_data.status = w.mesh.edges.flags[edge] & kSharpEdge ? "making the curve smooth" : "marking the curve sharp";
+          }
+        } else if (e.key == GLFW_KEY_E) {
+          // The surface as the frames have built it so far; a failed write leaves the session untouched.
+          if (w.surface.empty()) report("export: no surface yet (it needs a closed border)");
+          else if (const Status s = write_surface(to_surface_mesh(w.surface), export_path); !s) report("export failed: " + s.error);
+          else
+            report("exported " + std::to_string(w.surface.quad_count()) + " surface quads to " + export_path +
+                   (w.surface.settled ? "" : " (provisional: the fit was still converging)"));
         } else if (e.key == GLFW_KEY_1) hud_data.view.surface = !hud_data.view.surface;
         else if (e.key == GLFW_KEY_2) hud_data.view.curves = !hud_data.view.curves;
         else if (e.key == GLFW_KEY_3) hud_data.view.wireframe = !hud_data.view.wireframe;
@@ -403,7 +434,10 @@ void add_app_commands(CLI::App& app, Registry& registry) {
       "session bit for bit. Needs a display (DISPLAY or WAYLAND_DISPLAY); without one it exits 1 and points "
       "to `fire render`. On exit prints one JSON line: display_frames, system_frames, events, edges, faces, "
       "surface_quads, hash (as `fire replay --hash`), device, validation. FIRE_VK_VALIDATION=1 turns the "
-      "validation layer on; any message then fails the command.\n\nKeys:\n" + keys);
+      "validation layer on; any message then fails the command. While a stroke is drawn, the face it would split "
+      "is tinted magenta and the point its end would snap to is marked cyan; on an open border, its first vertex "
+      "is marked green when the stroke would close it there. Ctrl+S and E report in the HUD and on stderr."
+      "\n\nKeys:\n" + keys);
   cmd->add_option("NET", a->input_path, "curve network (.fnet) or input log to start from");
   cmd->add_option("--reference", a->reference_path,
                   "OBJ mesh drawn see-through; a left drag draws on it (ray casts through a BVH): a pen sample at "
@@ -417,6 +451,9 @@ void add_app_commands(CLI::App& app, Registry& registry) {
       ->capture_default_str();
   cmd->add_option("-o,--output", a->out_path, "where Ctrl+S saves the network (default: INPUT-app.fnet beside the "
                                               "input, or fire-app.fnet)");
+  cmd->add_option("--export", a->export_path,
+                  "where E exports the surface; the extension chooses the format: .obj, .ply, .stl or .glb "
+                  "(default: the -o network's path with .obj)");
   cmd->add_option("--record", a->record_path, "write the session's input log here on exit (not with a .fnet input)");
   cmd->add_option("--size", a->size, "window size WIDTHxHEIGHT in pixels")->capture_default_str();
   cmd->add_option("--levels", a->levels, "Catmull-Clark levels of the surface (1 to 6)")->capture_default_str();

@@ -18,9 +18,9 @@ std::vector<SystemSpec> session_systems(World& w) {
   systems.push_back({"triangulate", {"frame_events", "rig"}, {"frame_events"}, {}, [&w] {
                        if (w.rig) triangulate_system(w.frame, *w.rig, w.triangulate, w.frame_events);
                      }});
-  systems.push_back({"sketch", {"frame_events", "sketch_settings"}, {"requests", "rejections"}, {"mesh", "snap"}, [&w] {
+  systems.push_back({"sketch", {"frame_events", "sketch_settings"}, {"requests", "rejections", "pen_feedback"}, {"mesh", "snap"}, [&w] {
                        sketch_system(w.frame_events, w.mesh, w.snap, w.sketch_settings, w.sketch, w.requests,
-                                     w.rejections);
+                                     w.rejections, w.pen_feedback);
                      }});
   systems.push_back({"split", {"requests"}, {"mesh", "rejections"}, {}, [&w] {
                        split_system(w.requests, w.mesh, w.history, w.rejections);

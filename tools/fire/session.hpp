@@ -39,6 +39,7 @@ struct World {
   SketchSettings sketch_settings;
   std::vector<EditRequest> requests;
   std::vector<Rejection> rejections;
+  PenFeedback pen_feedback;  // for the renderer; outside world_hash
   // split
   Mesh mesh;
   SnapIndex snap;  // in step with `mesh` from the end of each frame

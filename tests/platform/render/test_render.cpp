@@ -291,6 +291,77 @@ TEST_CASE("a provisional surface is tinted, a settled one is neutral grey") {
   CHECK(provisional > settled + 25);
 }
 
+TEST_CASE("the pen's feedback: the face under the pen tinted, the snap target and the closing vertex marked") {
+  auto context = make_context();
+  auto renderer = Renderer::create(*context, {kWidth, kHeight});
+  REQUIRE(renderer);
+  Renderer& r = **renderer;
+  Scene scene = demo_scene();
+  const Camera camera = frame_box(box_of(scene), View::top, kWidth, kHeight);
+  auto draw = [&](const Mesh& network, const PenFeedback& feedback) {
+    REQUIRE(r.upload(network, scene.surface));
+    REQUIRE(r.set_pen_feedback(network, feedback));
+    REQUIRE(r.draw(camera));
+    CHECK(context->validation_message_count() == 0);
+    return r.image();
+  };
+  auto pixel_at = [&](const Image& im, const Vec3& p) {
+    const glm::vec2 px = project_to_pixels(camera, p, kWidth, kHeight);
+    return im.pixel(uint32_t(px.x), uint32_t(px.y));
+  };
+  const Mesh& net = scene.network;
+  uint32_t face = 0;
+  while (!net.face_alive(face)) ++face;
+  const Vec3 centre = loop_plane(net.face_boundary(face)).centroid;
+  const uint32_t edge = edge_of(net.face_loop(face)[0]);
+  const uint32_t point = net.edges.point_count[edge] / 2;
+
+  const Image plain = draw(net, {});
+  PenFeedback feedback;
+  feedback.pen_seen = true;
+  feedback.face = net.face_id(face);
+  feedback.target_edge = net.edge_id(edge);
+  feedback.target_point = point;
+  feedback.target = net.polyline(edge)[point];
+  const Image shown = draw(net, feedback);
+  {  // the face's middle turns magenta: red and blue over green, where the plain surface is grey
+    const uint8_t* before = pixel_at(plain, centre);
+    const uint8_t* after = pixel_at(shown, centre);
+    INFO("face centre before " << int(before[0]) << "," << int(before[1]) << "," << int(before[2]) << " after "
+                               << int(after[0]) << "," << int(after[1]) << "," << int(after[2]));
+    CHECK(std::abs(int(before[0]) - int(before[1])) < 20);
+    CHECK(int(after[0]) - int(after[1]) > 30);
+    CHECK(int(after[2]) - int(after[1]) > 20);
+  }
+  CHECK(near(pixel_at(shown, feedback.target), Palette::snap_target, 30));
+  CHECK_FALSE(near(pixel_at(plain, feedback.target), Palette::snap_target, 30));
+  PenFeedback moved = feedback;  // the pen along the same curve: only the marker is copied again
+  moved.target = net.polyline(edge)[point - 1];
+  draw(net, moved);
+  CHECK(r.last_upload().bytes == sizeof(glm::vec3));
+
+  PenFeedback stale = feedback;  // handles whose generation moved on are not drawn
+  ++stale.face.generation;
+  ++stale.target_edge.generation;
+  const Image none = draw(net, stale);
+  CHECK(std::equal(none.rgba.begin(), none.rgba.end(), plain.rgba.begin(), plain.rgba.end()));
+
+  // Border mode: an open border of two curves, the pen by its first vertex.
+  Mesh border;
+  const Vec3 a = net.vertices.position[net.edges.vertex[edge][0]], b = net.vertices.position[net.edges.vertex[edge][1]];
+  const uint32_t va = border.add_vertex(a), vb = border.add_vertex(b), vc = border.add_vertex(centre);
+  border.add_edge(va, vb, std::vector<Vec3>{a, b});
+  border.add_edge(vb, vc, std::vector<Vec3>{b, centre});
+  PenFeedback closing;
+  closing.pen_seen = true;
+  closing.first_vertex = border.vertex_id(va);
+  closing.closes_border = true;
+  closing.target = a;
+  CHECK(near(pixel_at(draw(border, closing), a), Palette::close_border, 30));
+  closing.closes_border = false;  // too far to close: the first vertex is not marked
+  CHECK_FALSE(near(pixel_at(draw(border, closing), a), Palette::close_border, 30));
+}
+
 TEST_CASE("Vulkan failures name the call") {
   CHECK(vk_failure("vkCreateDevice(physical_, &device, nullptr, &device_)", VK_ERROR_DEVICE_LOST) ==
         "vkCreateDevice failed: VK_ERROR_DEVICE_LOST (-4)");

@@ -2,7 +2,8 @@
 // validation layer on: a scripted interaction through the window's GLFW callbacks (an orbit drag, a zoom, the
 // help overlay, an undo, a resize, a close), a screenshot of the presented frame checked by pixel statistics,
 // the recorded input log replayed to the same hash; strokes drawn with the mouse on pawn.obj, replayed bit for
-// bit; and no display: a clear message, no crash.
+// bit; the pen's feedback (closing vertex, tinted face, snap target); a curve marked sharp and the surface
+// exported; and no display, a bad export: a clear message, no crash.
 #include <catch2/catch.hpp>
 #include <cstdlib>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include "platform/files.hpp"
 #include "platform/network_file.hpp"
 #include "platform/render/image.hpp"
+#include "platform/surface_io.hpp"
 #include "platform/render/renderer.hpp"
 
 namespace {
@@ -252,6 +254,129 @@ TEST_CASE("fire app: the stroke in progress is drawn before it becomes a curve",
   CHECK(inside > 150);
   CHECK(outside < 10);
   CHECK(curve_pixels(*image) < 20);
+  fs::remove_all(dir);
+}
+
+// Pixels with `test`, inside the rectangle [x0, x1] x [y0, y1] and outside it.
+template <class Test>
+std::pair<size_t, size_t> count_in_and_out(const Image& im, uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1, Test test) {
+  size_t inside = 0, outside = 0;
+  for (uint32_t y = 0; y < im.height; ++y)
+    for (uint32_t x = 0; x < im.width; ++x)
+      if (test(im.pixel(x, y))) (x >= x0 && x <= x1 && y >= y0 && y <= y1 ? inside : outside)++;
+  return {inside, outside};
+}
+
+// fire app on pawn.obj in a 960x720 window, driven by `script` of this folder.
+Run app_on_pawn(int display, const std::string& script, const std::string& args, const fs::path& dir) {
+  return run(app_command(display, "--reference " + quote(FIRE_PAWN) + " --size 960x720 --script " +
+                                      quote(std::string(FIRE_WINDOW_TEST_DIR "/") + script) + " " + args),
+             dir);
+}
+
+// The screenshot of app_on_pawn(script) and the app's JSON line.
+std::pair<Image, nlohmann::json> pawn_screenshot(int display, const std::string& script) {
+  const fs::path dir = scratch(script);
+  const std::string shot = (dir / "shot.png").string();
+  const Run app = app_on_pawn(display, script, "--screenshot " + quote(shot), dir);
+  INFO("stdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  auto image = fire::render::read_png(shot);
+  REQUIRE(image);
+  fs::remove_all(dir);
+  return {std::move(*image), nlohmann::json::parse(app.out)};
+}
+
+TEST_CASE("fire app: the border's first vertex is marked when the stroke's end would close it", "[app][window][feedback]") {
+  REQUIRE(has_xvfb());
+  const auto [image, json] = pawn_screenshot(240, "feedback_close.script");
+  CHECK(json["edges"] == 3);  // three sides, the fourth still being drawn
+  const auto [inside, outside] = count_in_and_out(image, 418, 168, 442, 192, [](const uint8_t* p) {
+    return near(p, Palette::close_border, 40);
+  });
+  INFO("closing-vertex pixels by the first corner " << inside << ", elsewhere " << outside);
+  CHECK(inside > 40);
+  CHECK(outside < 10);
+}
+
+TEST_CASE("fire app: the face a stroke would split is tinted and its end's snap target marked", "[app][window][feedback]") {
+  REQUIRE(has_xvfb());
+  const auto [image, json] = pawn_screenshot(260, "feedback_split.script");
+  CHECK(json["faces"] == 1);  // the stroke is still being drawn
+  // Magenta: red and blue well above green, which neither the grey surface nor the blue reference have.
+  const auto [tinted, tinted_outside] = count_in_and_out(image, 425, 175, 535, 265, [](const uint8_t* p) {
+    return int(p[0]) - int(p[1]) > 40 && int(p[2]) - int(p[1]) > 20;
+  });
+  INFO("tinted pixels in the square " << tinted << ", outside " << tinted_outside);
+  CHECK(tinted > 3000);  // of about 8000 in the square
+  CHECK(tinted_outside < 50);
+  // The target: on the bottom side below the pen, where the stroke would end.
+  const auto [target, target_outside] = count_in_and_out(image, 468, 248, 492, 272, [](const uint8_t* p) {
+    return near(p, Palette::snap_target, 40);
+  });
+  INFO("snap-target pixels below the pen " << target << ", elsewhere " << target_outside);
+  CHECK(target > 30);
+  CHECK(target_outside < 10);
+}
+
+TEST_CASE("fire app: K marks the curve under the cursor sharp, E exports the surface; both replay or reload",
+          "[app][window][sharp][export]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("sharp_export");
+  const std::string record = (dir / "sharp.log").string(), exported = (dir / "surface.ply").string(),
+                    network = (dir / "replayed.fnet").string();
+  const Run app = app_on_pawn(280, "sharp_export.script", "--record " + quote(record) + " --export " + quote(exported), dir);
+  INFO("stdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  const auto json = nlohmann::json::parse(app.out);
+  CHECK(json["faces"] == 2);
+  const auto log = fire::read_text_file(record);
+  REQUIRE(log);
+  CHECK(log->find(" cmd sharp ") != std::string::npos);
+  // The recorded log replays to the app's hash, and the split curve comes out sharp.
+  const Run replay = run(quote(FIRE_BINARY) + " replay " + quote(record) + " --hash -o " + quote(network), dir);
+  REQUIRE(replay.exit_code == 0);
+  CHECK(replay.out.find(json["hash"].get<std::string>()) != std::string::npos);
+  auto replayed = fire::load_network(network);
+  REQUIRE(replayed);
+  size_t sharp = 0;
+  for (uint32_t e = 0; e < replayed->edge_slots(); ++e)
+    sharp += replayed->edge_alive(e) && (replayed->edges.flags[e] & fire::kSharpEdge);
+  CHECK(sharp == 1);
+  // The export: the surface's quads, read back from the PLY.
+  CHECK(app.err.find("exported " + std::to_string(json["surface_quads"].get<int>()) + " surface quads to " + exported) !=
+        std::string::npos);
+  auto surface = fire::read_surface(exported);
+  INFO(surface.error());
+  REQUIRE(surface);
+  CHECK(surface->face_count() == json["surface_quads"].get<size_t>());
+  fs::remove_all(dir);
+}
+
+TEST_CASE("fire app: an export that cannot be written says why and loses nothing; a bad format is refused",
+          "[app][window][export]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("export_fails");
+  const std::string script = (dir / "export.script").string(), saved = (dir / "saved.fnet").string(),
+                    unwritable = (dir / "missing" / "surface.obj").string();
+  REQUIRE(fire::write_file_atomic(script, "2 key e\n4 key ctrl+s\n8 close\n"));
+  const Run app = run(app_command(300, quote(FIRE_DEMO_LOG) + " --size 320x200 --script " + quote(script) + " -o " +
+                                           quote(saved) + " --export " + quote(unwritable)),
+                      dir);
+  INFO("stdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  CHECK(app.err.find("export failed: ") != std::string::npos);
+  CHECK(app.err.find(unwritable) != std::string::npos);
+  CHECK_FALSE(fs::exists(unwritable));
+  auto network = fire::load_network(saved);  // the session went on: Ctrl+S after it saved every curve
+  REQUIRE(network);
+  CHECK(network->edge_count() == nlohmann::json::parse(app.out)["edges"].get<size_t>());
+
+  const Run bad = run("env -u DISPLAY -u WAYLAND_DISPLAY " + quote(FIRE_BINARY) + " app --export " +
+                          quote((dir / "surface.txt").string()),
+                      dir);
+  CHECK(bad.exit_code == 1);
+  CHECK(bad.err.find("--export: " + (dir / "surface.txt").string() + ": unknown surface format") != std::string::npos);
   fs::remove_all(dir);
 }
 

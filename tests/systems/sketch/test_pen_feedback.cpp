@@ -1,0 +1,150 @@
+// What the sketch system publishes about the pen (engine/pen_feedback.hpp), for scripted input logs on a
+// 10 cm square drawn in the xy plane: the closing vertex in border mode, the snap target and the face under
+// the pen in split mode, the face a stroke in progress would split; none of it in the replay hash.
+#include <catch2/catch.hpp>
+
+#include "tools/fire/session.hpp"
+
+using namespace fire;
+
+namespace {
+
+// A log built line by line, each event 10 ms after the last, so each lands in a frame of its own.
+struct Log {
+  std::string text = "FIRE-LOG 1\n";
+  int64_t t = 0;
+  Log& event(const std::string& what) {
+    text += std::to_string(t += 10000) + " " + what + "\n";
+    return *this;
+  }
+  Log& pen(double x, double y, double z = 0) {
+    return event("pen " + format_double(x) + " " + format_double(y) + " " + format_double(z));
+  }
+  Log& stroke(std::initializer_list<Vec3> points) {
+    event("down");
+    for (const Vec3& p : points) pen(p.x(), p.y(), p.z());
+    return event("up");
+  }
+};
+
+int64_t step_clock() {
+  static int64_t t = 0;
+  return t += 1000;
+}
+
+std::unique_ptr<World> replay(const Log& log) {
+  auto parsed = parse_input_log(log.text, "feedback.log");
+  REQUIRE(parsed);
+  auto w = std::make_unique<World>();
+  w->log = std::move(*parsed);
+  Scheduler scheduler = make_scheduler(*w, step_clock);
+  replay_headless(*w, scheduler);
+  return w;
+}
+
+// Three sides of the square; the fourth closes it when it ends within the default 1 cm of (0, 0, 0).
+Log open_border() {
+  Log log;
+  log.stroke({{0, 0, 0}, {0.05, 0, 0}, {0.1, 0, 0}});
+  log.stroke({{0.1, 0, 0}, {0.1, 0.05, 0}, {0.1, 0.1, 0}});
+  log.stroke({{0.1, 0.1, 0}, {0.05, 0.1, 0}, {0, 0.1, 0}});
+  return log;
+}
+
+Log closed_square() {
+  Log log = open_border();
+  log.stroke({{0, 0.1, 0}, {0, 0.05, 0}, {0.002, 0.001, 0}});
+  return log;
+}
+
+}  // namespace
+
+TEST_CASE("border mode: the first vertex is marked when a stroke ending at the pen would close the border",
+          "[sketch][feedback]") {
+  Log near_start = open_border();
+  near_start.pen(0.003, 0.002);  // hovering, pen up, 3.6 mm from the first vertex
+  auto w = replay(near_start);
+  REQUIRE(w->mesh.face_count() == 0);
+  const PenFeedback& fb = w->pen_feedback;
+  CHECK(fb.pen_seen);
+  CHECK_FALSE(fb.pen_down);
+  REQUIRE(w->mesh.valid(fb.first_vertex));
+  CHECK(w->mesh.vertices.position[fb.first_vertex.index] == Vec3(0, 0, 0));
+  CHECK(fb.closes_border);
+  CHECK(fb.has_target());
+  CHECK(fb.target == Vec3(0, 0, 0));
+  CHECK_FALSE(fb.face.valid());
+
+  Log far = open_border();
+  far.pen(0.05, 0.05);
+  w = replay(far);
+  CHECK(w->mesh.valid(w->pen_feedback.first_vertex));
+  CHECK_FALSE(w->pen_feedback.closes_border);
+  CHECK_FALSE(w->pen_feedback.has_target());
+}
+
+TEST_CASE("split mode: the snap target and the face under the pen", "[sketch][feedback]") {
+  Log log = closed_square();
+  log.pen(0.051, 0.003);  // 3.2 mm from the bottom curve's middle point
+  auto w = replay(log);
+  REQUIRE(w->mesh.face_count() == 1);
+  const PenFeedback& fb = w->pen_feedback;
+  REQUIRE(w->mesh.valid(fb.target_edge));
+  CHECK(fb.target_point == 1);
+  CHECK(fb.target == Vec3(0.05, 0, 0));
+  CHECK(w->mesh.polyline(fb.target_edge.index)[fb.target_point] == fb.target);
+  REQUIRE(w->mesh.valid(fb.face));
+  CHECK_FALSE(fb.closes_border);
+
+  log.pen(0.05, 0.05);  // the middle: over the face, no curve within 1 cm
+  w = replay(log);
+  CHECK_FALSE(w->pen_feedback.has_target());
+  CHECK(w->mesh.valid(w->pen_feedback.face));
+
+  log.pen(0.05, 0.3);  // beside the square
+  w = replay(log);
+  CHECK_FALSE(w->pen_feedback.face.valid());
+
+  log.pen(0.05, 0.05, 0.2);  // high above it
+  w = replay(log);
+  CHECK_FALSE(w->pen_feedback.face.valid());
+}
+
+TEST_CASE("while drawing: the face the stroke would split and where its end would snap", "[sketch][feedback]") {
+  Log log = closed_square();
+  log.event("down").pen(0.05, 0.001).pen(0.05, 0.05, 0.01).pen(0.049, 0.097);
+  auto w = replay(log);
+  const PenFeedback& fb = w->pen_feedback;
+  CHECK(fb.pen_down);
+  REQUIRE(w->mesh.valid(fb.face));
+  REQUIRE(w->mesh.valid(fb.target_edge));
+  CHECK(fb.target == Vec3(0.05, 0.1, 0));  // the top curve's middle point
+
+  // The pen goes up: the stroke splits the square, and nothing is shown until the pen is seen again.
+  log.event("up");
+  w = replay(log);
+  REQUIRE(w->mesh.face_count() == 2);
+  CHECK_FALSE(w->pen_feedback.pen_seen);
+  CHECK_FALSE(w->pen_feedback.face.valid());
+  CHECK_FALSE(w->pen_feedback.has_target());
+  // Then the pen over each half names a different face.
+  log.pen(0.02, 0.05);
+  w = replay(log);
+  REQUIRE(w->mesh.face_count() == 2);
+  const FaceId left = w->pen_feedback.face;
+  log.pen(0.08, 0.05);
+  w = replay(log);
+  const FaceId right = w->pen_feedback.face;
+  CHECK(w->mesh.valid(left));
+  CHECK(w->mesh.valid(right));
+  CHECK(left.index != right.index);
+}
+
+TEST_CASE("the pen's feedback is not part of the replay hash", "[sketch][feedback][replay]") {
+  Log plain = closed_square();
+  Log hovering = closed_square();
+  hovering.pen(0.051, 0.003).pen(0.05, 0.05);
+  const auto a = replay(plain), b = replay(hovering);
+  CHECK(b->pen_feedback.pen_seen);
+  CHECK(world_hash(*a) == world_hash(*b));
+}
