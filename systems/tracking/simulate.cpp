@@ -770,7 +770,7 @@ double angle_deg(const Eigen::Matrix3d& R) {
 
 }  // namespace
 
-Result<PenAccuracy> evaluate_pen_accuracy(const PenTrack& track, const CameraFrames& cam0, const SessionTruth& truth,
+Result<PenAccuracy> evaluate_pen_accuracy(const PenTrack& track, const SessionTruth& truth,
                                           double settle_s) {
   if (!truth.has_cameras)
     return Result<PenAccuracy>::failure("the log holds no camera truth (was it written by fire simulate sketch?)");
@@ -791,11 +791,7 @@ Result<PenAccuracy> evaluate_pen_accuracy(const PenTrack& track, const CameraFra
   uint32_t hold_stroke = 0;
   PenAccuracy acc;
   for (const PenSample& s : track.samples) {
-    if (s.cam0_frame >= cam0.size()) {
-      ++acc.unmatched;
-      continue;
-    }
-    const int64_t key = cam0.t_us[s.cam0_frame];
+    const int64_t key = s.cam0_arrival_us;
     const auto it = std::lower_bound(by_time.begin(), by_time.end(), key,
                                      [](const PenTruth* p, int64_t t) { return p->t_us < t; });
     if (it == by_time.end() || (*it)->t_us != key) {

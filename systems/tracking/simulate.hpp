@@ -151,7 +151,7 @@ struct PenAccuracy {
 // is moved into camera 0's frame with camera 0's true pose (X_cam0 = R0 X + t0): the calibrated
 // rig has camera 0 at its origin, so no registration stands between the two. Fails when the
 // log has no camera truth.
-Result<PenAccuracy> evaluate_pen_accuracy(const PenTrack& track, const CameraFrames& cam0, const SessionTruth& truth,
+Result<PenAccuracy> evaluate_pen_accuracy(const PenTrack& track, const SessionTruth& truth,
                                           double settle_s);
 
 // How far a calibrated rig is from the simulator's cameras (camera 1 relative to camera 0).

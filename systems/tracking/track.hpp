@@ -186,7 +186,7 @@ struct PenTrackOptions {
 struct PenSample {
   int64_t t_us = 0;         // camera 0's frame instant, rounded
   uint32_t stroke = 0;
-  uint32_t cam0_frame = 0;  // index into camera 0's frames: the report it came from
+  int64_t cam0_arrival_us = 0;  // arrival time of the camera 0 report it came from, as logged
   Vec3 raw = Vec3::Zero();       // triangulated, in the rig's frame (camera 0's), metres
   Vec3 filtered = Vec3::Zero();  // after the One Euro filter
   double reprojection_px = 0;

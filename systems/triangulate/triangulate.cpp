@@ -13,13 +13,14 @@ using tracking::Interpolated;
 using tracking::PenSample;
 
 constexpr double kNominalPeriodUs = 10'000;  // the remotes report at 100 Hz; the gaps say it better once seen
+constexpr double kRateReports = 200;         // fixed reports after which their own rate replaces the nominal one
 constexpr size_t kPeriodGaps = 63;           // arrival gaps the period is the median of
 constexpr size_t kMinPeriodGaps = 8;
 constexpr size_t kClockWindow = 400;         // reports the frame clock's line is fitted through (4 s)
-constexpr double kPendingTimeout = 1.5;      // periods after which no later report can renumber the newest
+constexpr double kPendingTimeout = 1.5;      // periods after which no later report can renumber the waiting ones
 // Camera 1 has not reported an instant this long after it (a lost report, latency and the wait for the
 // next report included): triangulate without it.
-constexpr double kCameraHorizonUs = 60'000;
+constexpr double kCameraHorizonUs = 120'000;
 constexpr int64_t kSilenceUs = 500'000;     // a remote this long without a report has stopped (a 100 Hz stream)
 constexpr int64_t kKeepUs = 30'000'000;      // trailing reports kept per camera (the offset's window)
 constexpr size_t kTrimChunk = 512;           // reports dropped from a window at once
@@ -60,6 +61,7 @@ struct ClockLine {
   double number_at(double t) const { return mean_n + (t - mean_t) / slope; }
 };
 
+// Through the trailing reports, at the rate of the whole session.
 ClockLine fit_line(const CameraWindow& w) {
   ClockLine line;
   for (const auto& [n, t] : w.fitted) {
@@ -69,53 +71,83 @@ ClockLine fit_line(const CameraWindow& w) {
   const double count = static_cast<double>(w.fitted.size());
   line.mean_n /= count;
   line.mean_t /= count;
-  double snn = 0, snt = 0;
-  for (const auto& [n, t] : w.fitted) {
-    snn += (n - line.mean_n) * (n - line.mean_n);
-    snt += (n - line.mean_n) * (t - line.mean_t);
-  }
-  line.slope = snn > 0 ? snt / snn : period_of(w);
+  line.slope = w.rate_count >= kRateReports && w.rate_cnn > 0 ? w.rate_cnt / w.rate_cnn : kNominalPeriodUs;
   return line;
 }
 
-constexpr size_t kLineNumbering = 50;  // fitted reports after which the line, not the loop, numbers reports
+void add_to_rate(CameraWindow& w, double n, double t) {
+  w.rate_count += 1;
+  const double dn = n - w.rate_mean_n, dt = t - w.rate_mean_t;
+  w.rate_mean_n += dn / w.rate_count;
+  w.rate_mean_t += dt / w.rate_count;
+  w.rate_cnn += dn * (n - w.rate_mean_n);
+  w.rate_cnt += dn * (t - w.rate_mean_t);
+}
 
-// The pending report's instant is fixed: on the line through the trailing (number, arrival) pairs.
-// Until that line is established, the phase-locked loop's number stands. After, the line numbers the
-// report itself, as the whole-log fit does with its second pass: of the two whole numbers around where
-// the line puts its arrival, the one that with the next report's (if one has arrived) leaves the smaller
-// squared misfit, the numbers increasing. A late report then gives its slot back to an on-time successor,
-// and the loop's occasional miscount never lasts.
-void fix_pending(CameraWindow& w, int camera, TriangulateState& state, const TrackingRig& rig,
-                 std::optional<int64_t> next_arrival_us) {
-  const CameraReport& r = *w.pending;
-  const double arrival = static_cast<double>(r.t_us - w.origin_us);
-  const double previous = w.fitted.empty() ? -std::numeric_limits<double>::infinity() : w.fitted.back()[0];
-  if (w.fitted.size() >= kLineNumbering) {
-    const ClockLine line = fit_line(w);
-    const double x = line.number_at(arrival);
-    double best = std::max(previous + 1, std::round(x)), best_cost = std::numeric_limits<double>::infinity();
-    for (const double n : {std::floor(x), std::floor(x) + 1}) {
-      if (!(n > previous)) continue;
-      double cost = (x - n) * (x - n);
-      if (next_arrival_us) {
-        const double x_next = line.number_at(static_cast<double>(*next_arrival_us - w.origin_us));
-        const double n_next = std::max(n + 1, std::round(x_next));
-        cost += (x_next - n_next) * (x_next - n_next);
-      }
-      if (cost < best_cost) {
-        best_cost = cost;
-        best = n;
+constexpr size_t kClockLag = 6;        // reports that wait for their number
+constexpr int kMaxLostInARow = 3;
+constexpr double kLostPenalty = 4.6;   // -log of a report's chance to be lost (about 1 %)
+constexpr double kDefaultJitterUs = 1000, kMinJitterUs = 100;
+constexpr size_t kJitterWindow = 101;
+
+// Numbers for the waiting reports, the oldest first, once the line is established: each report is one
+// slot after the one before unless reports were lost in between, and a lost report is rare. The most
+// likely numbering (Viterbi over the waiting reports: squared misfits to the line in units of the jitter,
+// plus a penalty per lost report) is taken for the oldest. A late or early report is then one outlier,
+// not a shift of the clock; a lost one shows as every later arrival a period early.
+double viterbi_number(const CameraWindow& w, const ClockLine& line, double previous) {
+  const size_t m = w.waiting.size();
+  std::vector<double> r(w.residuals_us.begin(), w.residuals_us.end());
+  double sigma = kDefaultJitterUs;
+  if (r.size() >= 16) {
+    std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
+    sigma = std::max(kMinJitterUs, 1.4826 * r[r.size() / 2]);
+  }
+  const int max_skip = kMaxLostInARow * static_cast<int>(m) + 1;
+  // cost[d]: best cost of the reports so far with d slots skipped in all; from[i][d]: the d before.
+  std::vector<double> cost(size_t(max_skip) + 1, std::numeric_limits<double>::infinity()), next(cost.size());
+  std::vector<std::vector<int>> from(m, std::vector<int>(cost.size(), -1));
+  cost[0] = 0;
+  for (size_t i = 0; i < m; ++i) {
+    const double arrival = static_cast<double>(w.waiting[i].t_us - w.origin_us);
+    std::fill(next.begin(), next.end(), std::numeric_limits<double>::infinity());
+    for (int d = 0; d <= max_skip; ++d) {
+      if (!std::isfinite(cost[size_t(d)])) continue;
+      for (int step = 0; step <= kMaxLostInARow && d + step <= max_skip; ++step) {
+        const double n = previous + static_cast<double>(i + 1) + d + step;
+        const double miss = (arrival - line.at(n)) / sigma;
+        const double c = cost[size_t(d)] + 0.5 * miss * miss + kLostPenalty * step;
+        if (c < next[size_t(d + step)]) {
+          next[size_t(d + step)] = c;
+          from[i][size_t(d + step)] = d;
+        }
       }
     }
-    w.pending_number = best;
-  } else {
-    w.pending_number = std::max(w.pending_number, previous + 1);
+    cost.swap(next);
   }
-  w.fitted.push_back({w.pending_number, arrival});
+  int d = static_cast<int>(std::min_element(cost.begin(), cost.end()) - cost.begin());
+  for (size_t i = m; i-- > 1;) d = from[i][size_t(d)];
+  return previous + 1 + d;
+}
+
+// The oldest waiting report's number is settled and its instant fixed: on the line through the trailing
+// (number, arrival) pairs.
+void fix_oldest(CameraWindow& w, int camera, TriangulateState& state, const TrackingRig& rig) {
+  const CameraReport r = w.waiting.front();
+  const double arrival = static_cast<double>(r.t_us - w.origin_us);
+  double number = 0;  // the camera's first report
+  if (!w.fitted.empty()) {
+    const ClockLine line = fit_line(w);
+    number = viterbi_number(w, line, w.fitted.back()[0]);
+    w.residuals_us.push_back(std::abs(arrival - line.at(number)));
+    if (w.residuals_us.size() > kJitterWindow) w.residuals_us.pop_front();
+  }
+  w.waiting.pop_front();
+  w.fitted.push_back({number, arrival});
+  add_to_rate(w, number, arrival);
   if (w.fitted.size() > kClockWindow) w.fitted.pop_front();
   const ClockLine line = fit_line(w);
-  double t_frame = static_cast<double>(w.origin_us) + line.at(w.pending_number);
+  double t_frame = static_cast<double>(w.origin_us) + line.at(number);
   CameraFrames& f = w.frames;
   if (f.size() > 0) t_frame = std::max(t_frame, f.t_frame_us.back() + 1.0);
   f.t_us.push_back(r.t_us);
@@ -125,7 +157,6 @@ void fix_pending(CameraWindow& w, int camera, TriangulateState& state, const Tra
   f.blobs.push_back(r.blobs);
   w.links.emplace_back();
   w.links.back().fill(-1);
-  w.pending.reset();
   if (f.size() < 2) return;
   const size_t k = f.size() - 2;
   w.links[k] = tracking::link_to_next(f, k);
@@ -308,7 +339,7 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
   }
   out.push_back(pen_event(t_us, f0.line[k], EventKind::Pen, *smooth));
   if (samples)
-    samples->push_back({t_us, s.counts.strokes - 1, static_cast<uint32_t>(s.cameras[0].first_index + k), tri.X, *smooth,
+    samples->push_back({t_us, s.counts.strokes - 1, f0.t_us[k], tri.X, *smooth,
                         tri.reprojection_error_px});
   s.both_lost += s.lost_now;
   s.lost_now = false;
@@ -334,7 +365,7 @@ void trim(CameraWindow& w, uint64_t keep_from_index) {
 }  // namespace
 
 bool TriangulateState::busy() const {
-  return cameras[0].pending || cameras[1].pending || next_cam0 < cameras[0].end_index() || down;
+  return !cameras[0].waiting.empty() || !cameras[1].waiting.empty() || next_cam0 < cameras[0].end_index() || down;
 }
 
 void triangulate_report(const TrackingRig& rig, TriangulateState& s, const CameraReport& r) {
@@ -343,47 +374,24 @@ void triangulate_report(const TrackingRig& rig, TriangulateState& s, const Camer
     ++s.out_of_order;
     return;
   }
-  const bool same_as_last = w.pending ? w.pending->blob_count == r.blob_count && w.pending->blobs == r.blobs
-                                      : w.frames.size() > 0 && w.frames.blob_count.back() == r.blob_count &&
-                                            w.frames.blobs.back() == r.blobs;
+  const bool same_as_last = !w.waiting.empty()
+                                ? w.waiting.back().blob_count == r.blob_count && w.waiting.back().blobs == r.blobs
+                                : w.frames.size() > 0 && w.frames.blob_count.back() == r.blob_count &&
+                                      w.frames.blobs.back() == r.blobs;
   if (w.reports > 0 && r.t_us == w.last_arrival_us && same_as_last) {
     ++s.duplicated;
     return;
   }
   s.silent[size_t(r.camera)] = false;
-  const double t = static_cast<double>(r.t_us);
   if (w.reports++ == 0) {
     w.origin_us = r.t_us;
-    w.predicted_us = t;
-    w.last_arrival_us = r.t_us;
-    w.pending = r;
-    w.pending_number = 0;
-    return;
-  }
-  if (r.t_us > w.last_arrival_us) {
-    w.gaps_us.push_back(t - static_cast<double>(w.last_arrival_us));
+  } else if (r.t_us > w.last_arrival_us) {
+    w.gaps_us.push_back(static_cast<double>(r.t_us - w.last_arrival_us));
     if (w.gaps_us.size() > kPeriodGaps) w.gaps_us.pop_front();
   }
   w.last_arrival_us = r.t_us;
-  // Frame numbers: a phase-locked loop on the regular clock tolerates jitter up to half a period in any
-  // one report. A report later than that looks like one after a lost report; when the next one then
-  // falls in the same slot, the earlier one was late, and it gets its slot back (while still pending).
-  const double period = period_of(w);
-  double gap = std::round((t - w.predicted_us) / period);
-  if (gap <= 0 && w.last_gap >= 2 && w.pending) {
-    w.pending_number -= 1;
-    w.predicted_us -= period;
-    gap = std::round((t - w.predicted_us) / period);
-  }
-  gap = std::max(1.0, gap);
-  const double number = (w.pending ? w.pending_number : w.last_number) + gap;
-  w.predicted_us += gap * period;
-  w.predicted_us += 0.1 * (t - w.predicted_us);
-  w.last_gap = gap;
-  if (w.pending) fix_pending(w, r.camera, s, rig, r.t_us);
-  w.pending = r;
-  w.pending_number = number;
-  w.last_number = number;
+  w.waiting.push_back(r);
+  while (w.waiting.size() > kClockLag) fix_oldest(w, r.camera, s, rig);
 }
 
 void triangulate_advance(int64_t now_us, const TrackingRig& rig, TriangulateState& s, std::vector<InputEvent>& out,
@@ -395,7 +403,9 @@ void triangulate_advance(int64_t now_us, const TrackingRig& rig, TriangulateStat
       s.silent[size_t(c)] = true;
       ++s.silences[size_t(c)];
     }
-    if (w.pending && now - static_cast<double>(w.pending->t_us) > kPendingTimeout * period_of(w)) fix_pending(w, c, s, rig, std::nullopt);
+    // No report for a while: nothing more will renumber the waiting ones.
+    if (!w.waiting.empty() && now - static_cast<double>(w.waiting.back().t_us) > kPendingTimeout * period_of(w))
+      while (!w.waiting.empty()) fix_oldest(w, c, s, rig);
   }
   if (!s.time_offset_started) {
     s.time_offset_us = rig.time_offset_us;
@@ -426,7 +436,7 @@ void triangulate_advance(int64_t now_us, const TrackingRig& rig, TriangulateStat
   }
   // Camera 0 has gone silent with the pen down: the stroke ends by the same rules, a little later.
   const tracking::PenTrackOptions& o = rig.options;
-  if (s.down && s.next_cam0 == w0.end_index() && !w0.pending &&
+  if (s.down && s.next_cam0 == w0.end_index() && w0.waiting.empty() &&
       (now - s.last_seen_t > static_cast<double>(o.max_gap_us) + 2 * kCameraHorizonUs ||
        now - s.last_sample_t > static_cast<double>(o.max_bridge_us) + 2 * kCameraHorizonUs))
     end_stroke(s, out);

@@ -3,8 +3,8 @@
 // time, seeing only the reports that have arrived before the frame ends (no look-ahead).
 //
 // Per camera it keeps a trailing window of reports: each report's instant on the remote's own frame clock
-// (a least-squares line through the trailing reports' frame numbers and arrival times, fitted once the next
-// report has fixed the report's number), and the blob links between consecutive reports. A camera 0 report
+// (a line through the trailing reports' frame numbers and arrival times at the session's rate, once the 5
+// reports after it have settled its number), and the blob links between consecutive reports. A camera 0 report
 // is triangulated once camera 1 has a report after its instant (camera 1's blobs are interpolated to it),
 // or once camera 1 has been silent too long to have one. The offset between the two remotes' latencies
 // starts at the rig file's value and is re-estimated every few seconds from the moving blobs of the
@@ -40,15 +40,17 @@ struct CameraWindow {
   tracking::CameraFrames frames;
   tracking::BlobLinks links;  // links[k]: frames[k] to frames[k + 1] (all -1 for the newest)
   uint64_t first_index = 0;
-  // The newest report, whose frame number the next report may still change (a late report looks like
-  // one after a lost report until the next one arrives in the same slot).
-  std::optional<tracking::CameraReport> pending;
-  double pending_number = 0;
-  // Frame clock: recent arrival gaps (for the period), the loop's prediction, the fitted reports.
+  // The newest reports, whose frame numbers the next ones may still change (a late report looks like one
+  // after a lost report until the reports after it show otherwise).
+  std::deque<tracking::CameraReport> waiting;
+  std::deque<double> residuals_us;            // |arrival - line| of recently fixed reports: the jitter
+  // Frame clock: recent arrival gaps (for the period), the fitted reports.
   std::deque<double> gaps_us;
-  double predicted_us = 0, last_gap = 1, last_number = 0;
   int64_t origin_us = 0;                      // arrival time of the camera's first report
   std::deque<std::array<double, 2>> fitted;   // (frame number, arrival - origin) of the trailing reports
+  // Running means and co-moments of every fixed report's (number, arrival - origin): the clock's rate,
+  // which is constant, from the whole session, so a recent miscount cannot tilt it.
+  double rate_count = 0, rate_mean_n = 0, rate_mean_t = 0, rate_cnn = 0, rate_cnt = 0;
   int64_t last_arrival_us = 0;
   uint64_t reports = 0;                       // reports taken (not out of order)
 

@@ -175,7 +175,7 @@ TEST_CASE("a short sketch session tracks within a millimetre or two") {
   CHECK(state.offset_estimates > 0);
   CHECK(std::abs(state.time_offset_us - 5000.0) < 300.0);
   CHECK(track.strokes == 3);
-  const Result<PenAccuracy> acc = evaluate_pen_accuracy(track, streams.cameras[0], read_session_truth(log.events), 0.25);
+  const Result<PenAccuracy> acc = evaluate_pen_accuracy(track, read_session_truth(log.events), 0.25);
   REQUIRE(acc.ok());
   CHECK(acc->static_filtered.samples > 100);
   CHECK(acc->dynamic_filtered.samples > 50);
@@ -234,7 +234,7 @@ TEST_CASE("a damaged log: bad reports and NaN lines are counted, the rest still 
   CHECK(track.strokes == 3);
   for (const InputEvent& e : pen_events(track))
     if (e.kind == EventKind::Pen) REQUIRE(e.p.allFinite());
-  const Result<PenAccuracy> acc = evaluate_pen_accuracy(track, streams.cameras[0], truth, 0.25);
+  const Result<PenAccuracy> acc = evaluate_pen_accuracy(track, truth, 0.25);
   REQUIRE(acc.ok());
   CHECK(acc->static_filtered.rms_mm < 1.0);
   CHECK(acc->dynamic_filtered.rms_mm < 2.0);

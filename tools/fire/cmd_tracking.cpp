@@ -335,7 +335,7 @@ int run_track(const TrackArgs& a) {
   out["rejected_reports"] = streams.counts.rejected_reports();
   out["reports"] = report_counts_json(streams.counts, truth.rejected_lines);
   if (args.truth) {
-    const Result<PenAccuracy> acc = evaluate_pen_accuracy(track, streams.cameras[0], truth, args.settle_s);
+    const Result<PenAccuracy> acc = evaluate_pen_accuracy(track, truth, args.settle_s);
     if (!acc) return fail(command, args.log_path + ": " + acc.error());
     auto put = [&](const std::string& name, const ErrorStats& e) {
       out[name + "_rms_mm"] = number_or_null(e.rms_mm, e.samples > 0);
