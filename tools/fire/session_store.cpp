@@ -69,7 +69,8 @@ Status apply_settings_json(std::string_view text, const std::string& source, Wor
   const json j = json::parse(text, nullptr, false);
   auto fail = [&](const std::string& why) { return Status::failure(source + ": " + why); };
   if (j.is_discarded() || !j.is_object()) return fail("not valid JSON");
-  if (j.value("version", 0) != 1) return fail("unsupported settings version (this build reads version 1)");
+  // Compared as JSON, not read as an int: a version out of int's range would be undefined behaviour.
+  if (!j.contains("version") || j["version"] != 1) return fail("unsupported settings version (this build reads version 1)");
   const char* keys[] = {"snap_distance", "close_samples", "surface", "method", "coons_steps", "levels", "planarity", "fairness"};
   for (const char* key : keys)
     if (!j.contains(key)) return fail(std::string("missing '") + key + "'");
