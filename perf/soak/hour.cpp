@@ -211,7 +211,7 @@ int main(int argc, char** argv) {
   std::printf("frames %llu, %zu edits rejected, %llu commits, %.1f s wall\n",
               static_cast<unsigned long long>(scheduler.frames()), w.rejections.size(),
               static_cast<unsigned long long>(writer->commits()), wall);
-  const double rss_end = resident_mib();  // before the peak is read: reading allocates too
+  const double rss_end = resident_mib();
   std::printf("resident: start %.1f MiB, end %.1f MiB, peak %.1f MiB\n", rss_start, rss_end, peak_mib());
   std::printf("on disk: log %.1f MiB, %zu snapshots kept, %.1f KiB together; the largest written %.1f KiB\n",
               double(writer->log_bytes()) / (1 << 20), snapshots, double(snapshot_bytes) / 1024,
