@@ -1,6 +1,7 @@
 #include "tools/fire/session_store.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 namespace fire {
@@ -135,6 +136,12 @@ Status load_world_snapshot(SnapshotReader& in, const SessionContents& session, W
   in.get(w.frame.index);
   in.get(w.frame.begin_us);
   in.get(w.frame.end_us);
+  // A frame is one step long and its times are the log's microseconds, far from int64's ends: the next
+  // frames' times are computed from them.
+  constexpr int64_t kFar = std::numeric_limits<int64_t>::max() / 2;
+  if (w.frame.index >= uint64_t(kFar) || w.frame.begin_us < -kFar || w.frame.begin_us > kFar ||
+      w.frame.end_us != w.frame.begin_us + kFrameStepUs)
+    return Status::failure("frame " + std::to_string(w.frame.index) + " has an impossible number or times (damaged)");
   if (!w.mesh.load(in)) return Status::failure("the pools do not load");
   if (!w.history.load(in, w.mesh)) return Status::failure("the undo history does not load");
   uint8_t pen_down = 0;
