@@ -28,6 +28,15 @@ int64_t SystemTiming::percentile_ns(double p) const {
   return sorted[rank - 1];
 }
 
+void SystemTiming::add(int64_t ns) {
+  if (samples_ns.size() == 2 * kTimingWindow)
+    samples_ns.erase(samples_ns.begin(), samples_ns.begin() + long(kTimingWindow));
+  samples_ns.push_back(ns);
+  ++frames;
+  total_ns += ns;
+  max_ns = std::max(max_ns, ns);
+}
+
 Result<Scheduler> Scheduler::build(std::vector<SystemSpec> systems, Clock clock) {
   for (size_t i = 0; i < systems.size(); ++i) {
     const SystemSpec& s = systems[i];
@@ -52,7 +61,10 @@ Result<Scheduler> Scheduler::build(std::vector<SystemSpec> systems, Clock clock)
 }
 
 Scheduler::Scheduler(std::vector<SystemSpec> systems, Clock clock) : systems_(std::move(systems)), clock_(clock) {
-  for (const SystemSpec& s : systems_) timings_.push_back({s.name, {}, 0, 0});
+  for (const SystemSpec& s : systems_) {
+    SystemTiming& t = timings_.emplace_back();
+    t.name = s.name;
+  }
 }
 
 void Scheduler::run_frame() {
@@ -60,16 +72,9 @@ void Scheduler::run_frame() {
   for (size_t i = 0; i < systems_.size(); ++i) {
     const int64_t t0 = clock_();
     systems_[i].run();
-    const int64_t dt = clock_() - t0;
-    SystemTiming& t = timings_[i];
-    t.samples_ns.push_back(dt);
-    t.total_ns += dt;
-    t.max_ns = std::max(t.max_ns, dt);
+    timings_[i].add(clock_() - t0);
   }
-  const int64_t dt = clock_() - frame_start;
-  frame_timing_.samples_ns.push_back(dt);
-  frame_timing_.total_ns += dt;
-  frame_timing_.max_ns = std::max(frame_timing_.max_ns, dt);
+  frame_timing_.add(clock_() - frame_start);
   ++frames_;
 }
 

@@ -8,7 +8,6 @@ namespace fire {
 namespace {
 
 constexpr uint32_t kByteOrderMark = 0x01020304u;
-constexpr size_t kSnapshotHeaderBytes = kSnapshotMagic.size() + sizeof(uint32_t) + 2 * sizeof(uint64_t);
 constexpr std::string_view kSnapshotPrefix = "snapshot-", kSnapshotSuffix = ".fsnap";
 constexpr size_t kFrameDigits = 20;
 
@@ -87,10 +86,9 @@ Result<SnapshotReader> SnapshotReader::open(std::string_view file, const std::st
   }
   uint32_t order = 0;
   uint64_t size = 0, sum = 0;
-  const char* at = file.data() + kSnapshotMagic.size();
-  std::memcpy(&order, at, sizeof order);
-  std::memcpy(&size, at + sizeof order, sizeof size);
-  std::memcpy(&sum, at + sizeof order + sizeof size, sizeof sum);
+  std::memcpy(&order, file.data() + kSnapshotMagic.size(), sizeof order);
+  std::memcpy(&size, file.data() + kSnapshotSizeAt, sizeof size);
+  std::memcpy(&sum, file.data() + kSnapshotChecksumAt, sizeof sum);
   if (order != kByteOrderMark) return fail("written on a machine of the other byte order");
   const std::string_view payload = file.substr(kSnapshotHeaderBytes);
   if (payload.size() != size)

@@ -68,6 +68,10 @@ Result<RecoveredLog> recover_input_log(std::string_view text, const std::string&
 //   "FIRE-SNAP 1\n" | u32 0x01020304 (byte order) | u64 payload size | u64 FNV-1a 64 of the payload | payload
 
 inline constexpr std::string_view kSnapshotMagic = "FIRE-SNAP 1\n";
+// Where the header's fields lie: the payload size, its checksum, then the payload.
+inline constexpr size_t kSnapshotSizeAt = kSnapshotMagic.size() + sizeof(uint32_t);
+inline constexpr size_t kSnapshotChecksumAt = kSnapshotSizeAt + sizeof(uint64_t);
+inline constexpr size_t kSnapshotHeaderBytes = kSnapshotChecksumAt + sizeof(uint64_t);
 
 class SnapshotWriter {
  public:

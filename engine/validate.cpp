@@ -43,6 +43,14 @@ std::string Mesh::validate() const {
     if (!is_finite(vertices.position[v])) return "vertex " + str(v) + " has a non-finite position";
   }
 
+  // Face ranges before the edges: an edge's check walks the loops of the faces it names.
+  for (uint32_t f = 0; f < nf; ++f) {
+    if (!face_alive(f)) continue;
+    const uint32_t off = faces.edge_offset[f], cnt = faces.edge_count[f];
+    if (cnt < 2) return "face " + str(f) + " has " + std::to_string(cnt) + " edge(s); a face needs at least 2";
+    if (size_t(off) + cnt > face_edges.size()) return "face " + str(f) + "'s edge list runs past the face-edge array";
+  }
+
   size_t incidences = 0;
   for (uint32_t e = 0; e < ne; ++e) {
     if (!edge_alive(e)) continue;
@@ -93,9 +101,7 @@ std::string Mesh::validate() const {
   for (uint32_t f = 0; f < nf; ++f) {
     if (!face_alive(f)) continue;
     const std::string name = "face " + str(f);
-    const uint32_t off = faces.edge_offset[f], cnt = faces.edge_count[f];
-    if (cnt < 2) return name + " has " + std::to_string(cnt) + " edge(s); a face needs at least 2";
-    if (size_t(off) + cnt > face_edges.size()) return name + "'s edge list runs past the face-edge array";
+    const uint32_t cnt = faces.edge_count[f];
     auto loop = face_loop(f);
     for (uint32_t k = 0; k < cnt; ++k) {
       uint32_t e = edge_of(loop[k]);

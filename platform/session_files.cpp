@@ -115,18 +115,20 @@ std::optional<uint64_t> load_last_good_snapshot(const SessionContents& session,
       skipped.push_back(bytes.error());
       continue;
     }
-    auto reader = SnapshotReader::open(*bytes, path);
-    if (!reader) {
-      skipped.push_back(reader.error());
-      continue;
-    }
-    if (Status s = load(*reader); !s) {
-      skipped.push_back(path + ": " + s.error);
+    if (Status s = load_snapshot(*bytes, path, load); !s) {
+      skipped.push_back(s.error);
       continue;
     }
     return frame;
   }
   return std::nullopt;
+}
+
+Status load_snapshot(std::string_view file, const std::string& path, const std::function<Status(SnapshotReader&)>& load) {
+  auto reader = SnapshotReader::open(file, path);
+  if (!reader) return Status::failure(reader.error());
+  if (Status s = load(*reader); !s) return Status::failure(path + ": " + s.error);
+  return Status::success();
 }
 
 }  // namespace fire

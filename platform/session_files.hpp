@@ -75,4 +75,9 @@ std::optional<uint64_t> load_last_good_snapshot(const SessionContents& session,
                                                 const std::function<Status(SnapshotReader&)>& load,
                                                 std::vector<std::string>& skipped);
 
+// One snapshot file's bytes, read by load_last_good_snapshot: its header and checksum checked, then
+// `load` run on it; an error names `path` and the problem. No file system call: the session fuzz target
+// (tests/fuzz/fuzz_session.cpp) runs it on its input.
+Status load_snapshot(std::string_view file, const std::string& path, const std::function<Status(SnapshotReader&)>& load);
+
 }  // namespace fire

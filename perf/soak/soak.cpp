@@ -6,20 +6,18 @@
 // surface from every change since they last ran; every `--check-every` operations the snapping index
 // validates and the settled surface is compared, bit for bit, with a full rebuild. Prints operations per second, peak memory, and resident memory at the start and the end.
 // Any violation stops the run with the operation, the seed and the reason, and exits 1.
-#include <sys/resource.h>
 #include <time.h>
-#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <random>
 #include <string>
 
 #include "engine/mesh.hpp"
 #include "engine/snap_index.hpp"
+#include "perf/soak/memory.hpp"
 #include "systems/reconstruct/reconstruct.hpp"
 #include "systems/refine/refine_system.hpp"
 #include "systems/split/edit.hpp"
@@ -27,6 +25,8 @@
 #include "tests/reconstruct/networks.hpp"
 
 using namespace fire;
+using soak::peak_mib;
+using soak::resident_mib;
 
 namespace {
 
@@ -44,19 +44,6 @@ double seconds_now() {
   timespec t;
   clock_gettime(CLOCK_MONOTONIC, &t);
   return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
-double resident_mib() {
-  std::ifstream statm("/proc/self/statm");
-  long pages = 0, resident = 0;
-  statm >> pages >> resident;
-  return double(resident) * double(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
-}
-
-double peak_mib() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return double(u.ru_maxrss) / 1024.0;
 }
 
 template <class T>

@@ -255,6 +255,19 @@ TEST_CASE("the scheduler keeps per-system samples for mean, p99 and max", "[sche
   CHECK_THAT(s->describe(), Catch::Contains("count: reads -; writes n"));
 }
 
+TEST_CASE("the scheduler's samples stay bounded over a long session; mean and max cover every frame", "[scheduler]") {
+  auto s = Scheduler::build({{"a", {}, {"n"}, {}, [] {}}}, fake_clock);
+  REQUIRE(s.ok());
+  const size_t frames = 2 * kTimingWindow + 1;
+  for (size_t i = 0; i < frames; ++i) s->run_frame();
+  for (const SystemTiming* t : {&s->timings()[0], &s->frame_timing()}) {
+    CHECK(t->frames == frames);
+    CHECK(t->samples_ns.size() == kTimingWindow + 1);  // the oldest window dropped when the next frame came
+    CHECK(t->mean_ns() == double(t->total_ns) / double(frames));
+    CHECK(t->percentile_ns(100) <= t->max_ns);
+  }
+}
+
 TEST_CASE("the session's frame order is accepted and the surface follows the network", "[scheduler][surface]") {
   World w;
   auto s = Scheduler::build(session_systems(w), fake_clock);

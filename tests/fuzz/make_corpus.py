@@ -1,11 +1,16 @@
 #!/usr/bin/env python3
 """Writes the fuzz targets' seed corpora into tests/fuzz/corpus/<target>/: small valid inputs in the
 layouts FIRE writes (taken from the demo log, the shared meshes and the formats' writers) and a few broken
-ones. Run from the repository root; the output is committed, so rerun only to change the seeds."""
+ones. Run from the repository root; the output is committed, so rerun only to change the seeds. The
+session seeds are real session folders written by `fire replay --session` (FIRE=path/to/fire, default
+build/fire)."""
+import glob
 import json
 import math
 import os
 import struct
+import subprocess
+import tempfile
 
 root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "corpus")
 shared = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "shared", "data", "meshes")
@@ -185,3 +190,57 @@ put("stl", "wrong_count.stl", s[:80] + struct.pack("<I", 7) + s[84:])
 g = glb(tetra_v, tetra_f)
 put("glb", "truncated.glb", g[: len(g) - 8])
 put("glb", "bad_magic.glb", b"gltf" + g[4:])
+
+# ---- session: `settings.json NUL input.log NUL snapshot` from session folders fire writes (the demo's border
+# and first split; undone and redone; stopped mid-stroke), seeds with the checksum and log hash zeroed
+# (fuzz_session.cpp fills them in, so mutations reach the fields behind them), a torn log, a snapshot of
+# another log and a cut snapshot.
+fire = os.environ.get("FIRE", "build/fire")
+def coarse(lines, every):
+    """The log with every `every`-th pen sample of each stroke kept, and its last: small seeds fuzz faster."""
+    kept, run = [], []
+    for line in lines + ["end\n"]:
+        if " pen " in line:
+            run.append(line)
+            continue
+        kept += run[::every] + ([run[-1]] if run and (len(run) - 1) % every else [])
+        run = []
+        kept.append(line)
+    return kept[:-1]
+
+
+first_split = coarse(demo[: demo.index("# split 2 edge-edge: left edge to the middle of split 1\n")], 8)
+t_end = int(first_split[-1].split()[0])
+logs = {
+    "border_split": first_split,
+    "undo_redo": first_split + [f"{t_end + 500000} cmd undo\n", f"{t_end + 1000000} cmd redo\n",
+                                f"{t_end + 1500000} cmd undo\n"],
+    "mid_stroke": first_split[:-3],
+}
+
+
+def session(lines, options=()):
+    """settings, log and newest snapshot of the session fire writes replaying `lines`."""
+    with tempfile.TemporaryDirectory() as tmp:
+        with open(os.path.join(tmp, "in.log"), "w") as f:
+            f.write("".join(lines))
+        out = os.path.join(tmp, "session")
+        subprocess.run([fire, "replay", os.path.join(tmp, "in.log"), "--session", out, "--snapshot-every", "25",
+                        *options], check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        read = lambda name: open(os.path.join(out, name), "rb").read()
+        return read("settings.json"), read("input.log"), read(sorted(glob.glob(os.path.join(out, "*.fsnap")))[-1])
+
+
+def zero_sums(snapshot):
+    # The header's checksum (bytes 24-31) and the payload's log hash (its bytes 8-15), as fuzz_session.cpp reads them.
+    return snapshot[:24] + bytes(8) + snapshot[32:40] + bytes(8) + snapshot[48:]
+
+
+for name, lines in logs.items():
+    settings, log, snap = session(lines, ["--no-surface"] if name == "mid_stroke" else [])
+    put("session", name, settings + b"\0" + log + b"\0" + snap)
+    put("session", name + "_zero_sums", settings + b"\0" + log + b"\0" + zero_sums(snap))
+settings, log, snap = session(logs["border_split"])
+put("session", "torn_log", settings + b"\0" + log + b"1 pen 0.1 0.2" + b"\0" + snap)
+put("session", "other_log", settings + b"\0" + log.replace(b"scene dome", b"scene bowl", 1) + b"\0" + snap)
+put("session", "cut_snapshot", settings + b"\0" + log + b"\0" + snap[: len(snap) // 2])

@@ -1,6 +1,7 @@
 #include "tools/fire/session_store.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 namespace fire {
@@ -69,7 +70,8 @@ Status apply_settings_json(std::string_view text, const std::string& source, Wor
   const json j = json::parse(text, nullptr, false);
   auto fail = [&](const std::string& why) { return Status::failure(source + ": " + why); };
   if (j.is_discarded() || !j.is_object()) return fail("not valid JSON");
-  if (j.value("version", 0) != 1) return fail("unsupported settings version (this build reads version 1)");
+  // Compared as JSON, not read as an int: a version out of int's range would be undefined behaviour.
+  if (!j.contains("version") || j["version"] != 1) return fail("unsupported settings version (this build reads version 1)");
   const char* keys[] = {"snap_distance", "close_samples", "surface", "method", "coons_steps", "levels", "planarity", "fairness"};
   for (const char* key : keys)
     if (!j.contains(key)) return fail(std::string("missing '") + key + "'");
@@ -134,6 +136,12 @@ Status load_world_snapshot(SnapshotReader& in, const SessionContents& session, W
   in.get(w.frame.index);
   in.get(w.frame.begin_us);
   in.get(w.frame.end_us);
+  // A frame is one step long and its times are the log's microseconds, far from int64's ends: the next
+  // frames' times are computed from them.
+  constexpr int64_t kFar = std::numeric_limits<int64_t>::max() / 2;
+  if (w.frame.index >= uint64_t(kFar) || w.frame.begin_us < -kFar || w.frame.begin_us > kFar ||
+      w.frame.end_us != w.frame.begin_us + kFrameStepUs)
+    return Status::failure("frame " + std::to_string(w.frame.index) + " has an impossible number or times (damaged)");
   if (!w.mesh.load(in)) return Status::failure("the pools do not load");
   if (!w.history.load(in, w.mesh)) return Status::failure("the undo history does not load");
   uint8_t pen_down = 0;

@@ -26,6 +26,7 @@ namespace fs = std::filesystem;
 struct Run {
   int exit_code = -1;
   std::string out, err;
+  int runner_exit = -1;  // xvfb-run's own status, for the report: exit_code is the app's
 };
 
 std::string quote(const std::string& s) { return "'" + s + "'"; }
@@ -45,11 +46,21 @@ bool has_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0
 
 // fire app under a fresh X server; the validation layer on, LeakSanitizer's suppressions for Mesa in the
 // sanitizer build. Each test case searches for a free display from its own number: xvfb-run -a alone races
-// when ctest -j starts two at once (both take :99).
-std::string app_command(int display, const std::string& args, const std::string& env = "") {
-  return "env " + env + " FIRE_VK_VALIDATION=1 LSAN_OPTIONS=suppressions=" + FIRE_LSAN_SUPPRESSIONS +
-         ":print_suppressions=0 xvfb-run -a -n " + std::to_string(display) +
-         " -s '-screen 0 1280x800x24' timeout 240 " + quote(FIRE_BINARY) + " app " + args;
+// when ctest -j starts two at once (both take :99). The app runs through record_exit.sh, so its exit status
+// is judged apart from xvfb-run's, which can fail in its own cleanup after the app exited; no status file
+// means xvfb-run never ran the app to its end, and exit_code stays -1.
+Run run_app(int display, const std::string& args, const fs::path& dir, const std::string& env = "") {
+  const fs::path status_file = dir / "app_status";
+  fs::remove(status_file);
+  Run r = run("env " + env + " FIRE_VK_VALIDATION=1 LSAN_OPTIONS=suppressions=" + FIRE_LSAN_SUPPRESSIONS +
+                  ":print_suppressions=0 xvfb-run -a -n " + std::to_string(display) + " -s '-screen 0 1280x800x24' " +
+                  quote(FIRE_RECORD_EXIT) + " " + quote(status_file.string()) + " timeout 240 " + quote(FIRE_BINARY) +
+                  " app " + args,
+              dir);
+  r.runner_exit = r.exit_code;
+  r.exit_code = -1;
+  if (auto status = fire::read_text_file(status_file.string())) r.exit_code = std::atoi(status->c_str());
+  return r;
 }
 
 fs::path scratch(const std::string& name) {
@@ -94,11 +105,12 @@ TEST_CASE("fire app: a scripted session in a window, its screenshot and its repl
   const fs::path dir = scratch("session");
   const std::string shot = (dir / "shot.png").string(), record = (dir / "session.log").string(),
                     saved = (dir / "saved.fnet").string();
-  const Run app = run(app_command(120, quote(FIRE_DEMO_LOG) + " --size 960x600 --script " +
-                                  quote(FIRE_WINDOW_TEST_DIR "/session.script") + " --screenshot " + quote(shot) +
-                                  " --record " + quote(record) + " -o " + quote(saved)),
-                      dir);
-  INFO("stdout: " << app.out << "\nstderr: " << app.err);
+  const Run app = run_app(120,
+                          quote(FIRE_DEMO_LOG) + " --size 960x600 --script " +
+                              quote(FIRE_WINDOW_TEST_DIR "/session.script") + " --screenshot " + quote(shot) +
+                              " --record " + quote(record) + " -o " + quote(saved),
+                          dir);
+  INFO("xvfb-run exit: " << app.runner_exit << "\nstdout: " << app.out << "\nstderr: " << app.err);
   REQUIRE(app.exit_code == 0);
   CHECK(app.err.find("validation") == std::string::npos);
   const auto json = nlohmann::json::parse(app.out);
@@ -166,10 +178,11 @@ TEST_CASE("fire app: curves toggled off are not drawn", "[app][window]") {
   REQUIRE(has_xvfb());
   const fs::path dir = scratch("curves_off");
   const std::string shot = (dir / "shot.png").string();
-  const Run app = run(app_command(140, quote(FIRE_DEMO_LOG) + " --size 640x400 --script " +
-                                  quote(FIRE_WINDOW_TEST_DIR "/curves_off.script") + " --screenshot " + quote(shot)),
-                      dir);
-  INFO("stdout: " << app.out << "\nstderr: " << app.err);
+  const Run app = run_app(140,
+                          quote(FIRE_DEMO_LOG) + " --size 640x400 --script " +
+                              quote(FIRE_WINDOW_TEST_DIR "/curves_off.script") + " --screenshot " + quote(shot),
+                          dir);
+  INFO("xvfb-run exit: " << app.runner_exit << "\nstdout: " << app.out << "\nstderr: " << app.err);
   REQUIRE(app.exit_code == 0);
   auto image = fire::render::read_png(shot);
   REQUIRE(image);
@@ -185,11 +198,12 @@ TEST_CASE("fire app: strokes drawn with the mouse on a reference mesh replay bit
   REQUIRE(has_xvfb());
   const fs::path dir = scratch("draw");
   const std::string shot = (dir / "shot.png").string(), record = (dir / "draw.log").string();
-  const Run app = run(app_command(160, "--reference " + quote(FIRE_PAWN) + " --size 960x720 --script " +
-                                  quote(FIRE_WINDOW_TEST_DIR "/draw_on_pawn.script") + " --screenshot " + quote(shot) +
-                                  " --record " + quote(record)),
-                      dir);
-  INFO("stdout: " << app.out << "\nstderr: " << app.err);
+  const Run app = run_app(160,
+                          "--reference " + quote(FIRE_PAWN) + " --size 960x720 --script " +
+                              quote(FIRE_WINDOW_TEST_DIR "/draw_on_pawn.script") + " --screenshot " + quote(shot) +
+                              " --record " + quote(record),
+                          dir);
+  INFO("xvfb-run exit: " << app.runner_exit << "\nstdout: " << app.out << "\nstderr: " << app.err);
   REQUIRE(app.exit_code == 0);
   const auto json = nlohmann::json::parse(app.out);
   // A closed border of 4 curves, split once (its curve and the halves of the two edges it ends on).
@@ -236,11 +250,11 @@ TEST_CASE("fire app: the stroke in progress is drawn before it becomes a curve",
   REQUIRE(has_xvfb());
   const fs::path dir = scratch("stroke");
   const std::string shot = (dir / "shot.png").string();
-  const Run app = run(app_command(220, "--reference " + quote(FIRE_PAWN) + " --size 960x720 --script " +
-                                           quote(FIRE_WINDOW_TEST_DIR "/stroke_in_progress.script") +
-                                           " --screenshot " + quote(shot)),
-                      dir);
-  INFO("stdout: " << app.out << "\nstderr: " << app.err);
+  const Run app = run_app(220,
+                          "--reference " + quote(FIRE_PAWN) + " --size 960x720 --script " +
+                              quote(FIRE_WINDOW_TEST_DIR "/stroke_in_progress.script") + " --screenshot " + quote(shot),
+                          dir);
+  INFO("xvfb-run exit: " << app.runner_exit << "\nstdout: " << app.out << "\nstderr: " << app.err);
   REQUIRE(app.exit_code == 0);
   CHECK(nlohmann::json::parse(app.out)["edges"] == 0);  // the pen never went up
   auto image = fire::render::read_png(shot);
@@ -395,14 +409,13 @@ TEST_CASE("fire app: no Vulkan device, a reference that does not load: a clear m
   REQUIRE(has_xvfb());
   const fs::path dir = scratch("bad_input");
   const Run no_device =
-      run(app_command(180, "--size 320x200 " + quote(FIRE_DEMO_LOG),
-                      "VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json"),
-          dir);
-  INFO("stderr: " << no_device.err);
+      run_app(180, "--size 320x200 " + quote(FIRE_DEMO_LOG), dir,
+              "VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json");
+  INFO("xvfb-run exit: " << no_device.runner_exit << "\nstderr: " << no_device.err);
   CHECK(no_device.exit_code == 1);
   CHECK(no_device.err.find("mesa-vulkan-drivers") != std::string::npos);
-  const Run bad_reference = run(app_command(200, "--reference " + quote((dir / "missing.obj").string())), dir);
-  INFO("stderr: " << bad_reference.err);
+  const Run bad_reference = run_app(200, "--reference " + quote((dir / "missing.obj").string()), dir);
+  INFO("xvfb-run exit: " << bad_reference.runner_exit << "\nstderr: " << bad_reference.err);
   CHECK(bad_reference.exit_code == 1);
   CHECK(bad_reference.err.find("--reference: " + (dir / "missing.obj").string()) != std::string::npos);
   fs::remove_all(dir);
