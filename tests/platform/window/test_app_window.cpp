@@ -283,9 +283,10 @@ std::pair<size_t, size_t> count_in_and_out(const Image& im, uint32_t x0, uint32_
 
 // fire app on pawn.obj in a 960x720 window, driven by `script` of this folder.
 Run app_on_pawn(int display, const std::string& script, const std::string& args, const fs::path& dir) {
-  return run(app_command(display, "--reference " + quote(FIRE_PAWN) + " --size 960x720 --script " +
-                                      quote(std::string(FIRE_WINDOW_TEST_DIR "/") + script) + " " + args),
-             dir);
+  return run_app(display,
+                 "--reference " + quote(FIRE_PAWN) + " --size 960x720 --script " +
+                     quote(std::string(FIRE_WINDOW_TEST_DIR "/") + script) + " " + args,
+                 dir);
 }
 
 // The screenshot of app_on_pawn(script) and the app's JSON line.
@@ -374,9 +375,10 @@ TEST_CASE("fire app: an export that cannot be written says why and loses nothing
   const std::string script = (dir / "export.script").string(), saved = (dir / "saved.fnet").string(),
                     unwritable = (dir / "missing" / "surface.obj").string();
   REQUIRE(fire::write_file_atomic(script, "2 key e\n4 key ctrl+s\n8 close\n"));
-  const Run app = run(app_command(300, quote(FIRE_DEMO_LOG) + " --size 320x200 --script " + quote(script) + " -o " +
-                                           quote(saved) + " --export " + quote(unwritable)),
-                      dir);
+  const Run app = run_app(300,
+                          quote(FIRE_DEMO_LOG) + " --size 320x200 --script " + quote(script) + " -o " + quote(saved) +
+                              " --export " + quote(unwritable),
+                          dir);
   INFO("stdout: " << app.out << "\nstderr: " << app.err);
   REQUIRE(app.exit_code == 0);
   CHECK(app.err.find("export failed: ") != std::string::npos);
