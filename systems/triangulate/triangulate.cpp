@@ -378,10 +378,9 @@ void triangulate_report(const TrackingRig& rig, TriangulateState& s, const Camer
                                 ? w.waiting.back().blob_count == r.blob_count && w.waiting.back().blobs == r.blobs
                                 : w.frames.size() > 0 && w.frames.blob_count.back() == r.blob_count &&
                                       w.frames.blobs.back() == r.blobs;
-  if (w.reports > 0 && r.t_us == w.last_arrival_us && same_as_last) {
-    ++s.duplicated;
-    return;
-  }
+  // A report repeated at the same instant may be sent twice or held and sent with the next (a Bluetooth
+  // burst, the pen at rest): the two cannot be told apart, and dropping one lost strokes in bursts.
+  if (w.reports > 0 && r.t_us == w.last_arrival_us && same_as_last) ++s.duplicated;
   s.silent[size_t(r.camera)] = false;
   if (w.reports++ == 0) {
     w.origin_us = r.t_us;
@@ -458,7 +457,8 @@ std::vector<std::string> describe_device_problems(const TriangulateState& s) {
   say(c.out_of_range_slots, "IR blob(s) outside the camera's 1024 x 768 pixels: dropped");
   say(c.bad_device_records, "device record(s) that do not read: ignored");
   say(s.out_of_order, "report(s) stamped earlier than their remote's previous report (time going backwards): dropped");
-  say(s.duplicated, "report(s) repeating their remote's previous report at the same instant: dropped");
+  say(s.duplicated, "report(s) repeating their remote's previous report at the same instant (sent twice, or held "
+                    "and sent with the next): kept");
   for (int k = 0; k < 2; ++k)
     say(s.silences[size_t(k)], std::string("time(s) camera ") + char('0' + k) + " stopped reporting for more than 0.5 s" +
                                    (s.silent[size_t(k)] ? " (silent at the end)" : ""));

@@ -61,7 +61,7 @@ struct TriangulateState {
   tracking::DeviceDecoder decoder;
   std::array<CameraWindow, 2> cameras;
   size_t out_of_order = 0;       // reports that arrived earlier than their camera's previous one: dropped
-  size_t duplicated = 0;         // reports equal to their camera's previous one, at the same instant: dropped
+  size_t duplicated = 0;         // reports equal to their camera's previous one, at the same instant (kept)
   size_t both_lost = 0;          // times neither camera saw the pen in the middle of a stroke that went on after
   bool lost_now = false;
   size_t stray_frames = 0;       // pen samples taken from a frame that also showed another blob (a reflection)

@@ -44,7 +44,7 @@ awk '/ hid 1 /{n++; if (n == 700) $1 = $1 - 30000} {print}' s.log > backwards.lo
 case_ backwards "$clean" "stamped earlier than their remote's previous report (time going backwards): dropped"
 # A report delivered twice.
 awk '{print} / hid 0 /{n++; if (n % 300 == 0) print}' s.log > duplicated.log
-case_ duplicated "$clean" "repeating their remote's previous report at the same instant: dropped"
+case_ duplicated "$clean" "repeating their remote's previous report at the same instant (sent twice, or held and sent with the next): kept"
 # Camera 1 stops reporting halfway (switched off): the curves drawn before are kept.
 half=$(awk '/ hid 1 /{t = $1} END {print int(t / 2)}' s.log)
 awk -v half="$half" '!(/ hid 1 / && $1 > half)' s.log > stopped.log
