@@ -212,95 +212,112 @@ DeviceStreams decode_device_streams(std::span<const InputEvent> events) {
   return out;
 }
 
+namespace {
+
+constexpr double kNominalPeriodUs = 10'000;  // the remotes report at 100 Hz
+constexpr double kRateReports = 200;         // settled reports after which their own rate replaces the nominal one
+constexpr size_t kClockWindow = 400;         // trailing reports the line's position comes from (4 s)
+constexpr int kMaxLostInARow = 3;
+constexpr double kLostPenalty = 4.6;         // -log of a report's chance to be lost (about 1 %)
+constexpr double kDefaultJitterUs = 1000, kMinJitterUs = 100;
+constexpr size_t kJitterWindow = 101;
+
+}  // namespace
+
+double FrameNumbering::instant(double number) const {
+  double n0 = 0, t0 = 0;
+  for (const auto& [n, t] : trailing) {
+    n0 += n;
+    t0 += t;
+  }
+  const double size = static_cast<double>(trailing.size());
+  const double slope = count >= kRateReports && cnn > 0 ? cnt / cnn : kNominalPeriodUs;
+  return size > 0 ? t0 / size + slope * (number - n0 / size) : slope * number;
+}
+
+double FrameNumbering::settle(std::span<const double> waiting) {
+  const size_t m = std::min(waiting.size(), kLookahead + 1);
+  double number = 0;
+  if (!trailing.empty()) {
+    const double previous = trailing.back()[0];
+    std::vector<double> r(residuals.begin(), residuals.end());
+    double sigma = kDefaultJitterUs;
+    if (r.size() >= 16) {
+      std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
+      sigma = std::max(kMinJitterUs, 1.4826 * r[r.size() / 2]);
+    }
+    const double line0 = instant(0), slope = instant(1) - line0;
+    const int max_skip = kMaxLostInARow * static_cast<int>(m) + 1;
+    // cost[d]: the best cost of the reports so far with d frames skipped in all; from[i][d]: the d before.
+    std::vector<double> cost(size_t(max_skip) + 1, std::numeric_limits<double>::infinity()), next(cost.size());
+    std::vector<std::vector<int>> from(m, std::vector<int>(cost.size(), -1));
+    cost[0] = 0;
+    for (size_t i = 0; i < m; ++i) {
+      std::fill(next.begin(), next.end(), std::numeric_limits<double>::infinity());
+      for (int d = 0; d <= max_skip; ++d) {
+        if (!std::isfinite(cost[size_t(d)])) continue;
+        for (int step = 0; step <= kMaxLostInARow && d + step <= max_skip; ++step) {
+          const double n = previous + static_cast<double>(i + 1) + d + step;
+          const double miss = (waiting[i] - (line0 + slope * n)) / sigma;
+          const double c = cost[size_t(d)] + 0.5 * miss * miss + kLostPenalty * step;
+          if (c < next[size_t(d + step)]) {
+            next[size_t(d + step)] = c;
+            from[i][size_t(d + step)] = d;
+          }
+        }
+      }
+      cost.swap(next);
+    }
+    int d = static_cast<int>(std::min_element(cost.begin(), cost.end()) - cost.begin());
+    for (size_t i = m; i-- > 1;) d = from[i][size_t(d)];
+    number = previous + 1 + d;
+    residuals.push_back(std::abs(waiting[0] - (line0 + slope * number)));
+    if (residuals.size() > kJitterWindow) residuals.pop_front();
+  }
+  trailing.push_back({number, waiting[0]});
+  if (trailing.size() > kClockWindow) trailing.pop_front();
+  count += 1;
+  const double dn = number - mean_n, dt = waiting[0] - mean_t;
+  mean_n += dn / count;
+  mean_t += dt / count;
+  cnn += dn * (number - mean_n);
+  cnt += dn * (waiting[0] - mean_t);
+  return number;
+}
+
 void fit_frame_clock(CameraFrames& f) {
   const size_t n = f.size();
   for (size_t k = 0; k < n; ++k) f.t_frame_us[k] = static_cast<double>(f.t_us[k]);
   if (n < 3) return;
-  std::vector<double> gaps;
-  for (size_t k = 1; k < n; ++k)
-    if (f.t_us[k] > f.t_us[k - 1]) gaps.push_back(static_cast<double>(f.t_us[k] - f.t_us[k - 1]));
-  const double period = median(gaps);
-  if (!(period > 0)) return;
-  // Frame numbers: a phase-locked loop on the regular clock tolerates jitter up to half a period
-  // in any one report, where counting the gaps between neighbours would not. A report later than
-  // that looks like one after a lost report; when the next one then falls in the same slot, the
-  // earlier one was late, and it gets its slot back.
-  std::vector<double> number(n, 0.0);
-  double predicted = static_cast<double>(f.t_us[0]);
-  double last_gap = 1;
-  for (size_t k = 1; k < n; ++k) {
-    const double t = static_cast<double>(f.t_us[k]);
-    double gap = std::round((t - predicted) / period);
-    if (gap <= 0 && last_gap >= 2) {
-      number[k - 1] -= 1;
-      predicted -= period;
-      gap = std::round((t - predicted) / period);
-    }
-    gap = std::max(1.0, gap);
-    number[k] = number[k - 1] + gap;
-    predicted += gap * period;
-    predicted += 0.1 * (t - predicted);
-    last_gap = gap;
-  }
-  constexpr ptrdiff_t kHalfWindow = 200;  // +-2 s: long enough to average the jitter, short for slow drift
   const double t_origin = static_cast<double>(f.t_us[0]);
   auto arrival = [&](size_t i) { return static_cast<double>(f.t_us[i]) - t_origin; };
-  // Per report, the least-squares line t = a + b n through its neighbours.
-  std::vector<Eigen::Vector2d> line(n);
-  auto fit = [&] {
-    for (ptrdiff_t k = 0; k < static_cast<ptrdiff_t>(n); ++k) {
-      const auto lo = static_cast<size_t>(std::max<ptrdiff_t>(0, k - kHalfWindow));
-      const auto hi = static_cast<size_t>(std::min<ptrdiff_t>(static_cast<ptrdiff_t>(n) - 1, k + kHalfWindow));
-      double mean_n = 0, mean_t = 0;
-      for (size_t i = lo; i <= hi; ++i) {
-        mean_n += number[i];
-        mean_t += arrival(i);
-      }
-      const double count = static_cast<double>(hi - lo + 1);
-      mean_n /= count;
-      mean_t /= count;
-      double snn = 0, snt = 0;
-      for (size_t i = lo; i <= hi; ++i) {
-        snn += (number[i] - mean_n) * (number[i] - mean_n);
-        snt += (number[i] - mean_n) * (arrival(i) - mean_t);
-      }
-      const double slope = snn > 0 ? snt / snn : period;
-      line[static_cast<size_t>(k)] = Eigen::Vector2d(mean_t - slope * mean_n, slope);
+  // Frame numbers as the live triangulation system settles them (FrameNumbering).
+  std::vector<double> arrivals(n), number(n);
+  for (size_t k = 0; k < n; ++k) arrivals[k] = arrival(k);
+  FrameNumbering numbering;
+  for (size_t k = 0; k < n; ++k)
+    number[k] = numbering.settle(std::span<const double>(arrivals).subspan(k, std::min(n - k, FrameNumbering::kLookahead + 1)));
+  // Per report, the least-squares line t = a + b n through its neighbours on both sides.
+  constexpr ptrdiff_t kHalfWindow = 200;  // +-2 s: long enough to average the jitter, short for slow drift
+  for (ptrdiff_t k = 0; k < static_cast<ptrdiff_t>(n); ++k) {
+    const auto lo = static_cast<size_t>(std::max<ptrdiff_t>(0, k - kHalfWindow));
+    const auto hi = static_cast<size_t>(std::min<ptrdiff_t>(static_cast<ptrdiff_t>(n) - 1, k + kHalfWindow));
+    double mean_n = 0, mean_t = 0;
+    for (size_t i = lo; i <= hi; ++i) {
+      mean_n += number[i];
+      mean_t += arrivals[i];
     }
-  };
-  fit();
-  // The loop can still number a report one off (one early right after a lost one takes the lost
-  // one's number): choose every report's number within one of the loop's, increasing, so that the
-  // arrivals sit closest to their lines (a Viterbi pass over three states per report), and refit.
-  auto miss = [&](size_t k, int j) {
-    const double r = arrival(k) - (line[k](0) + line[k](1) * (number[k] + j));
-    return r * r;
-  };
-  std::vector<std::array<double, 3>> cost(n);
-  std::vector<std::array<int8_t, 3>> from(n);
-  for (int j = 0; j < 3; ++j) cost[0][j] = miss(0, j - 1);
-  for (size_t k = 1; k < n; ++k)
-    for (int j = 0; j < 3; ++j) {
-      cost[k][j] = std::numeric_limits<double>::infinity();
-      for (int i = 0; i < 3; ++i)
-        if (number[k - 1] + (i - 1) < number[k] + (j - 1) && cost[k - 1][i] < cost[k][j]) {
-          cost[k][j] = cost[k - 1][i];
-          from[k][j] = static_cast<int8_t>(i);
-        }
-      cost[k][j] += miss(k, j - 1);
+    const double count = static_cast<double>(hi - lo + 1);
+    mean_n /= count;
+    mean_t /= count;
+    double snn = 0, snt = 0;
+    for (size_t i = lo; i <= hi; ++i) {
+      snn += (number[i] - mean_n) * (number[i] - mean_n);
+      snt += (number[i] - mean_n) * (arrivals[i] - mean_t);
     }
-  int state = static_cast<int>(std::min_element(cost[n - 1].begin(), cost[n - 1].end()) - cost[n - 1].begin());
-  bool renumbered = false;
-  for (size_t k = n; k-- > 0;) {
-    renumbered |= state != 1;
-    const int previous = k > 0 ? from[k][state] : 1;
-    number[k] += state - 1;
-    state = previous;
-  }
-  if (renumbered) fit();
-  for (size_t k = 0; k < n; ++k) {
-    const double t = t_origin + line[k](0) + line[k](1) * number[k];
-    f.t_frame_us[k] = k == 0 ? t : std::max(t, f.t_frame_us[k - 1] + 1.0);
+    const double slope = snn > 0 ? snt / snn : numbering.instant(1) - numbering.instant(0);
+    const double t = t_origin + mean_t + slope * (number[size_t(k)] - mean_n);
+    f.t_frame_us[size_t(k)] = k == 0 ? t : std::max(t, f.t_frame_us[size_t(k) - 1] + 1.0);
   }
 }
 

@@ -12,6 +12,7 @@
 #include <map>
 #include <string>
 #include <cstdint>
+#include <deque>
 #include <optional>
 #include <span>
 #include <vector>
@@ -76,9 +77,30 @@ struct DeviceDecoder {
 // Decodes every camera's `hid` events (DeviceDecoder). t_frame_us starts as the arrival time.
 DeviceStreams decode_device_streams(std::span<const InputEvent> events);
 
-// Replaces arrival jitter by the remote's regular clock: frame numbers follow from the gaps
-// between reports (a lost report leaves a gap of two periods), then each report's instant is
-// read off a least-squares line through (frame number, arrival time) over its neighbours.
+// A remote's frame numbers from the arrival times of its reports, one report at a time. Each report is
+// one frame after the one before unless reports were lost in between, and a lost report is rare; so the
+// oldest of the reports still waiting gets the number of the most likely numbering of them all (Viterbi:
+// misfits to the clock's line in units of the measured jitter, plus -log 1 % per lost report). A late or
+// early report is then one outlier, not a shift of the clock. The line runs through the trailing reports
+// at the rate of every report so far (the nominal 100 Hz for the first 200), so a miscount cannot tilt it.
+// Arrivals are microseconds from any fixed origin (keep them small: they are doubles).
+struct FrameNumbering {
+  static constexpr size_t kLookahead = 5;  // reports after the oldest that settle its number
+
+  // Settles the number of waiting[0], given the reports after it (up to kLookahead are used), records it
+  // and returns it. The first report is number 0.
+  double settle(std::span<const double> waiting);
+  // The clock's instant of frame `number`, on the arrivals' axis.
+  double instant(double number) const;
+
+  std::deque<std::array<double, 2>> trailing;  // (number, arrival) of the last 400 settled reports
+  double count = 0, mean_n = 0, mean_t = 0, cnn = 0, cnt = 0;  // running moments of every settled report
+  std::deque<double> residuals;               // |arrival - line| of the last 101: the jitter
+};
+
+// Replaces arrival jitter by the remote's regular clock: frame numbers as FrameNumbering settles
+// them (as the live triangulation system does), then each report's instant read off a least-squares
+// line through (frame number, arrival time) over its neighbours on both sides.
 void fit_frame_clock(CameraFrames& frames);
 
 // Drops blobs that stay within `radius_px` of where they are for `min_frames` consecutive

@@ -13,10 +13,8 @@ using tracking::Interpolated;
 using tracking::PenSample;
 
 constexpr double kNominalPeriodUs = 10'000;  // the remotes report at 100 Hz; the gaps say it better once seen
-constexpr double kRateReports = 200;         // fixed reports after which their own rate replaces the nominal one
 constexpr size_t kPeriodGaps = 63;           // arrival gaps the period is the median of
 constexpr size_t kMinPeriodGaps = 8;
-constexpr size_t kClockWindow = 400;         // reports the frame clock's line is fitted through (4 s)
 constexpr double kPendingTimeout = 1.5;      // periods after which no later report can renumber the waiting ones
 // Camera 1 has not reported an instant this long after it (a lost report, latency and the wait for the
 // next report included): triangulate without it.
@@ -54,100 +52,15 @@ void erase_front(CameraWindow& w, size_t n) {
   w.first_index += n;
 }
 
-// Least-squares line t = a + b (n - mean_n) through the trailing (number, arrival) pairs.
-struct ClockLine {
-  double mean_n = 0, mean_t = 0, slope = 0;
-  double at(double n) const { return mean_t + slope * (n - mean_n); }
-  double number_at(double t) const { return mean_n + (t - mean_t) / slope; }
-};
-
-// Through the trailing reports, at the rate of the whole session.
-ClockLine fit_line(const CameraWindow& w) {
-  ClockLine line;
-  for (const auto& [n, t] : w.fitted) {
-    line.mean_n += n;
-    line.mean_t += t;
-  }
-  const double count = static_cast<double>(w.fitted.size());
-  line.mean_n /= count;
-  line.mean_t /= count;
-  line.slope = w.rate_count >= kRateReports && w.rate_cnn > 0 ? w.rate_cnt / w.rate_cnn : kNominalPeriodUs;
-  return line;
-}
-
-void add_to_rate(CameraWindow& w, double n, double t) {
-  w.rate_count += 1;
-  const double dn = n - w.rate_mean_n, dt = t - w.rate_mean_t;
-  w.rate_mean_n += dn / w.rate_count;
-  w.rate_mean_t += dt / w.rate_count;
-  w.rate_cnn += dn * (n - w.rate_mean_n);
-  w.rate_cnt += dn * (t - w.rate_mean_t);
-}
-
-constexpr size_t kClockLag = 6;        // reports that wait for their number
-constexpr int kMaxLostInARow = 3;
-constexpr double kLostPenalty = 4.6;   // -log of a report's chance to be lost (about 1 %)
-constexpr double kDefaultJitterUs = 1000, kMinJitterUs = 100;
-constexpr size_t kJitterWindow = 101;
-
-// Numbers for the waiting reports, the oldest first, once the line is established: each report is one
-// slot after the one before unless reports were lost in between, and a lost report is rare. The most
-// likely numbering (Viterbi over the waiting reports: squared misfits to the line in units of the jitter,
-// plus a penalty per lost report) is taken for the oldest. A late or early report is then one outlier,
-// not a shift of the clock; a lost one shows as every later arrival a period early.
-double viterbi_number(const CameraWindow& w, const ClockLine& line, double previous) {
-  const size_t m = w.waiting.size();
-  std::vector<double> r(w.residuals_us.begin(), w.residuals_us.end());
-  double sigma = kDefaultJitterUs;
-  if (r.size() >= 16) {
-    std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
-    sigma = std::max(kMinJitterUs, 1.4826 * r[r.size() / 2]);
-  }
-  const int max_skip = kMaxLostInARow * static_cast<int>(m) + 1;
-  // cost[d]: best cost of the reports so far with d slots skipped in all; from[i][d]: the d before.
-  std::vector<double> cost(size_t(max_skip) + 1, std::numeric_limits<double>::infinity()), next(cost.size());
-  std::vector<std::vector<int>> from(m, std::vector<int>(cost.size(), -1));
-  cost[0] = 0;
-  for (size_t i = 0; i < m; ++i) {
-    const double arrival = static_cast<double>(w.waiting[i].t_us - w.origin_us);
-    std::fill(next.begin(), next.end(), std::numeric_limits<double>::infinity());
-    for (int d = 0; d <= max_skip; ++d) {
-      if (!std::isfinite(cost[size_t(d)])) continue;
-      for (int step = 0; step <= kMaxLostInARow && d + step <= max_skip; ++step) {
-        const double n = previous + static_cast<double>(i + 1) + d + step;
-        const double miss = (arrival - line.at(n)) / sigma;
-        const double c = cost[size_t(d)] + 0.5 * miss * miss + kLostPenalty * step;
-        if (c < next[size_t(d + step)]) {
-          next[size_t(d + step)] = c;
-          from[i][size_t(d + step)] = d;
-        }
-      }
-    }
-    cost.swap(next);
-  }
-  int d = static_cast<int>(std::min_element(cost.begin(), cost.end()) - cost.begin());
-  for (size_t i = m; i-- > 1;) d = from[i][size_t(d)];
-  return previous + 1 + d;
-}
-
-// The oldest waiting report's number is settled and its instant fixed: on the line through the trailing
-// (number, arrival) pairs.
+// The oldest waiting report's frame number is settled and its instant fixed on the camera's clock.
 void fix_oldest(CameraWindow& w, int camera, TriangulateState& state, const TrackingRig& rig) {
   const CameraReport r = w.waiting.front();
-  const double arrival = static_cast<double>(r.t_us - w.origin_us);
-  double number = 0;  // the camera's first report
-  if (!w.fitted.empty()) {
-    const ClockLine line = fit_line(w);
-    number = viterbi_number(w, line, w.fitted.back()[0]);
-    w.residuals_us.push_back(std::abs(arrival - line.at(number)));
-    if (w.residuals_us.size() > kJitterWindow) w.residuals_us.pop_front();
-  }
+  std::array<double, tracking::FrameNumbering::kLookahead + 1> arrivals;
+  const size_t m = std::min(w.waiting.size(), arrivals.size());
+  for (size_t i = 0; i < m; ++i) arrivals[i] = static_cast<double>(w.waiting[i].t_us - w.origin_us);
+  const double number = w.clock.settle(std::span<const double>(arrivals.data(), m));
   w.waiting.pop_front();
-  w.fitted.push_back({number, arrival});
-  add_to_rate(w, number, arrival);
-  if (w.fitted.size() > kClockWindow) w.fitted.pop_front();
-  const ClockLine line = fit_line(w);
-  double t_frame = static_cast<double>(w.origin_us) + line.at(number);
+  double t_frame = static_cast<double>(w.origin_us) + w.clock.instant(number);
   CameraFrames& f = w.frames;
   if (f.size() > 0) t_frame = std::max(t_frame, f.t_frame_us.back() + 1.0);
   f.t_us.push_back(r.t_us);
@@ -390,7 +303,7 @@ void triangulate_report(const TrackingRig& rig, TriangulateState& s, const Camer
   }
   w.last_arrival_us = r.t_us;
   w.waiting.push_back(r);
-  while (w.waiting.size() > kClockLag) fix_oldest(w, r.camera, s, rig);
+  while (w.waiting.size() > tracking::FrameNumbering::kLookahead) fix_oldest(w, r.camera, s, rig);
 }
 
 void triangulate_advance(int64_t now_us, const TrackingRig& rig, TriangulateState& s, std::vector<InputEvent>& out,

@@ -43,14 +43,10 @@ struct CameraWindow {
   // The newest reports, whose frame numbers the next ones may still change (a late report looks like one
   // after a lost report until the reports after it show otherwise).
   std::deque<tracking::CameraReport> waiting;
-  std::deque<double> residuals_us;            // |arrival - line| of recently fixed reports: the jitter
-  // Frame clock: recent arrival gaps (for the period), the fitted reports.
+  // Frame clock: recent arrival gaps (for the period and the timeouts), the frame numbering.
   std::deque<double> gaps_us;
   int64_t origin_us = 0;                      // arrival time of the camera's first report
-  std::deque<std::array<double, 2>> fitted;   // (frame number, arrival - origin) of the trailing reports
-  // Running means and co-moments of every fixed report's (number, arrival - origin): the clock's rate,
-  // which is constant, from the whole session, so a recent miscount cannot tilt it.
-  double rate_count = 0, rate_mean_n = 0, rate_mean_t = 0, rate_cnn = 0, rate_cnt = 0;
+  tracking::FrameNumbering clock;             // on arrivals since origin_us
   int64_t last_arrival_us = 0;
   uint64_t reports = 0;                       // reports taken (not out of order)
 
