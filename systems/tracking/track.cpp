@@ -224,16 +224,22 @@ constexpr size_t kJitterWindow = 101;
 
 }  // namespace
 
-double FrameNumbering::instant(double number) const {
-  double n0 = 0, t0 = 0;
+FrameNumbering::Line FrameNumbering::line() const {
+  Line l;
   for (const auto& [n, t] : trailing) {
-    n0 += n;
-    t0 += t;
+    l.mean_n += n;
+    l.mean_t += t;
   }
   const double size = static_cast<double>(trailing.size());
-  const double slope = count >= kRateReports && cnn > 0 ? cnt / cnn : kNominalPeriodUs;
-  return size > 0 ? t0 / size + slope * (number - n0 / size) : slope * number;
+  l.slope = count >= kRateReports && cnn > 0 ? cnt / cnn : kNominalPeriodUs;
+  if (size > 0) {
+    l.mean_n /= size;
+    l.mean_t /= size;
+  }
+  return l;
 }
+
+double FrameNumbering::instant(double number) const { return line().at(number); }
 
 double FrameNumbering::settle(std::span<const double> waiting) {
   const size_t m = std::min(waiting.size(), kLookahead + 1);
@@ -246,7 +252,8 @@ double FrameNumbering::settle(std::span<const double> waiting) {
       std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
       sigma = std::max(kMinJitterUs, 1.4826 * r[r.size() / 2]);
     }
-    const double line0 = instant(0), slope = instant(1) - line0;
+    const Line l = line();
+    const double line0 = l.at(0), slope = l.at(1) - line0;
     const int max_skip = kMaxLostInARow * static_cast<int>(m) + 1;
     // cost[d]: the best cost of the reports so far with d frames skipped in all; from[i][d]: the d before.
     std::vector<double> cost(size_t(max_skip) + 1, std::numeric_limits<double>::infinity()), next(cost.size());

@@ -93,6 +93,13 @@ struct FrameNumbering {
   // The clock's instant of frame `number`, on the arrivals' axis.
   double instant(double number) const;
 
+  // The clock's line through the trailing reports' means at the session's rate.
+  struct Line {
+    double mean_n = 0, mean_t = 0, slope = 0;
+    double at(double number) const { return mean_t + slope * (number - mean_n); }
+  };
+  Line line() const;
+
   std::deque<std::array<double, 2>> trailing;  // (number, arrival) of the last 400 settled reports
   double count = 0, mean_n = 0, mean_t = 0, cnn = 0, cnt = 0;  // running moments of every settled report
   std::deque<double> residuals;               // |arrival - line| of the last 101: the jitter

@@ -32,13 +32,16 @@ constexpr double kMaxPenSpeed_m_s = 5.0;  // a hand moves the pen no faster
 constexpr double kBridgeSpeed_m_s = 1.0;  // a drawing hand, while both cameras lose the pen, moves it no faster
 constexpr double kFollowStep_px = 40;     // the pen's blob moves less than this between two frames of a camera
 
-double period_of(const CameraWindow& w) {
-  if (w.gaps_us.size() < kMinPeriodGaps) return kNominalPeriodUs;
-  std::vector<double> g(w.gaps_us.begin(), w.gaps_us.end());
+// The median of the recent gaps, taken when a gap is added: every report and frame reads it.
+double median_period(const std::deque<double>& gaps_us) {
+  if (gaps_us.size() < kMinPeriodGaps) return kNominalPeriodUs;
+  std::vector<double> g(gaps_us.begin(), gaps_us.end());
   const auto mid = g.begin() + static_cast<std::ptrdiff_t>(g.size() / 2);
   std::nth_element(g.begin(), mid, g.end());
   return *mid;
 }
+
+double period_of(const CameraWindow& w) { return w.period_us; }
 
 void erase_front(CameraWindow& w, size_t n) {
   CameraFrames& f = w.frames;
@@ -300,6 +303,7 @@ void triangulate_report(const TrackingRig& rig, TriangulateState& s, const Camer
   } else if (r.t_us > w.last_arrival_us) {
     w.gaps_us.push_back(static_cast<double>(r.t_us - w.last_arrival_us));
     if (w.gaps_us.size() > kPeriodGaps) w.gaps_us.pop_front();
+    w.period_us = median_period(w.gaps_us);
   }
   w.last_arrival_us = r.t_us;
   w.waiting.push_back(r);

@@ -45,6 +45,7 @@ struct CameraWindow {
   std::deque<tracking::CameraReport> waiting;
   // Frame clock: recent arrival gaps (for the period and the timeouts), the frame numbering.
   std::deque<double> gaps_us;
+  double period_us = 10'000;                  // their median once there are 8 (the nominal 100 Hz before)
   int64_t origin_us = 0;                      // arrival time of the camera's first report
   tracking::FrameNumbering clock;             // on arrivals since origin_us
   int64_t last_arrival_us = 0;
