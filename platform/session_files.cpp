@@ -6,7 +6,7 @@
 
 namespace fire {
 
-Result<SessionWriter> SessionWriter::create(const std::string& dir, std::string_view settings_json) {
+Result<SessionWriter> SessionWriter::create(const std::string& dir, std::string_view settings_json, std::string_view rig_json) {
   using R = Result<SessionWriter>;
   if (Status s = make_directory(dir); !s) return R::failure(s.error);
   auto names = list_directory(dir);
@@ -14,6 +14,8 @@ Result<SessionWriter> SessionWriter::create(const std::string& dir, std::string_
   if (!names->empty()) return R::failure(dir + ": the session folder is not empty (a session is written into a new folder)");
   SessionPaths paths{dir};
   if (Status s = write_file_durable(paths.settings(), settings_json); !s) return R::failure(s.error);
+  if (!rig_json.empty())
+    if (Status s = write_file_durable(paths.rig(), rig_json); !s) return R::failure(s.error);
   auto log = AppendFile::open(paths.log());
   if (!log) return R::failure(log.error());
   SessionWriter w(paths, std::move(*log));
@@ -100,6 +102,11 @@ Result<SessionContents> read_session(const std::string& dir) {
   for (const std::string& name : *names) {
     uint64_t frame = 0;
     if (parse_snapshot_name(name, frame)) c.snapshot_frames.push_back(frame);
+    if (name == kSessionRig) {
+      auto rig = read_text_file(c.paths.rig());
+      if (!rig) return R::failure(rig.error());
+      c.rig = std::move(*rig);
+    }
   }
   std::sort(c.snapshot_frames.rbegin(), c.snapshot_frames.rend());
   return c;

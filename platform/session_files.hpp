@@ -20,14 +20,16 @@ struct SessionContents {
   SessionPaths paths;
   std::string settings;   // settings.json as written
   std::string log_bytes;  // the log as found, torn tail included
+  std::string rig;        // rig.json as written; empty when the session has none (no device reports)
   RecoveredLog log;
   std::vector<uint64_t> snapshot_frames;  // newest first
 };
 
 class SessionWriter {
  public:
-  // Makes `dir` (missing or empty) and writes the settings and the log's header, durably.
-  static Result<SessionWriter> create(const std::string& dir, std::string_view settings_json);
+  // Makes `dir` (missing or empty) and writes the settings, the rig (when given) and the log's header, durably.
+  static Result<SessionWriter> create(const std::string& dir, std::string_view settings_json,
+                                      std::string_view rig_json = {});
   // Opens a session that read_session recovered for appending after a crash: cuts its torn last record
   // off the log (durably), so the next record starts a line of its own, and removes the temporary files a
   // killed writer left. The records kept count as not yet on disk until the next commit.

@@ -57,8 +57,8 @@ Run replay(const std::vector<InputEvent>& events, uint32_t levels, double snap) 
   // The replay loop of tools/fire/session.cpp, watching each frame for a commit and for the surface.
   begin_frame(w, 0, w.log.events.front().t_us);
   int64_t pending_commit = -1;  // frame index of a commit whose faces are not shown yet
-  while (w.cursor.next < w.log.events.size() || !w.sketch.pending.empty()) {
-    if (w.sketch.pending.empty() && w.log.events[w.cursor.next].t_us >= w.frame.end_us) {
+  while (!replay_done(w)) {
+    if (!systems_waiting(w) && w.log.events[w.cursor.next].t_us >= w.frame.end_us) {
       const int64_t steps = (w.log.events[w.cursor.next].t_us - w.frame.begin_us) / kFrameStepUs;
       begin_frame(w, w.frame.index + uint64_t(steps), w.frame.begin_us + steps * kFrameStepUs);
     }

@@ -136,6 +136,45 @@ std::optional<std::pair<int, int>> device_record(const std::string& text, std::s
 
 }  // namespace
 
+void DeviceDecoder::save(SnapshotWriter& out) const {
+  const ReportCounts& c = counts;
+  for (size_t n : {c.ir_reports, c.not_ir, c.garbled, c.bad_length, c.unknown_id, c.unknown_device, c.pad_reports,
+                   c.bad_device_records, c.out_of_range_slots})
+    out.put(uint64_t(n));
+  out.put(camera_address[0]);
+  out.put(camera_address[1]);
+  out.put(pad_address);
+  out.put(uint64_t(role_of_.size()));
+  for (const auto& [device, role] : role_of_) out.put(std::pair{int32_t(device), int32_t(role)});
+  out.put(uint8_t(has_records_));
+}
+
+bool DeviceDecoder::load(SnapshotReader& in) {
+  ReportCounts& c = counts;
+  for (size_t* n : {&c.ir_reports, &c.not_ir, &c.garbled, &c.bad_length, &c.unknown_id, &c.unknown_device,
+                    &c.pad_reports, &c.bad_device_records, &c.out_of_range_slots}) {
+    uint64_t v = 0;
+    in.get(v);
+    *n = size_t(v);
+  }
+  in.get(camera_address[0]);
+  in.get(camera_address[1]);
+  in.get(pad_address);
+  uint64_t roles = 0;
+  in.get(roles);
+  role_of_.clear();
+  for (uint64_t k = 0; k < roles && in.ok(); ++k) {
+    std::pair<int32_t, int32_t> entry;
+    in.get(entry);
+    if (entry.second != kPad && entry.second != kNoRole && entry.second != 0 && entry.second != 1) in.fail();
+    role_of_[entry.first] = entry.second;
+  }
+  uint8_t records = 0;
+  in.get(records);
+  has_records_ = records != 0;
+  return in.ok();
+}
+
 std::optional<CameraReport> DeviceDecoder::read(const InputEvent& e) {
   ReportCounts& c = counts;
   if (e.kind == EventKind::Meta && e.name == "device") {

@@ -19,6 +19,7 @@
 
 #include "engine/common.hpp"
 #include "engine/input_log.hpp"
+#include "engine/session_dir.hpp"
 #include "systems/tracking/calibration.hpp"
 #include "systems/tracking/camera.hpp"
 #include "systems/tracking/hid.hpp"
@@ -68,6 +69,10 @@ struct DeviceDecoder {
 
   // A camera's IR report, or nothing (a record, another kind of event, or input counted and skipped).
   std::optional<CameraReport> read(const InputEvent& event);
+
+  // For snapshots (engine/SESSION.md): everything above and the roles learned from the device records.
+  void save(SnapshotWriter& out) const;
+  bool load(SnapshotReader& in);
 
  private:
   std::map<int, int> role_of_;  // device -> camera index or pad, once the log has device records

@@ -20,6 +20,7 @@
 
 #include "engine/input_log.hpp"
 #include "engine/scheduler.hpp"
+#include "engine/session_dir.hpp"
 #include "systems/tracking/track.hpp"
 
 namespace fire {
@@ -94,6 +95,11 @@ struct TriangulateState {
 // `samples`, when given, receives every pen sample too (what `fire track --truth` measures).
 void triangulate_system(const FrameTime& frame, const TrackingRig& rig, TriangulateState& state,
                         std::vector<InputEvent>& frame_events, std::vector<tracking::PenSample>* samples = nullptr);
+
+// For snapshots (engine/SESSION.md): every field, so a reopened session triangulates its log's tail as the
+// run that wrote the snapshot would have. Loading fails on a state that cannot be (sizes that disagree).
+void save_triangulate_state(SnapshotWriter& out, const TriangulateState& state);
+bool load_triangulate_state(SnapshotReader& in, TriangulateState& state);
 
 // What went wrong with the device input so far, one sentence per kind of problem (none: empty).
 std::vector<std::string> describe_device_problems(const TriangulateState& state);

@@ -19,6 +19,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "platform/obj.hpp"
+#include "systems/tracking/rig_io.hpp"
+#include "systems/tracking/simulate.hpp"
+#include "tools/fire/session_rig.hpp"
 #include "tools/fire/session_store.hpp"
 
 using namespace fire;
@@ -85,13 +89,28 @@ std::vector<InputEvent> without_durable(const std::vector<InputEvent>& events) {
   return out;
 }
 
-// A clean replay of these events from the start, as `fire replay LOG --hash` runs it.
-uint64_t clean_hash(const std::vector<InputEvent>& events) {
+// The rig of a log of device reports, from rig.json's text (none: empty).
+std::optional<TrackingRig> rig_of(const std::string& rig_json, const std::vector<InputEvent>& events) {
+  if (rig_json.empty()) return std::nullopt;
+  InputLog log;
+  log.events = events;
+  auto rig = tracking_rig_from_json(rig_json, "rig.json", log, "log");
+  REQUIRE(rig.ok());
+  return *rig;
+}
+
+// A clean replay of these events from the start, as `fire replay LOG [--rig RIG] --hash` runs it.
+uint64_t clean_hash(const std::vector<InputEvent>& events, const std::string& rig_json = "", World* out = nullptr) {
   auto w = std::make_unique<World>();
   w->log.events = events;
+  w->rig = rig_of(rig_json, events);
   Scheduler s = make_scheduler(*w, fake_clock);
   replay_headless(*w, s);
   REQUIRE(w->mesh.validate() == "");
+  if (out) {
+    out->triangulate = w->triangulate;
+    out->rejections = w->rejections;
+  }
   return world_hash(*w);
 }
 
@@ -104,11 +123,13 @@ uint64_t demo_prefix_hash(size_t n) {
   return memo[n] = clean_hash(std::vector<InputEvent>(all.begin(), all.begin() + std::ptrdiff_t(std::min(n, all.size()))));
 }
 
-Status write_session(const InputLog& log, const fs::path& dir, const SessionWriteOptions& options) {
+Status write_session(const InputLog& log, const fs::path& dir, const SessionWriteOptions& options,
+                     const std::string& rig_json = "") {
   auto w = std::make_unique<World>();
   w->log = log;
+  w->rig = rig_of(rig_json, log.events);
   Scheduler s = make_scheduler(*w, fake_clock);
-  auto out = SessionWriter::create(dir.string(), settings_json(*w));
+  auto out = SessionWriter::create(dir.string(), settings_json(*w), rig_json);
   if (!out) return Status::failure(out.error());
   return replay_into_session(*w, s, *out, options);
 }
@@ -127,17 +148,18 @@ uint64_t snapshot_log_bytes(const std::string& file) {
 struct WrittenSession {
   TempDir root;
   fs::path dir;
-  std::string settings, log;
+  std::string settings, log, rig;
   std::map<uint64_t, std::string> snapshots;     // frame -> file bytes
   std::map<uint64_t, uint64_t> snapshot_prefix;  // frame -> log bytes it continues from
 };
 
-void write_with_snapshots(const InputLog& log, uint64_t every, WrittenSession& s) {
+void write_with_snapshots(const InputLog& log, uint64_t every, WrittenSession& s, const std::string& rig_json = "") {
   s.dir = s.root.path / "whole";
+  s.rig = rig_json;
   SessionWriteOptions options;
   options.snapshot_every = every;
   options.on_snapshot = [&](uint64_t frame) { s.snapshots[frame] = read_file(SessionPaths{s.dir.string()}.snapshot(frame)); };
-  REQUIRE(write_session(log, s.dir, options).ok());
+  REQUIRE(write_session(log, s.dir, options, rig_json).ok());
   s.settings = read_file(s.dir / kSessionSettings);
   s.log = read_file(s.dir / kSessionLog);
   for (const auto& [frame, bytes] : s.snapshots) s.snapshot_prefix[frame] = snapshot_log_bytes(bytes);
@@ -156,8 +178,9 @@ struct SnapshotCoverage {
   size_t pen_down = 0, pending = 0, redo = 0, tails = 0;
 };
 
-// Reopens `s` from each of its snapshots alone with the whole log: the hash must be `expected`.
-SnapshotCoverage reopen_from_each_snapshot(const WrittenSession& s, uint64_t expected) {
+// Reopens `s` from each of its snapshots alone with the whole log: the hash must be `expected`, and with a
+// rig the triangulation system must end as `tracked` (its counts and the rejections of its strokes).
+SnapshotCoverage reopen_from_each_snapshot(const WrittenSession& s, uint64_t expected, const World* tracked = nullptr) {
   SnapshotCoverage c;
   TempDir scratch;
   for (const auto& [frame, bytes] : s.snapshots) {
@@ -166,11 +189,13 @@ SnapshotCoverage reopen_from_each_snapshot(const WrittenSession& s, uint64_t exp
     fs::create_directory(dir);
     write_file(dir / kSessionSettings, s.settings);
     write_file(dir / kSessionLog, s.log);
+    if (!s.rig.empty()) write_file(dir / kSessionRig, s.rig);
     write_file(SessionPaths{dir.string()}.snapshot(frame), bytes);
     auto contents = read_session(dir.string());
     REQUIRE(contents.ok());
     World w;
     REQUIRE(apply_settings_json(contents->settings, "settings", w).ok());
+    w.rig = rig_of(s.rig, contents->log.log.events);
     auto reader = SnapshotReader::open(bytes, "snapshot");
     REQUIRE(reader.ok());
     REQUIRE(load_world_snapshot(*reader, *contents, w).ok());
@@ -185,6 +210,17 @@ SnapshotCoverage reopen_from_each_snapshot(const WrittenSession& s, uint64_t exp
     c.tails += r->events_replayed > 0;
     REQUIRE(r->world->mesh.validate() == "");
     REQUIRE(world_hash(*r->world) == expected);
+    if (tracked) {
+      const TriangulateState& a = r->world->triangulate;
+      const TriangulateState& b = tracked->triangulate;
+      CHECK(a.counts.strokes == b.counts.strokes);
+      CHECK(a.counts.frames_seen_by_both == b.counts.frames_seen_by_both);
+      CHECK(a.counts.bridged_frames == b.counts.bridged_frames);
+      CHECK(a.time_offset_us == b.time_offset_us);
+      CHECK(a.offset_estimates == b.offset_estimates);
+      CHECK(describe_device_problems(a) == describe_device_problems(b));
+      CHECK(r->world->rejections.size() == tracked->rejections.size());
+    }
   }
   // Only the last snapshot, after the last frame, has no tail to replay.
   CHECK(c.tails + 1 == s.snapshots.size());
@@ -339,6 +375,62 @@ TEST_CASE("every snapshot plus the log's tail equals a full replay, hash for has
     CHECK(c.pen_down > 0);
     CHECK(c.redo > 0);
   }
+}
+
+TEST_CASE("a tracked drawing's snapshots hold the triangulation system's state", "[session][snapshot][tracked]") {
+  // Wii Remote reports of a pen drawing on the pawn, simulated, with the true cameras as the rig: each
+  // snapshot, taken while the system holds reports waiting for their frame numbers, an open stroke and
+  // its filter, reopens to what a clean `fire replay --rig` gives.
+  auto pawn = read_obj(FIRE_SHARED_DIR "/data/meshes/pawn.obj");
+  REQUIRE(pawn.ok());
+  tracking::RigOptions rig_options;
+  rig_options.occlusion_per_s = 0.5;
+  tracking::SketchOptions sketch;
+  sketch.duration_s = 14;
+  sketch.strokes = 4;
+  sketch.hold_s = 0.5;
+  auto simulated = tracking::simulate_sketch(rig_options, sketch,
+                                             {pawn->positions, pawn->face_offsets, pawn->face_vertices});
+  REQUIRE(simulated.ok());
+  auto cameras = tracking::make_simulated_rig(rig_options);
+  REQUIRE(cameras.ok());
+  tracking::CalibrationResult calibrated;
+  calibrated.cam0 = cameras->cameras[0];
+  calibrated.cam1 = cameras->cameras[1];
+  calibrated.time_offset_us = rig_options.clock_offset_ms * 1e3;
+  const std::string rig_json = tracking::rig_to_json(calibrated);
+  auto log = parse_input_log(format_input_log(simulated->events), "sketch.log");
+  REQUIRE(log.ok());
+
+  WrittenSession s;
+  write_with_snapshots(*log, 53, s, rig_json);
+  REQUIRE(s.snapshots.size() >= 10);
+  World tracked;
+  const uint64_t expected = clean_hash(log->events, rig_json, &tracked);
+  REQUIRE(tracked.triangulate.counts.strokes >= 3);
+  CHECK(clean_hash(recover_input_log(s.log, "log")->log.events, rig_json) == expected);
+  reopen_from_each_snapshot(s, expected, &tracked);
+
+  // Without its rig.json the session is refused in words, not replayed without its pen.
+  const fs::path bare = s.root.path / "no-rig";
+  fs::create_directory(bare);
+  write_file(bare / kSessionSettings, s.settings);
+  write_file(bare / kSessionLog, s.log);
+  const auto& [frame, bytes] = *s.snapshots.begin();
+  write_file(SessionPaths{bare.string()}.snapshot(frame), bytes);
+  auto r = reopen_session(bare.string(), fake_clock);
+  REQUIRE_FALSE(r.ok());
+  CHECK(r.error() == (bare / "input.log").string() + " holds Wii Remote reports, but the session has no rig.json to "
+                     "triangulate them with (put the rig they were drawn with there, from fire calibrate)");
+  // A snapshot of a tracked drawing in a session whose rig went missing is passed over by name.
+  World w;
+  auto contents = read_session(s.dir.string());
+  REQUIRE(contents.ok());
+  auto reader = SnapshotReader::open(bytes, "snapshot");
+  REQUIRE(reader.ok());
+  const Status loaded = load_world_snapshot(*reader, *contents, w);
+  REQUIRE_FALSE(loaded.ok());
+  CHECK(loaded.error == "holds the triangulation system's state, but the session has no rig.json");
 }
 
 TEST_CASE("a session writer killed with SIGKILL at random moments reopens with every committed stroke",

@@ -244,3 +244,24 @@ settings, log, snap = session(logs["border_split"])
 put("session", "torn_log", settings + b"\0" + log + b"1 pen 0.1 0.2" + b"\0" + snap)
 put("session", "other_log", settings + b"\0" + log.replace(b"scene dome", b"scene bowl", 1) + b"\0" + snap)
 put("session", "cut_snapshot", settings + b"\0" + log + b"\0" + snap[: len(snap) // 2])
+
+
+def tracked_session():
+    """settings, log and the older kept snapshot (taken mid-drawing) of a short simulated Wii Remote drawing
+    written as a session with its rig: a snapshot holding the triangulation system's state."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = lambda name: os.path.join(tmp, name)
+        quiet = dict(check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        subprocess.run([fire, "simulate", "wand", "-o", path("w.log"), "--duration-s", "20"], **quiet)
+        subprocess.run([fire, "calibrate", path("w.log"), "-o", path("rig.json")], **quiet)
+        subprocess.run([fire, "simulate", "sketch", "-o", path("s.log"), "--duration-s", "2.5", "--strokes", "1",
+                        "--hold-s", "0.3"], **quiet)
+        subprocess.run([fire, "replay", path("s.log"), "--rig", path("rig.json"), "--session", path("session"),
+                        "--snapshot-every", "60"], **quiet)
+        read = lambda name: open(os.path.join(tmp, "session", name), "rb").read()
+        older = sorted(glob.glob(os.path.join(tmp, "session", "*.fsnap")))[-2]
+        return read("settings.json"), read("input.log"), open(older, "rb").read()
+
+
+settings, log, snap = tracked_session()
+put("session", "tracked", settings + b"\0" + log + b"\0" + snap)

@@ -384,7 +384,7 @@ int run_app(const AppArgs& a) {
   if (!app.status()) return fail("Vulkan: " + app.status().error);
 
   // Every logged event handled, as `fire replay` ends; then the last picture, which --screenshot keeps.
-  while (w.cursor.next < w.log.events.size() || !w.sketch.pending.empty()) app.run_frame();
+  while (!replay_done(w)) app.run_frame();
   render::Image shot;
   if (!a.screenshot_path.empty()) {
     bool shown = false;

@@ -10,6 +10,7 @@
 #include "platform/surface_io.hpp"
 #include "tools/fire/commands.hpp"
 #include "tools/fire/session.hpp"
+#include "tools/fire/session_rig.hpp"
 #include "tools/fire/session_store.hpp"
 
 namespace fire::cli {
@@ -52,9 +53,8 @@ int run_replay(const ReplayOptions& o) {
     std::cerr << "fire replay: --session writes a new session from a log; " << o.log_path << " is a session already\n";
     return 1;
   }
-  if (!o.rig_path.empty() && (session_in || !o.session_dir.empty())) {
-    std::cerr << "fire replay: --rig with a session folder is not supported yet: a snapshot does not hold the "
-                 "triangulation system's state, so a reopened session could not continue bit for bit\n";
+  if (!o.rig_path.empty() && session_in) {
+    std::cerr << "fire replay: " << o.log_path << " is a session folder: it replays with the rig.json it holds, not --rig\n";
     return 1;
   }
   if (o.snapshot_every > 0 && o.session_dir.empty()) {
@@ -95,13 +95,17 @@ int run_replay(const ReplayOptions& o) {
       return 1;
     }
     world = std::make_unique<World>();
+    std::string rig_text;  // a session written from this log keeps a copy of it
     if (!o.rig_path.empty()) {
-      Result<TrackingRig> rig = load_tracking_rig(o.rig_path, *log, o.log_path);
+      Result<std::string> text = read_text_file(o.rig_path);
+      Result<TrackingRig> rig = text ? tracking_rig_from_json(*text, o.rig_path, *log, o.log_path)
+                                     : Result<TrackingRig>::failure(text.error());
       if (!rig) {
         std::cerr << "fire replay: " << rig.error() << "\n";
         return 1;
       }
       world->rig = *rig;
+      rig_text = std::move(*text);
     } else if (has_device_reports(*log)) {
       std::cerr << "fire replay: " << o.log_path << " holds Wii Remote reports; give the rig they were drawn with: "
                 << "--rig RIG.json (from fire calibrate)\n";
@@ -115,7 +119,7 @@ int run_replay(const ReplayOptions& o) {
     if (o.session_dir.empty()) {
       replay_headless(*world, *scheduler_owner);
     } else {
-      auto writer = SessionWriter::create(o.session_dir, settings_json(*world));
+      auto writer = SessionWriter::create(o.session_dir, settings_json(*world), rig_text);
       if (!writer) {
         std::cerr << "fire replay: " << writer.error() << "\n";
         return 1;
@@ -206,7 +210,8 @@ void add_network_commands(CLI::App& app, Registry& registry) {
       ->capture_default_str();
   replay->add_option("--rig", o->rig_path,
                      "rig file from fire calibrate: the log's Wii Remote reports go through the triangulation system "
-                     "(pen samples in the rig's frame, camera 0's, metres); needed when the log holds reports");
+                     "(pen samples in the rig's frame, camera 0's, metres); needed when the log holds reports; a --session "
+                     "written from the log keeps a copy (rig.json), so reopening it needs no --rig");
   replay->add_option("-o,--output", o->out_path, "write the final curve network here (format: engine/NETWORK_FORMAT.md)");
   replay->add_option("--export-obj", o->obj_path, "also write the network's polylines as OBJ lines");
   replay->add_option("--surface", o->surface_path,

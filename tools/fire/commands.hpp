@@ -19,11 +19,6 @@ void add_synth_commands(CLI::App& app, Registry& registry);
 
 // simulate wand|sketch, calibrate, track (stereo tracking, systems/tracking)
 void add_tracking_commands(CLI::App& app, Registry& registry);
-// The rig a log of device reports was drawn with, for the triangulation system: reads rig_path and refuses
-// it when the log's device records name other remotes than the rig's. Errors name the files.
-Result<TrackingRig> load_tracking_rig(const std::string& rig_path, const InputLog& log, const std::string& log_path);
-// Whether a log holds device reports (and so needs a rig to be replayed).
-bool has_device_reports(const InputLog& log);
 
 // eval (surface distance to a reference limit surface, systems/evaluate)
 void add_eval_commands(CLI::App& app, Registry& registry);

@@ -57,9 +57,13 @@ void replay_headless(World& w, Scheduler& scheduler, const ReplayHooks& hooks) {
   continue_replay(w, scheduler, hooks);
 }
 
+bool systems_waiting(const World& w) { return !w.sketch.pending.empty() || (w.rig && w.triangulate.busy()); }
+
+bool replay_done(const World& w) { return w.cursor.next >= w.log.events.size() && !systems_waiting(w); }
+
 void continue_replay(World& w, Scheduler& scheduler, const ReplayHooks& hooks) {
-  auto waiting = [&] { return !w.sketch.pending.empty() || (w.rig && w.triangulate.busy()); };
-  while (w.cursor.next < w.log.events.size() || waiting()) {
+  auto waiting = [&] { return systems_waiting(w); };
+  while (!replay_done(w)) {
     // Skip stretches with nothing to do: the frames still count, so frame numbers match a live session.
     if (!waiting() && w.log.events[w.cursor.next].t_us >= w.frame.end_us) {
       const int64_t steps = (w.log.events[w.cursor.next].t_us - w.frame.begin_us) / kFrameStepUs;

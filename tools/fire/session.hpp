@@ -65,6 +65,11 @@ void begin_frame(World& world, uint64_t index, int64_t begin_us);
 struct ReplayHooks {
   std::function<void(const World&)> before_frame, after_frame;
 };
+// Whether a system still holds input that later frames will act on (the sketch system's requests, the
+// triangulation system's reports or open stroke): a replay out of events runs frames until it does not.
+bool systems_waiting(const World& world);
+// Every event consumed and nothing waiting: where a replay ends.
+bool replay_done(const World& world);
 // Runs fixed-step frames from the first event until every event is consumed and no request waits.
 void replay_headless(World& world, Scheduler& scheduler, const ReplayHooks& hooks = {});
 // The same from where `world` stands: a frame begun, as replay_headless and a loaded snapshot leave it.

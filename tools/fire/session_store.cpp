@@ -4,6 +4,8 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "tools/fire/session_rig.hpp"
+
 namespace fire {
 
 namespace {
@@ -121,6 +123,8 @@ std::string snapshot_world(const World& w, uint64_t log_bytes, uint64_t log_hash
     out.put(r.line);
     out.put(r.reason);
   }
+  out.put(uint8_t(w.rig.has_value()));
+  if (w.rig) save_triangulate_state(out, w.triangulate);
   return out.finish();
 }
 
@@ -162,6 +166,15 @@ Status load_world_snapshot(SnapshotReader& in, const SessionContents& session, W
     in.get(r.line);
     in.get(r.reason);
   }
+  uint8_t tracked = 0;
+  in.get(tracked);
+  if (in.ok() && tracked > 1) in.fail();
+  if (in.ok() && (tracked != 0) != w.rig.has_value())
+    return Status::failure(tracked ? "holds the triangulation system's state, but the session has no " +
+                                         std::string(kSessionRig)
+                                   : "holds no triangulation state, but the session has a " + std::string(kSessionRig));
+  if (in.ok() && tracked && !load_triangulate_state(in, w.triangulate))
+    return Status::failure("the triangulation system's state does not load");
   if (!in.ok() || !in.at_end()) return Status::failure("cut off or followed by bytes it does not hold (damaged)");
   if (std::string problem = w.mesh.validate(); !problem.empty())
     return Status::failure("the pools break an invariant: " + problem);
@@ -212,7 +225,7 @@ Status replay_into_session(World& w, Scheduler& scheduler, SessionWriter& out, c
     if (commit_point) commit();
   };
   hooks.after_frame = [&](const World& world) {
-    const bool last = world.cursor.next >= world.log.events.size() && world.sketch.pending.empty();
+    const bool last = replay_done(world);
     if (options.snapshot_every > 0 && (last || world.frame.index >= last_snapshot + options.snapshot_every))
       snapshot(world);
   };
@@ -229,9 +242,18 @@ Result<ReopenedSession> reopen_session(const std::string& dir, Scheduler::Clock 
   auto fresh = [&] {
     auto w = std::make_unique<World>();
     Status s = apply_settings_json(c.settings, c.paths.settings(), *w);
+    if (s && !c.rig.empty()) {
+      Result<TrackingRig> rig = tracking_rig_from_json(c.rig, c.paths.rig(), c.log.log, c.paths.log());
+      if (rig) w->rig = *rig;
+      else s = Status::failure(rig.error());
+    }
     return std::make_pair(std::move(w), s);
   };
   if (Status s = fresh().second; !s) return Result<ReopenedSession>::failure(s.error);
+  if (c.rig.empty() && has_device_reports(c.log.log))
+    return Result<ReopenedSession>::failure(c.paths.log() + " holds Wii Remote reports, but the session has no " +
+                                            std::string(kSessionRig) + " to triangulate them with (put the rig "
+                                            "they were drawn with there, from fire calibrate)");
   ReopenedSession r;
   if (c.log.dropped_bytes > 0)
     r.notes.push_back(c.paths.log() + ":" + std::to_string(c.log.torn_line) + ": torn last record dropped (" +

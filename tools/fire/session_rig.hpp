@@ -1,0 +1,20 @@
+#pragma once
+// The rig a session's device reports were drawn with: from a rig file given on the command line, or from
+// the copy a session folder keeps (engine/SESSION.md), checked against the log's remotes either way.
+#include <string>
+
+#include "engine/input_log.hpp"
+#include "systems/triangulate/triangulate.hpp"
+
+namespace fire {
+
+// The rig a log of device reports was drawn with, for the triangulation system: reads rig_path and refuses
+// it when the log's device records name other remotes than the rig's. Errors name the files.
+Result<TrackingRig> load_tracking_rig(const std::string& rig_path, const InputLog& log, const std::string& log_path);
+// The same from rig.json's text (a session folder's copy); `rig_path` names it in errors.
+Result<TrackingRig> tracking_rig_from_json(const std::string& rig_text, const std::string& rig_path, const InputLog& log,
+                                           const std::string& log_path);
+// Whether a log holds device reports (and so needs a rig to be replayed).
+bool has_device_reports(const InputLog& log);
+
+}  // namespace fire
