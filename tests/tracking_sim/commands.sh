@@ -71,6 +71,18 @@ expect_replay_error "replay of device reports without a rig" "give the rig they 
 sed '0,/{/s//{"remotes": [{"address": "00:1f:32:aa:bb:01", "role": "camera0"}],/' rig.json > other_rig.json
 expect_replay_error "replay with the rig of other remotes" "was calibrated with 00:1F:32:AA:BB:01 as camera 0" other.log --rig other_rig.json
 
+# Written as a session, the drawing keeps its rig: reopening it (last snapshot, then the tail) needs no
+# --rig and gives the same hash; a session whose rig.json is gone is refused by name.
+h3=$("$fire" replay occluded.log --rig rig.json --session tracked --snapshot-every 700 --hash)
+[ "$h3" = "$h1" ] || fail "fire replay --rig --session ($h3) and fire replay --rig ($h1) disagree"
+cmp -s rig.json tracked/rig.json || fail "the session folder's rig.json is not the rig it was written with"
+h4=$("$fire" replay tracked --hash 2>reopen.txt)
+[ "$h4" = "$h1" ] || fail "the reopened tracked session ($h4) is not the replay ($h1)"
+grep -q "snapshot after frame" reopen.txt || fail "the tracked session reopened without its snapshot: $(cat reopen.txt)"
+expect_replay_error "a session folder given --rig" "it replays with the rig.json it holds" tracked --rig rig.json
+rm tracked/rig.json
+expect_replay_error "a tracked session without its rig" "has no rig.json to triangulate them with" tracked
+
 # Damage some reports: an odd hex digit count, a truncated report, an unknown id, a NaN truth line.
 awk 'BEGIN{n=0} / hid /{n++; if (n==100) $4=$4"f"; if (n==200) $4=substr($4,1,10); if (n==300) $4="99" substr($4,3)}
      {print} / hid 0 /{if (!done && n>400) {print $1" truth pen 0 nan 0 0 0 1 0 0"; done=1}}' s.log > damaged.log
