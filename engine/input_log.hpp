@@ -29,6 +29,9 @@ struct InputEvent {
 
 struct InputLog {
   std::vector<InputEvent> events;
+  // Events dropped from the front of `events` once delivered and on disk (a live session's log, which
+  // would otherwise grow with the drawing): events[0] is the log's event number `forgotten`.
+  uint64_t forgotten = 0;
   size_t rejected_hid_lines = 0;      // garbled hid payloads, kept as events with hid_ok = false
   size_t hid_back_in_time = 0;        // hid lines stamped before the line above them, kept
 };

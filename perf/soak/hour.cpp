@@ -1,8 +1,9 @@
 // The simulated hour (issue 14): an hour of seeded pen input drawn through the whole frame (input, sketch,
-// split, refine, subdivide, snap) while the session folder is written, exactly as `fire replay LOG
-// --session DIR` writes it (replay_into_session: the log appended and fsynced at every pen-up and command,
-// snapshots every --snapshot-every frames). Prints resident memory before the log is made, once it is in
-// memory, every five simulated minutes and at the end, the peak, and the log's and snapshots' size on disk.
+// split, refine, subdivide, snap) while the session folder is written, as `fire app --session DIR` writes
+// it (SessionRecorder: each event appended as its frame delivers it, the log fsynced at every pen-up and
+// command, snapshots every --snapshot-every frames, delivered events dropped from memory). The events
+// arrive as the frames reach their time, as the app's do. Prints resident memory at the start, every five
+// simulated minutes and at the end, the peak, and the log's and snapshots' size on disk.
 //
 // The drawing: a square border on a 20 cm dome, then splits, each across one rectangle of the drawing from
 // one side to the opposite side (so both ends lie on the same face); now and then an undo and a redo, or a
@@ -15,6 +16,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <deque>
 #include <filesystem>
 #include <random>
 #include <string>
@@ -52,7 +54,7 @@ class Drawing {
   Drawing(uint64_t seed, int64_t end_us) : rng_(seed), end_us_(end_us) {}
 
   bool more_time() const { return t_ < end_us_; }
-  InputLog take() { return std::move(log_); }
+  InputLog take() { return std::exchange(log_, {}); }
   uint64_t strokes = 0, drawings = 0;
 
   void draw(uint32_t min_faces, uint32_t max_faces) {
@@ -158,17 +160,31 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  const double rss_before = resident_mib();
+  // The events arrive as the app's do: a drawing's worth is made when the frames reach it, handed to the
+  // world's log as its time comes, and dropped from memory once delivered (the session has it on disk).
   const int64_t end_us = 1'000'000 + int64_t(minutes * 60e6);
   Drawing drawing(seed, end_us);
-  while (drawing.more_time()) drawing.draw(min_faces, max_faces);
+  std::deque<InputEvent> coming;
   World w;
-  w.log = drawing.take();
+  auto refill = [&] {
+    while (coming.empty() && drawing.more_time()) {
+      drawing.draw(min_faces, max_faces);
+      for (InputEvent& e : drawing.take().events) coming.push_back(std::move(e));
+    }
+  };
+  auto arrive = [&](int64_t before_us) {
+    for (refill(); !coming.empty() && coming.front().t_us < before_us; refill()) {
+      w.log.events.push_back(std::move(coming.front()));
+      coming.pop_front();
+    }
+  };
+  refill();
+  if (coming.empty()) {
+    std::fprintf(stderr, "hour: --minutes %g draws nothing\n", minutes);
+    return 2;
+  }
+  arrive(coming.front().t_us + 1);  // the first event fixes frame 0, as in a replay
   const double rss_start = resident_mib();
-  std::printf("log: %zu events in memory (%llu strokes, %llu drawings, %.0f simulated minutes)\n", w.log.events.size(),
-              static_cast<unsigned long long>(drawing.strokes), static_cast<unsigned long long>(drawing.drawings),
-              minutes);
-  std::printf("resident: %.1f MiB before the log, %.1f MiB with it (the start)\n", rss_before, rss_start);
 
   std::filesystem::remove_all(dir);
   auto writer = SessionWriter::create(dir, settings_json(w));
@@ -185,18 +201,36 @@ int main(int argc, char** argv) {
     snapshot_max = std::max(snapshot_max, snapshot_last);
   };
   int64_t next_report = w.log.events.front().t_us;
-  std::printf("%8s %12s %8s %10s %12s %8s %14s\n", "minute", "resident_MiB", "faces", "undo_depth", "vertex_slots",
-              "log_MiB", "snapshot_KiB");
+  std::printf("%8s %12s %8s %10s %12s %8s %14s %10s\n", "minute", "resident_MiB", "faces", "undo_depth", "vertex_slots",
+              "log_MiB", "snapshot_KiB", "in_memory");
   options.on_commit = [&](uint64_t, uint64_t) {
     if (w.frame.begin_us < next_report) return;
     next_report += kReportEveryUs;
-    std::printf("%8.1f %12.1f %8zu %10zu %12zu %8.1f %14.1f\n", double(w.frame.begin_us) / 60e6, resident_mib(),
+    std::printf("%8.1f %12.1f %8zu %10zu %12zu %8.1f %14.1f %10zu\n", double(w.frame.begin_us) / 60e6, resident_mib(),
                 w.mesh.face_count(), w.history.undo_depth(), w.mesh.vertex_slots(),
-                double(writer->log_bytes()) / (1 << 20), double(snapshot_last) / 1024);
+                double(writer->log_bytes()) / (1 << 20), double(snapshot_last) / 1024, w.log.events.size());
     std::fflush(stdout);
   };
   const auto started = std::chrono::steady_clock::now();
-  if (Status s = replay_into_session(w, scheduler, *writer, options); !s) {
+  // The app's frame loop (AppWindow::run_frame with a session): frames with no input are skipped as a
+  // replay skips them, which changes nothing but the count of frames run.
+  SessionRecorder recorder(w, *writer, options);
+  begin_frame(w, 0, w.log.events.front().t_us);
+  for (;;) {
+    arrive(w.frame.end_us);
+    if (replay_done(w)) {
+      if (coming.empty()) break;
+      const int64_t steps = (coming.front().t_us - w.frame.begin_us) / kFrameStepUs;
+      begin_frame(w, w.frame.index + uint64_t(steps), w.frame.begin_us + steps * kFrameStepUs);
+      arrive(w.frame.end_us);
+    }
+    recorder.before_frame(w);
+    scheduler.run_frame();
+    recorder.after_frame(w, false);
+    forget_delivered_events(w);
+    begin_frame(w, w.frame.index + 1, w.frame.end_us);
+  }
+  if (Status s = recorder.finish(); !s) {
     std::fprintf(stderr, "hour: %s\n", s.error.c_str());
     return 1;
   }
@@ -208,6 +242,10 @@ int main(int argc, char** argv) {
     uint64_t frame = 0;
     if (parse_snapshot_name(entry.path().filename().string(), frame)) snapshot_bytes += entry.file_size(), ++snapshots;
   }
+  std::printf("%llu events (%llu strokes, %llu drawings, %.0f simulated minutes), %zu in memory at the end\n",
+              static_cast<unsigned long long>(w.log.forgotten + w.log.events.size()),
+              static_cast<unsigned long long>(drawing.strokes), static_cast<unsigned long long>(drawing.drawings), minutes,
+              w.log.events.size());
   std::printf("frames %llu, %zu edits rejected, %llu commits, %.1f s wall\n",
               static_cast<unsigned long long>(scheduler.frames()), w.rejections.size(),
               static_cast<unsigned long long>(writer->commits()), wall);

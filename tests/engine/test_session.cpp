@@ -377,6 +377,44 @@ TEST_CASE("every snapshot plus the log's tail equals a full replay, hash for has
   }
 }
 
+TEST_CASE("a live session forgets the events it has written and still reopens to the same drawing", "[session][live]") {
+  // The app's loop (AppWindow::run_frame with a session): events arrive as their time comes, each frame's
+  // are written before it runs, and the delivered ones leave memory (kept below 8 here, 4096 in the app).
+  TempDir root;
+  const fs::path dir = root.path / "live";
+  const auto& demo = demo_log().events;
+  World w;
+  auto out = SessionWriter::create(dir.string(), settings_json(w));
+  REQUIRE(out.ok());
+  Scheduler s = make_scheduler(w, fake_clock);
+  SessionWriteOptions options;
+  options.snapshot_every = 41;
+  SessionRecorder recorder(w, *out, options);
+  size_t arrived = 0, most_in_memory = 0;
+  auto arrive = [&](int64_t before_us) {
+    for (; arrived < demo.size() && demo[arrived].t_us < before_us; ++arrived) w.log.events.push_back(demo[arrived]);
+  };
+  arrive(demo.front().t_us + 1);
+  begin_frame(w, 0, demo.front().t_us);
+  while (arrived < demo.size() || !replay_done(w)) {
+    arrive(w.frame.end_us);
+    recorder.before_frame(w);
+    s.run_frame();
+    recorder.after_frame(w, false);
+    forget_delivered_events(w, 8);
+    most_in_memory = std::max(most_in_memory, w.log.events.size());
+    begin_frame(w, w.frame.index + 1, w.frame.end_us);
+  }
+  REQUIRE(recorder.finish().ok());
+  CHECK(w.log.forgotten + w.log.events.size() == demo.size());
+  CHECK(most_in_memory < 30);
+  CHECK(world_hash(w) == demo_hash());
+  auto r = reopen_session(dir.string(), fake_clock);
+  REQUIRE(r.ok());
+  CHECK(r->snapshot.has_value());
+  CHECK(world_hash(*r->world) == demo_hash());
+}
+
 TEST_CASE("a tracked drawing's snapshots hold the triangulation system's state", "[session][snapshot][tracked]") {
   // Wii Remote reports of a pen drawing on the pawn, simulated, with the true cameras as the rig: each
   // snapshot, taken while the system holds reports waiting for their frame numbers, an open stroke and

@@ -69,12 +69,17 @@ int64_t AppWindow::session_us() const {
 void AppWindow::log_event(InputEvent e) {
   InputLog& log = world_.log;
   e.t_us = std::max({session_us(), world_.frame.begin_us, log.events.back().t_us});
-  e.line = uint32_t(log.events.size() + 2);  // its line in the recorded log (after the header)
+  e.line = uint32_t(log.forgotten + log.events.size() + 2);  // its line in the recorded log (after the header)
   log.events.push_back(std::move(e));
 }
 
-void AppWindow::run_frame() {
+void AppWindow::run_frame(bool last) {
+  if (recorder_) recorder_->before_frame(world_);
   scheduler_.run_frame();
+  if (recorder_) {
+    recorder_->after_frame(world_, last);
+    forget_delivered_events(world_);
+  }
   begin_frame(world_, world_.frame.index + 1, world_.frame.end_us);
 }
 

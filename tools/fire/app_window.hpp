@@ -12,6 +12,7 @@
 #include "platform/window/hud.hpp"
 #include "platform/window/window.hpp"
 #include "tools/fire/session.hpp"
+#include "tools/fire/session_store.hpp"
 
 namespace fire::cli {
 
@@ -44,8 +45,11 @@ class AppWindow {
   // Appends `e` to the input log at the session's time, never before the frame about to run nor before the
   // last event, so the log stays in time order and a replay delivers it in the same frame.
   void log_event(InputEvent e);
-  // Runs the begun frame and begins the next.
-  void run_frame();
+  // Runs the begun frame and begins the next; with a session recorder, writes the frame's events to the
+  // session first and, after it, the snapshot the schedule asks for (one in any case after the `last`),
+  // and drops the delivered events from memory (they are on disk).
+  void run_frame(bool last = false);
+  void record_into(SessionRecorder* recorder) { recorder_ = recorder; }
   // One displayed frame, the camera from `orbit`. With `capture`, a presented frame is read back into it.
   // False: nothing was shown (minimised, the swapchain was remade for a new size, or status() failed).
   bool display(const render::Orbit& orbit, render::Image* capture = nullptr);
@@ -72,6 +76,7 @@ class AppWindow {
 
   World& world_;
   Scheduler& scheduler_;
+  SessionRecorder* recorder_ = nullptr;
   std::unique_ptr<window::Window> window_;
   std::unique_ptr<render::Context> context_;
   std::unique_ptr<render::Presenter> presenter_;

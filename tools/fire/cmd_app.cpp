@@ -33,7 +33,8 @@ namespace {
 
 struct AppArgs {
   std::string input_path, reference_path, out_path, export_path, record_path, script_path, screenshot_path,
-      size = "1280x720";
+      session_dir, size = "1280x720";
+  uint64_t snapshot_every = 3000;
   uint32_t levels = 3;
   int reference_levels = 3;
   double snap_pixels = 12;
@@ -192,9 +193,20 @@ int run_app(const AppArgs& a) {
   if (!a.screenshot_path.empty() && !ends_with(a.screenshot_path, ".png"))
     return fail(a.screenshot_path + ": --screenshot must be a .png file");
   const bool from_network = ends_with(a.input_path, ".fnet");
+  const bool session_in = !a.input_path.empty() && is_directory(a.input_path);
+  const bool recording = session_in || !a.session_dir.empty();
   if (from_network && !a.record_path.empty())
     return fail("--record: a session that starts from a network file cannot be replayed from its log alone; "
                 "start from an input log or from nothing");
+  if (from_network && !a.session_dir.empty())
+    return fail("--session: a session that starts from a network file cannot be replayed from its log alone; "
+                "start from an input log or from nothing");
+  if (session_in && !a.session_dir.empty())
+    return fail("--session writes a new session folder; " + a.input_path +
+                " is a session already, and it goes on being written");
+  if (recording && !a.record_path.empty())
+    return fail("--record: the session folder's input.log is the record already");
+  if (a.snapshot_every == 0) return fail("--snapshot-every must be at least 1 frame");
   std::vector<ScriptEvent> script;
   if (!a.script_path.empty()) {
     auto s = read_script(a.script_path);
@@ -220,19 +232,41 @@ int run_app(const AppArgs& a) {
   const evaluate::TriangleBvh reference_bvh(reference);
   const std::vector<Vec3>& reference_positions = reference.positions;
 
-  // The session: a network to continue from, or an input log replayed first, or nothing.
-  auto world = std::make_unique<World>();
-  World& w = *world;
-  w.surface_options.levels = a.levels;
-  if (from_network) {
-    auto network = load_network(a.input_path);
-    if (!network) return fail(network.error());
-    w.mesh = std::move(*network);
-  } else if (!a.input_path.empty()) {
-    auto log = read_input_log(a.input_path);
-    if (!log) return fail(log.error());
-    w.log = std::move(*log);
+  // The session: a session folder to go on with, a network to continue from, or an input log replayed
+  // first, or nothing; written to a session folder as it goes, when it has one.
+  std::unique_ptr<World> world;
+  std::unique_ptr<Scheduler> scheduler_owner;
+  std::optional<SessionWriter> writer;
+  SessionWriteOptions write_options;
+  write_options.snapshot_every = a.snapshot_every;
+  if (session_in) {
+    auto reopened = reopen_session(a.input_path, monotonic_ns);
+    if (!reopened) return fail(reopened.error());
+    for (const std::string& note : reopened->notes) std::cerr << "fire app: " << note << "\n";
+    auto contents = read_session(a.input_path);
+    if (!contents) return fail(contents.error());
+    auto resumed = SessionWriter::resume(*contents);
+    if (!resumed) return fail(resumed.error());
+    writer.emplace(std::move(*resumed));
+    world = std::move(reopened->world);
+    scheduler_owner = std::move(reopened->scheduler);
+    std::cerr << "fire app: " << a.input_path << ": reopened ("
+              << (reopened->snapshot ? "snapshot after frame " + std::to_string(*reopened->snapshot) : std::string("no snapshot"))
+              << ", then " << reopened->events_replayed << " event(s) of its log); new strokes are added to it\n";
+  } else {
+    world = std::make_unique<World>();
+    world->surface_options.levels = a.levels;
+    if (from_network) {
+      auto network = load_network(a.input_path);
+      if (!network) return fail(network.error());
+      world->mesh = std::move(*network);
+    } else if (!a.input_path.empty()) {
+      auto log = read_input_log(a.input_path);
+      if (!log) return fail(log.error());
+      world->log = std::move(*log);
+    }
   }
+  World& w = *world;
   if (w.log.events.empty()) {
     // Frame 0 starts at the first event, in a replay as here: a first event at 0 fixes the clock's origin.
     InputEvent start;
@@ -241,12 +275,31 @@ int run_app(const AppArgs& a) {
     start.text = "fire app";
     w.log.events.push_back(start);
   }
-  Scheduler scheduler = make_scheduler(w, monotonic_ns);
-  replay_headless(w, scheduler);
+  if (!a.session_dir.empty()) {
+    auto created = SessionWriter::create(a.session_dir, settings_json(w));
+    if (!created) return fail(created.error());
+    writer.emplace(std::move(*created));
+  }
+  if (!scheduler_owner) scheduler_owner = std::make_unique<Scheduler>(make_scheduler(w, monotonic_ns));
+  Scheduler& scheduler = *scheduler_owner;
+  std::optional<SessionRecorder> recorder;
+  if (writer) {
+    recorder.emplace(w, *writer, write_options);
+    if (!session_in) {  // the input log, replayed first, is the new session's beginning
+      ReplayHooks hooks;
+      hooks.before_frame = [&](World& world) { recorder->before_frame(world); };
+      hooks.after_frame = [&](const World& world) { recorder->after_frame(world, false); };
+      replay_headless(w, scheduler, hooks);
+    }
+    if (Status s = recorder->finish(); !s) return fail(s.error);
+  } else {
+    replay_headless(w, scheduler);
+  }
 
   auto opened = AppWindow::open(w, scheduler, width, height, reference.positions, reference.triangles);
   if (!opened) return fail(opened.error());
   AppWindow& app = **opened;
+  if (recorder) app.record_into(&*recorder);
   window::Window& window = app.window();
 
   render::Orbit orbit = frame_orbit(scene_box(w.mesh, w.surface, reference_positions), app.width(), app.height());
@@ -383,8 +436,13 @@ int run_app(const AppArgs& a) {
   }
   if (!app.status()) return fail("Vulkan: " + app.status().error);
 
-  // Every logged event handled, as `fire replay` ends; then the last picture, which --screenshot keeps.
+  // Every logged event handled, as `fire replay` ends, and the session's last snapshot; then the last
+  // picture, which --screenshot keeps.
   while (!replay_done(w)) app.run_frame();
+  if (recorder) {
+    app.run_frame(true);
+    if (Status s = recorder->finish(); !s) return fail(s.error);
+  }
   render::Image shot;
   if (!a.screenshot_path.empty()) {
     bool shown = false;
@@ -407,7 +465,7 @@ int run_app(const AppArgs& a) {
   nlohmann::ordered_json out;
   out["display_frames"] = display_frame;
   out["system_frames"] = scheduler.frames();
-  out["events"] = w.log.events.size();
+  out["events"] = w.log.forgotten + w.log.events.size();
   out["edges"] = w.mesh.edge_count();
   out["faces"] = w.mesh.face_count();
   out["surface_quads"] = w.surface.quad_count();
@@ -438,7 +496,17 @@ void add_app_commands(CLI::App& app, Registry& registry) {
       "is tinted magenta and the point its end would snap to is marked cyan; on an open border, its first vertex "
       "is marked green when the stroke would close it there. Ctrl+S and E report in the HUD and on stderr."
       "\n\nKeys:\n" + keys);
-  cmd->add_option("NET", a->input_path, "curve network (.fnet) or input log to start from");
+  cmd->add_option("INPUT", a->input_path,
+                  "a session folder to go on with (engine/SESSION.md: its last good snapshot, then its log's tail; "
+                  "new strokes are written to it; its settings.json fixes --levels), a curve network (.fnet) to "
+                  "continue from, or an input log replayed first");
+  cmd->add_option("--session", a->session_dir,
+                  "write the session to this new folder as it goes (engine/SESSION.md): every event on disk as it is "
+                  "delivered, fsynced at every pen-up and command, snapshots on the way, so a crash or a kill loses "
+                  "no committed stroke; reopen it with `fire app DIR` or `fire replay DIR`");
+  cmd->add_option("--snapshot-every", a->snapshot_every,
+                  "frames (10 ms each) between a session's snapshots, which bound the replay on reopening")
+      ->capture_default_str();
   cmd->add_option("--reference", a->reference_path,
                   "OBJ mesh drawn see-through; a left drag draws on it (ray casts through a BVH): a pen sample at "
                   "every hit, logged with its snap radius");

@@ -76,6 +76,14 @@ void continue_replay(World& w, Scheduler& scheduler, const ReplayHooks& hooks) {
   }
 }
 
+void forget_delivered_events(World& w, size_t keep_below) {
+  if (w.cursor.next <= keep_below) return;
+  const size_t drop = w.cursor.next - 1;
+  w.log.events.erase(w.log.events.begin(), w.log.events.begin() + std::ptrdiff_t(drop));
+  w.cursor.next -= drop;
+  w.log.forgotten += drop;
+}
+
 uint64_t world_hash(const World& w) {
   Fnv1a h;
   const uint64_t pools = w.mesh.hash(), surface = surface_hash(w.surface);

@@ -63,7 +63,8 @@ void begin_frame(World& world, uint64_t index, int64_t begin_us);
 // so the snapping index has synced with every write of the frame): the session writer's log appends and
 // snapshots (tools/fire/session_store.hpp).
 struct ReplayHooks {
-  std::function<void(const World&)> before_frame, after_frame;
+  std::function<void(World&)> before_frame;
+  std::function<void(const World&)> after_frame;
 };
 // Whether a system still holds input that later frames will act on (the sketch system's requests, the
 // triangulation system's reports or open stroke): a replay out of events runs frames until it does not.
@@ -74,6 +75,10 @@ bool replay_done(const World& world);
 void replay_headless(World& world, Scheduler& scheduler, const ReplayHooks& hooks = {});
 // The same from where `world` stands: a frame begun, as replay_headless and a loaded snapshot leave it.
 void continue_replay(World& world, Scheduler& scheduler, const ReplayHooks& hooks = {});
+// Drops the delivered events from the front of the world's log (all but the newest delivered one), so a
+// live session's memory does not grow with its log; only for a log that is on disk elsewhere (a session
+// folder's). Amortized: does nothing until `keep_below` events are waiting to be dropped.
+void forget_delivered_events(World& world, size_t keep_below = 4096);
 // Hash of the pools and the surface: what a replay must reproduce bit for bit.
 uint64_t world_hash(const World& world);
 

@@ -193,46 +193,57 @@ Status load_world_snapshot(SnapshotReader& in, const SessionContents& session, W
   return Status::success();
 }
 
-Status replay_into_session(World& w, Scheduler& scheduler, SessionWriter& out, const SessionWriteOptions& options) {
-  Status status;
-  size_t appended = w.cursor.next;  // a reopened world's events are in the log already
-  uint64_t ups = 0, commands = 0, last_snapshot = w.frame.index;
-  auto commit = [&] {
-    if (!status) return;
-    status = out.commit();
-    if (status && options.on_commit) options.on_commit(ups, commands);
-  };
-  auto snapshot = [&](const World& world) {
-    commit();
-    if (status) status = out.write_snapshot(world.frame.index, snapshot_world(world, out.log_bytes(), out.log_hash()));
-    if (status && options.on_snapshot) options.on_snapshot(world.frame.index);
-    last_snapshot = world.frame.index;
-  };
-  ReplayHooks hooks;
-  // The events this frame delivers (input_system: t_us before the frame's end) go to the log first, and
-  // take the line they have there, so rejections name the session log's lines, as after reopening.
-  hooks.before_frame = [&](const World&) {
-    bool commit_point = false;
-    for (; appended < w.log.events.size() && w.log.events[appended].t_us < w.frame.end_us; ++appended) {
-      InputEvent& e = w.log.events[appended];
-      if (is_durable_record(e)) continue;  // a replayed session's own records name offsets in its log, not this one
-      e.line = out.lines() + 1;
-      if (status) status = out.append(e);
-      ups += e.kind == EventKind::Up;
-      commands += e.kind == EventKind::Command;
-      commit_point = commit_point || e.kind == EventKind::Up || e.kind == EventKind::Command;
-    }
-    if (commit_point) commit();
-  };
-  hooks.after_frame = [&](const World& world) {
-    const bool last = replay_done(world);
-    if (options.snapshot_every > 0 && (last || world.frame.index >= last_snapshot + options.snapshot_every))
-      snapshot(world);
-  };
-  if (w.cursor.next == 0) replay_headless(w, scheduler, hooks);
-  else continue_replay(w, scheduler, hooks);
+SessionRecorder::SessionRecorder(const World& w, SessionWriter& out, SessionWriteOptions options)
+    : out_(out),
+      options_(std::move(options)),
+      appended_(w.log.forgotten + w.cursor.next),
+      last_snapshot_(w.frame.index) {}
+
+void SessionRecorder::commit() {
+  if (!status_) return;
+  status_ = out_.commit();
+  if (status_ && options_.on_commit) options_.on_commit(ups_, commands_);
+}
+
+
+// The events this frame delivers (input_system: t_us before the frame's end) go to the log first, and
+// take the line they have there, so rejections name the session log's lines, as after reopening.
+void SessionRecorder::before_frame(World& w) {
+  bool commit_point = false;
+  for (; appended_ - w.log.forgotten < w.log.events.size(); ++appended_) {
+    InputEvent& e = w.log.events[appended_ - w.log.forgotten];
+    if (e.t_us >= w.frame.end_us) break;
+    if (is_durable_record(e)) continue;  // a replayed session's own records name offsets in its log, not this one
+    e.line = out_.lines() + 1;
+    if (status_) status_ = out_.append(e);
+    ups_ += e.kind == EventKind::Up;
+    commands_ += e.kind == EventKind::Command;
+    commit_point = commit_point || e.kind == EventKind::Up || e.kind == EventKind::Command;
+  }
+  if (commit_point) commit();
+}
+
+void SessionRecorder::after_frame(const World& w, bool last) {
+  if (options_.snapshot_every == 0 || !(last || w.frame.index >= last_snapshot_ + options_.snapshot_every)) return;
   commit();
-  return status;
+  if (status_) status_ = out_.write_snapshot(w.frame.index, snapshot_world(w, out_.log_bytes(), out_.log_hash()));
+  if (status_ && options_.on_snapshot) options_.on_snapshot(w.frame.index);
+  last_snapshot_ = w.frame.index;
+}
+
+Status SessionRecorder::finish() {
+  commit();
+  return status_;
+}
+
+Status replay_into_session(World& w, Scheduler& scheduler, SessionWriter& out, const SessionWriteOptions& options) {
+  SessionRecorder recorder(w, out, options);
+  ReplayHooks hooks;
+  hooks.before_frame = [&](World& world) { recorder.before_frame(world); };
+  hooks.after_frame = [&](const World& world) { recorder.after_frame(world, replay_done(world)); };
+  if (w.cursor.next == 0 && w.log.forgotten == 0) replay_headless(w, scheduler, hooks);
+  else continue_replay(w, scheduler, hooks);
+  return recorder.finish();
 }
 
 Result<ReopenedSession> reopen_session(const std::string& dir, Scheduler::Clock clock) {

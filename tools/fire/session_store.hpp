@@ -36,6 +36,31 @@ struct SessionWriteOptions {
   std::function<void(uint64_t frame)> on_snapshot;
 };
 
+// Writes a running world's session frame by frame, for a replay or the app: call before_frame before each
+// frame runs and after_frame after it (before the next frame begins). Each event the frame delivers is
+// appended to the log first (and takes its line there), the log is committed whenever those events hold
+// a pen-up or a command, and a snapshot follows every `snapshot_every` frames and the `last` frame.
+// Stops writing at the first failed write and keeps its error.
+class SessionRecorder {
+ public:
+  // `w`'s events before its cursor are in `out`'s log already (a new world has none; a reopened one all).
+  SessionRecorder(const World& w, SessionWriter& out, SessionWriteOptions options);
+  void before_frame(World& w);
+  void after_frame(const World& w, bool last);
+  // Commits what was appended since the last commit; the first failed write, if any.
+  Status finish();
+  const Status& status() const { return status_; }
+  // Events of the world's log appended so far, counting those it has forgotten (InputLog::forgotten).
+  uint64_t appended() const { return appended_; }
+
+ private:
+  void commit();
+  SessionWriter& out_;
+  SessionWriteOptions options_;
+  Status status_;
+  uint64_t appended_ = 0, ups_ = 0, commands_ = 0, last_snapshot_ = 0;
+};
+
 // replay_headless, writing a session: each event is appended to the log before the frame that delivers
 // it, the log is committed (durability record, fsync) whenever those events hold a pen-up or a command,
 // and a snapshot follows every `snapshot_every` frames and the last frame. Each event's `line` becomes its

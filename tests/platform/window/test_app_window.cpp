@@ -246,6 +246,53 @@ TEST_CASE("fire app: strokes drawn with the mouse on a reference mesh replay bit
   fs::remove_all(dir);
 }
 
+TEST_CASE("fire app --session: every stroke on disk as it is drawn; reopened, the app goes on with it",
+          "[app][window][session]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("session");
+  const std::string session = (dir / "drawing").string();
+  const Run app = run_app(170,
+                          "--reference " + quote(FIRE_PAWN) + " --size 960x720 --script " +
+                              quote(FIRE_WINDOW_TEST_DIR "/draw_on_pawn.script") + " --session " + quote(session),
+                          dir);
+  INFO("xvfb-run exit: " << app.runner_exit << "\nstdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  const auto first = nlohmann::json::parse(app.out);
+  CHECK(first["faces"] == 2);  // the second split was undone
+  CHECK(fs::exists(fs::path(session) / "settings.json"));
+  size_t snapshots = 0;
+  for (const auto& entry : fs::directory_iterator(session)) snapshots += entry.path().extension() == ".fsnap";
+  CHECK(snapshots >= 1);
+  // The folder reopens (its snapshot) and its log replays (from the start) to what the app showed.
+  for (const std::string& input : {session, session + "/input.log"}) {
+    const Run replay = run(quote(FIRE_BINARY) + " replay " + quote(input) + " --hash", dir);
+    INFO(input << ": " << replay.err);
+    REQUIRE(replay.exit_code == 0);
+    CHECK(replay.out == first["hash"].get<std::string>() + "\n");
+  }
+
+  // Opened again, the app starts where the drawing stands and writes what follows into the same folder.
+  const Run again = run_app(171, quote(session) + " --size 960x720 --script " + quote(FIRE_WINDOW_TEST_DIR "/redo.script"),
+                            dir);
+  INFO("xvfb-run exit: " << again.runner_exit << "\nstdout: " << again.out << "\nstderr: " << again.err);
+  REQUIRE(again.exit_code == 0);
+  CHECK(again.err.find("reopened (snapshot after frame") != std::string::npos);
+  const auto second = nlohmann::json::parse(again.out);
+  CHECK(second["faces"] == 3);  // the split redone
+  const Run replay = run(quote(FIRE_BINARY) + " replay " + quote(session) + " --hash", dir);
+  REQUIRE(replay.exit_code == 0);
+  CHECK(replay.out == second["hash"].get<std::string>() + "\n");
+
+  // Refused in words: a new session into a folder that is not empty, and --record beside a session.
+  const Run taken = run_app(172, "--session " + quote(session), dir);
+  CHECK(taken.exit_code == 1);
+  CHECK(taken.err.find("the session folder is not empty") != std::string::npos);
+  const Run both = run_app(173, quote(session) + " --record " + quote((dir / "x.log").string()), dir);
+  CHECK(both.exit_code == 1);
+  CHECK(both.err.find("--record: the session folder's input.log is the record already") != std::string::npos);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("fire app: the stroke in progress is drawn before it becomes a curve", "[app][window][sketch]") {
   REQUIRE(has_xvfb());
   const fs::path dir = scratch("stroke");
