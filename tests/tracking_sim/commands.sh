@@ -83,6 +83,22 @@ expect_replay_error "a session folder given --rig" "it replays with the rig.json
 rm tracked/rig.json
 expect_replay_error "a tracked session without its rig" "has no rig.json to triangulate them with" tracked
 
+# The simulators write the session layout too: the same drawing as a folder with its rig replays, tracks
+# and reopens as the bare log does; a wand session calibrates as its log does.
+"$fire" simulate sketch --strokes 6 --occlusion 0.5 --clock-offset-ms 5 --focal-error 0.02 --session simulated \
+  --rig rig.json >/dev/null
+cmp -s rig.json simulated/rig.json || fail "fire simulate --session --rig: the folder's rig.json is not the rig"
+h5=$("$fire" replay simulated --hash 2>/dev/null)
+[ "$h5" = "$h1" ] || fail "the simulated session ($h5) and the simulated log with --rig ($h1) disagree"
+"$fire" track simulated --rig rig.json -o pen4.log >/dev/null
+grep -v ' meta source ' pen3.log > a.txt; grep -v ' meta source ' pen4.log > b.txt
+cmp -s a.txt b.txt || fail "fire track of the simulated session and of the simulated log give different pen logs"
+"$fire" simulate wand --duration-s 10 --clock-offset-ms 5 --focal-error 0.02 --session wand >/dev/null
+"$fire" calibrate wand -o rig_session.json >/dev/null
+cmp -s rig.json rig_session.json || fail "fire calibrate of the wand session and of the wand log give different rigs"
+if "$fire" simulate sketch --strokes 1 --rig rig.json -o x.log >out.txt 2>err.txt; then fail "--rig without --session: succeeded"; fi
+grep -q "requires --session" err.txt || fail "--rig without --session: $(cat err.txt)"
+
 # Damage some reports: an odd hex digit count, a truncated report, an unknown id, a NaN truth line.
 awk 'BEGIN{n=0} / hid /{n++; if (n==100) $4=$4"f"; if (n==200) $4=substr($4,1,10); if (n==300) $4="99" substr($4,3)}
      {print} / hid 0 /{if (!done && n>400) {print $1" truth pen 0 nan 0 0 0 1 0 0"; done=1}}' s.log > damaged.log

@@ -19,6 +19,7 @@
 #include "systems/triangulate/triangulate.hpp"
 #include "tools/fire/commands.hpp"
 #include "tools/fire/session_rig.hpp"
+#include "tools/fire/session_store.hpp"
 
 #ifndef FIRE_DEFAULT_MESH
 #define FIRE_DEFAULT_MESH "../shared/data/meshes/pawn.obj"
@@ -57,13 +58,22 @@ struct SimulateArgs {
   RigOptions rig;
   WandOptions wand;
   SketchOptions sketch;
-  std::string out_path;
+  std::string out_path, session_dir, rig_path;
   std::string mesh_path = FIRE_DEFAULT_MESH;
 };
 
 void add_rig_options(CLI::App* cmd, SimulateArgs& a) {
   RigOptions& r = a.rig;
-  cmd->add_option("-o,--output", a.out_path, "input log to write (engine/INPUT_LOG.md)")->required();
+  auto* out = cmd->add_option("-o,--output", a.out_path, "input log to write (engine/INPUT_LOG.md)");
+  auto* session = cmd->add_option("--session", a.session_dir,
+                                  "write a session folder instead (engine/SESSION.md), which fire calibrate, fire track, "
+                                  "fire replay and fire app read as they read a log");
+  out->excludes(session);
+  session->excludes(out);
+  cmd->add_option("--rig", a.rig_path,
+                  "with --session: the rig file (from fire calibrate) the session keeps as its rig.json, so that "
+                  "fire replay DIR and fire app DIR triangulate its reports with no --rig")
+      ->needs(session);
   cmd->add_option("--seed", r.seed, "seed of the noise, timing, motion, dropouts, stray blob and occlusions (same seeds and options, byte-identical log)")
       ->capture_default_str();
   cmd->add_option("--rig-seed", r.rig_seed,
@@ -96,7 +106,7 @@ ordered_json simulation_json(const char* scenario, const SimulateArgs& a, const 
   const SimulationStats& st = s.stats;
   ordered_json out;
   out["scenario"] = scenario;
-  out["log"] = a.out_path;
+  out["log"] = a.session_dir.empty() ? a.out_path : SessionPaths{a.session_dir}.log();
   out["seed"] = a.rig.seed;
   out["rig_seed"] = a.rig.rig_seed;
   out["duration_s"] = st.duration_s;
@@ -111,23 +121,47 @@ ordered_json simulation_json(const char* scenario, const SimulateArgs& a, const 
   return out;
 }
 
-int write_session(const char* scenario, const SimulateArgs& a, const Result<SimulatedSession>& s) {
+int write_simulation(const char* scenario, const SimulateArgs& a, const Result<SimulatedSession>& s) {
   const std::string command = std::string("simulate ") + scenario;
   if (!s) return fail(command, s.error());
-  if (Status w = write_file_atomic(a.out_path, format_input_log(s->events)); !w) return fail(command, w.error);
+  if (a.session_dir.empty()) {
+    if (Status w = write_file_atomic(a.out_path, format_input_log(s->events)); !w) return fail(command, w.error);
+  } else {
+    std::string rig_json;
+    if (!a.rig_path.empty()) {
+      Result<std::string> text = read_text_file(a.rig_path);
+      if (!text) return fail(command, text.error());
+      InputLog log;
+      log.events = s->events;
+      if (auto rig = tracking_rig_from_json(*text, a.rig_path, log, a.session_dir); !rig) return fail(command, rig.error());
+      rig_json = std::move(*text);
+    }
+    if (Status w = write_log_session(a.session_dir, World{}, s->events, rig_json); !w) return fail(command, w.error);
+  }
   std::cout << simulation_json(scenario, a, *s).dump() << "\n";
   return 0;
 }
 
-int run_simulate_wand(const SimulateArgs& a) { return write_session("wand", a, simulate_wand(a.rig, a.wand)); }
+// Checked before simulating, which takes seconds.
+bool output_chosen(const char* scenario, const SimulateArgs& a) {
+  if (!a.out_path.empty() || !a.session_dir.empty()) return true;
+  fail(std::string("simulate ") + scenario, "give where to write it: -o LOG, or --session DIR");
+  return false;
+}
+
+int run_simulate_wand(const SimulateArgs& a) {
+  if (!output_chosen("wand", a)) return 1;
+  return write_simulation("wand", a, simulate_wand(a.rig, a.wand));
+}
 
 int run_simulate_sketch(const SimulateArgs& a) {
+  if (!output_chosen("sketch", a)) return 1;
   Result<PolygonMesh> mesh = read_obj(a.mesh_path);
   if (!mesh) return fail("simulate sketch", mesh.error() + " (choose the object with --mesh)");
   SketchOptions sketch = a.sketch;
   sketch.mesh_name = a.mesh_path.substr(a.mesh_path.find_last_of('/') + 1);
   const MeshView view{mesh->positions, mesh->face_offsets, mesh->face_vertices};
-  return write_session("sketch", a, simulate_sketch(a.rig, sketch, view));
+  return write_simulation("sketch", a, simulate_sketch(a.rig, sketch, view));
 }
 
 // --- calibrate ---
@@ -155,8 +189,10 @@ struct CalibrateArgs {
 
 int run_calibrate(const CalibrateArgs& a) {
   const std::string command = "calibrate";
-  Result<InputLog> log = read_input_log(a.log_path);
+  std::vector<std::string> notes;
+  Result<InputLog> log = read_log_or_session(a.log_path, notes);
   if (!log) return fail(command, log.error());
+  for (const std::string& note : notes) std::cerr << "fire calibrate: " << note << "\n";
   const SessionTruth truth = read_session_truth(log->events);
   CalibrationOptions options;
   options.nominal0 = truth.has_nominal[0] ? truth.nominal[0] : wiimote_nominal_intrinsics();
@@ -251,8 +287,10 @@ int run_track(const TrackArgs& a) {
   args.options.max_gap_us = std::llround(args.max_gap_ms * 1e3);
   args.options.max_bridge_us = std::llround(args.max_bridge_ms * 1e3);
 
-  Result<InputLog> log = read_input_log(args.log_path);
+  std::vector<std::string> notes;
+  Result<InputLog> log = read_log_or_session(args.log_path, notes);
   if (!log) return fail(command, log.error());
+  for (const std::string& note : notes) std::cerr << "fire track: " << note << "\n";
   const SessionTruth truth = read_session_truth(log->events);
   if (args.truth && !truth.has_cameras)
     return fail(command, args.log_path + ": --truth needs the simulator's truth lines (truth camera 0 and 1), and the log has none");
@@ -357,7 +395,7 @@ void add_tracking_commands(CLI::App& app, Registry& registry) {
   // calibrate
   auto cal = std::make_shared<CalibrateArgs>();
   CLI::App* c = app.add_subcommand("calibrate", "Calibrate the stereo rig from a logged wand session");
-  c->add_option("LOG", cal->log_path, "input log with the remotes' reports of a waved two-LED wand")->required();
+  c->add_option("LOG", cal->log_path, "input log (or session folder) with the remotes' reports of a waved two-LED wand")->required();
   c->add_option("-o,--output", cal->out_path, "rig file to write (systems/tracking/README.md)")->required();
   c->add_option("--wand-length", cal->wand_length_m,
                 "distance between the wand's LEDs, metres (default: the log's meta wand_length_m, else 0.3)");
@@ -375,7 +413,7 @@ void add_tracking_commands(CLI::App& app, Registry& registry) {
   // track
   auto tr = std::make_shared<TrackArgs>();
   CLI::App* t = app.add_subcommand("track", "Track the pen in a logged session: pen samples and down/up events");
-  t->add_option("LOG", tr->log_path, "input log with the remotes' reports")->required();
+  t->add_option("LOG", tr->log_path, "input log (or session folder) with the remotes' reports")->required();
   t->add_option("--rig", tr->rig_path, "rig file from fire calibrate")->required();
   t->add_option("-o,--output", tr->out_path, "pen log to write: down, pen x y z (metres, camera 0's frame), up")->required();
   t->add_flag("--truth", tr->truth, "compare with the simulator's ground truth: static_rms_mm, dynamic_rms_mm");

@@ -4,6 +4,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "platform/files.hpp"
 #include "tools/fire/session_rig.hpp"
 
 namespace fire {
@@ -51,6 +52,11 @@ bool load_event(SnapshotReader& in, InputEvent& e) {
 }
 
 bool is_durable_record(const InputEvent& e) { return e.kind == EventKind::Meta && e.name == kDurableKey; }
+
+std::string torn_record_note(const SessionContents& c) {
+  return c.paths.log() + ":" + std::to_string(c.log.torn_line) + ": torn last record dropped (" +
+         std::to_string(c.log.dropped_bytes) + " bytes without an end of line): the writer stopped inside it";
+}
 
 }  // namespace
 
@@ -246,6 +252,30 @@ Status replay_into_session(World& w, Scheduler& scheduler, SessionWriter& out, c
   return recorder.finish();
 }
 
+Status write_log_session(const std::string& dir, const World& w, std::span<const InputEvent> events,
+                         std::string_view rig_json) {
+  auto out = SessionWriter::create(dir, settings_json(w), rig_json);
+  if (!out) return Status::failure(out.error());
+  constexpr size_t kCommitEvery = 1000;
+  size_t since_commit = 0;
+  for (const InputEvent& e : events) {
+    if (Status s = out->append(e); !s) return s;
+    if (e.kind == EventKind::Up || e.kind == EventKind::Command || ++since_commit == kCommitEvery) {
+      if (Status s = out->commit(); !s) return s;
+      since_commit = 0;
+    }
+  }
+  return out->commit();
+}
+
+Result<InputLog> read_log_or_session(const std::string& path, std::vector<std::string>& notes) {
+  if (!is_directory(path)) return read_input_log(path);
+  auto session = read_session(path);
+  if (!session) return Result<InputLog>::failure(session.error());
+  if (session->log.dropped_bytes > 0) notes.push_back(torn_record_note(*session));
+  return std::move(session->log.log);
+}
+
 Result<ReopenedSession> reopen_session(const std::string& dir, Scheduler::Clock clock) {
   auto contents = read_session(dir);
   if (!contents) return Result<ReopenedSession>::failure(contents.error());
@@ -266,9 +296,7 @@ Result<ReopenedSession> reopen_session(const std::string& dir, Scheduler::Clock 
                                             std::string(kSessionRig) + " to triangulate them with (put the rig "
                                             "they were drawn with there, from fire calibrate)");
   ReopenedSession r;
-  if (c.log.dropped_bytes > 0)
-    r.notes.push_back(c.paths.log() + ":" + std::to_string(c.log.torn_line) + ": torn last record dropped (" +
-                      std::to_string(c.log.dropped_bytes) + " bytes without an end of line): the writer stopped inside it");
+  if (c.log.dropped_bytes > 0) r.notes.push_back(torn_record_note(c));
   r.snapshot = load_last_good_snapshot(
       c,
       [&](SnapshotReader& in) {
