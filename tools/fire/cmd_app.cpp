@@ -51,8 +51,8 @@ bool ends_with(const std::string& s, const std::string& tail) {
 
 // The help overlay and `fire app --help` list the same keys.
 const std::vector<std::string> kKeys = {
-    "left drag       orbit; with --reference: draw a stroke on it (logged)",
-    "right drag      pan; with --reference: orbit",
+    "left drag       draw a stroke (logged): on --reference, else on the surface or the view plane",
+    "right drag      orbit",
     "Shift + drag    pan",
     "scroll          zoom",
     "Ctrl+Z          undo (logged)",
@@ -323,24 +323,69 @@ int run_app(const AppArgs& a) {
     e.kind = kind;
     app.log_event(std::move(e));
   };
-  // The mouse pen: the ray from the cursor onto the reference; a hit is a pen sample with the snap radius
-  // of --snap-pixels at its depth, both logged, so the drawing replays without the view.
-  auto pen_sample = [&](glm::vec2 pixel) {
+  // The mouse pen draws on the reference; without one, on the surface where the stroke starts on it, or
+  // else on the plane through the view's centre facing the view, kept for the whole stroke.
+  std::optional<evaluate::TriangleBvh> surface_bvh;  // the surface as the stroke began
+  const evaluate::TriangleBvh* stroke_mesh = nullptr;
+  Vec3 plane_point = Vec3::Zero(), plane_normal = Vec3::UnitZ();
+  auto cursor_ray = [&](glm::vec2 pixel) {
     const render::Camera& camera = app.camera();
-    const glm::vec3 direction = render::ray_through_pixel(camera, pixel, app.width(), app.height());
-    const evaluate::TriangleBvh::Hit hit = reference_bvh.ray_cast(
-        Vec3(camera.eye.x, camera.eye.y, camera.eye.z), Vec3(direction.x, direction.y, direction.z));
-    if (hit.triangle == evaluate::kNoTriangle) return false;
+    const glm::vec3 d = render::ray_through_pixel(camera, pixel, app.width(), app.height());
+    return std::pair{Vec3(camera.eye.x, camera.eye.y, camera.eye.z), Vec3(d.x, d.y, d.z)};
+  };
+  auto hit_mesh = [&](const evaluate::TriangleBvh& bvh, glm::vec2 pixel) -> std::optional<Vec3> {
+    const auto [origin, direction] = cursor_ray(pixel);
+    const evaluate::TriangleBvh::Hit hit = bvh.ray_cast(origin, direction);
+    if (hit.triangle == evaluate::kNoTriangle) return std::nullopt;
+    return hit.point;
+  };
+  auto hit_plane = [&](glm::vec2 pixel) -> std::optional<Vec3> {
+    const auto [origin, direction] = cursor_ray(pixel);
+    const double facing = direction.dot(plane_normal);
+    if (std::abs(facing) < 1e-9) return std::nullopt;
+    const double t = (plane_point - origin).dot(plane_normal) / facing;
+    if (!(t > 0)) return std::nullopt;
+    return Vec3(origin + t * direction);
+  };
+  // Chooses what the stroke starting at `pixel` draws on; false when the pen would draw on nothing.
+  auto begin_stroke_target = [&](glm::vec2 pixel) {
+    if (!reference.triangles.empty()) {
+      stroke_mesh = &reference_bvh;
+      return hit_mesh(reference_bvh, pixel).has_value();
+    }
+    stroke_mesh = nullptr;
+    if (!w.surface.empty()) {
+      evaluate::TriangleMesh mesh{w.surface.positions, {}};
+      mesh.triangles.reserve(w.surface.quads.size() / 4 * 6);
+      for (size_t q = 0; q + 3 < w.surface.quads.size(); q += 4) {
+        const uint32_t* v = &w.surface.quads[q];
+        mesh.triangles.insert(mesh.triangles.end(), {v[0], v[1], v[2], v[0], v[2], v[3]});
+      }
+      surface_bvh.emplace(mesh);
+      if (hit_mesh(*surface_bvh, pixel)) {
+        stroke_mesh = &*surface_bvh;
+        return true;
+      }
+    }
+    const render::Camera& camera = app.camera();
+    plane_point = Vec3(orbit.target.x, orbit.target.y, orbit.target.z);
+    plane_normal = (plane_point - Vec3(camera.eye.x, camera.eye.y, camera.eye.z)).normalized();
+    return hit_plane(pixel).has_value();
+  };
+  // A hit is a pen sample with the snap radius of --snap-pixels at its depth, both logged, so the drawing
+  // replays without the view.
+  auto pen_sample = [&](glm::vec2 pixel) {
+    const std::optional<Vec3> hit = stroke_mesh ? hit_mesh(*stroke_mesh, pixel) : hit_plane(pixel);
+    if (!hit) return false;
     InputEvent e;
     e.kind = EventKind::Pen;
-    e.p = hit.point;
-    const glm::vec3 p(float(hit.point.x()), float(hit.point.y()), float(hit.point.z()));
-    e.snap = a.snap_pixels * double(render::pixel_size_at(camera, p, app.height()));
+    e.p = *hit;
+    const glm::vec3 p(float(hit->x()), float(hit->y()), float(hit->z()));
+    e.snap = a.snap_pixels * double(render::pixel_size_at(app.camera(), p, app.height()));
     app.log_event(std::move(e));
     return true;
   };
   bool dragging = false, panning = false, drawing = false;
-  const bool can_draw = !reference.triangles.empty();
   glm::vec2 cursor(0.0f);
   uint64_t display_frame = 0;
   size_t next_script = 0;
@@ -364,15 +409,15 @@ int run_app(const AppArgs& a) {
         cursor = glm::vec2(float(e.x), float(e.y));
         if (app.hud().wants_mouse() || dragging || panning || drawing) break;
         if (shift || e.button == window::Button::Middle) panning = true;
-        else if (e.button == window::Button::Left && can_draw) {
-          // A stroke starts only on the reference: the pen goes down with its first sample.
+        else if (e.button == window::Button::Left) {
+          // The pen goes down with its first sample, on what the stroke will draw on.
+          if (!begin_stroke_target(cursor)) {
+            hud_data.status = "press on the reference mesh to draw";
+            break;
+          }
           log_pen(fire::EventKind::Down);
           drawing = pen_sample(cursor);
-          if (!drawing) {
-            w.log.events.pop_back();  // the down: not yet delivered, since events wait for the next frame
-            hud_data.status = "press on the reference mesh to draw";
-          }
-        } else if (e.button == window::Button::Left || (e.button == window::Button::Right && can_draw)) dragging = true;
+        } else if (e.button == window::Button::Right) dragging = true;
         else panning = true;
         break;
       case EventKind::ButtonRelease:
@@ -509,7 +554,8 @@ void add_app_commands(CLI::App& app, Registry& registry) {
       ->capture_default_str();
   cmd->add_option("--reference", a->reference_path,
                   "OBJ mesh drawn see-through; a left drag draws on it (ray casts through a BVH): a pen sample at "
-                  "every hit, logged with its snap radius");
+                  "every hit, logged with its snap radius. Without one, a stroke draws on the surface where it starts "
+                  "on it, or else on the plane through the view's centre facing the view");
   cmd->add_option("--reference-levels", a->reference_levels,
                   "the reference as its Catmull-Clark limit surface at this level (so strokes lie on the surface "
                   "fire eval measures against); 0: its faces as they are")

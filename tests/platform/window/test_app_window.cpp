@@ -5,6 +5,8 @@
 // bit; the pen's feedback (closing vertex, tinted face, snap target); a curve marked sharp and the surface
 // exported; and no display, a bad export: a clear message, no crash.
 #include <catch2/catch.hpp>
+
+#include <Eigen/Geometry>
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -290,6 +292,53 @@ TEST_CASE("fire app --session: every stroke on disk as it is drawn; reopened, th
   const Run both = run_app(173, quote(session) + " --record " + quote((dir / "x.log").string()), dir);
   CHECK(both.exit_code == 1);
   CHECK(both.err.find("--record: the session folder's input.log is the record already") != std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("fire app: with no reference, strokes draw on the view plane, then on the surface they made",
+          "[app][window][sketch]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("no_reference");
+  const std::string shot = (dir / "shot.png").string(), record = (dir / "draw.log").string();
+  const Run app = run_app(175,
+                          "--size 960x720 --script " + quote(FIRE_WINDOW_TEST_DIR "/draw_without_reference.script") +
+                              " --screenshot " + quote(shot) + " --record " + quote(record),
+                          dir);
+  INFO("xvfb-run exit: " << app.runner_exit << "\nstdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  const auto json = nlohmann::json::parse(app.out);
+  CHECK(json["faces"] == 2);  // the border, split once
+  CHECK(json["edges"] == 7);
+  CHECK(json["surface_quads"].get<int>() > 0);
+  const Run replay = run(quote(FIRE_BINARY) + " replay " + quote(record) + " --hash", dir);
+  REQUIRE(replay.exit_code == 0);
+  CHECK(replay.out == json["hash"].get<std::string>() + "\n");
+
+  // Every sample lies on one plane: the border's on the view plane, the split's on the flat surface.
+  const auto log = fire::read_input_log(record);
+  REQUIRE(log);
+  std::vector<fire::Vec3> samples;
+  for (const fire::InputEvent& e : log->events)
+    if (e.kind == fire::EventKind::Pen) samples.push_back(e.p);
+  REQUIRE(samples.size() > 20);
+  const fire::Vec3 a = samples.front(), b = samples[samples.size() / 3], c = samples[2 * samples.size() / 3];
+  const fire::Vec3 normal = (b - a).cross(c - a).normalized();
+  double farthest = 0, extent = 0;
+  for (const fire::Vec3& p : samples) {
+    farthest = std::max(farthest, std::abs((p - a).dot(normal)));
+    extent = std::max(extent, (p - a).norm());
+  }
+  CHECK(farthest < 1e-4 * extent);
+
+  auto image = fire::render::read_png(shot);
+  REQUIRE(image);
+  size_t inside = 0, outside = 0;
+  for (uint32_t y = 0; y < image->height; ++y)
+    for (uint32_t x = 0; x < image->width; ++x)
+      if (near(image->pixel(x, y), Palette::curve, 40)) (x >= 420 && x <= 540 && y >= 170 && y <= 270 ? inside : outside)++;
+  INFO("curve pixels inside " << inside << ", outside " << outside);
+  CHECK(inside > 400);
+  CHECK(outside < 20);
   fs::remove_all(dir);
 }
 
