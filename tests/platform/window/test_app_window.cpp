@@ -342,6 +342,34 @@ TEST_CASE("fire app: with no reference, strokes draw on the view plane, then on 
   fs::remove_all(dir);
 }
 
+TEST_CASE("fire app: a 24-face grid drawn with the mouse on the pawn, one split undone, replays bit for bit",
+          "[app][window][sketch]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("grid");
+  const std::string record = (dir / "grid.log").string(), exported = (dir / "grid.obj").string();
+  const Run app = run_app(176,
+                          "--reference " + quote(FIRE_PAWN) + " --size 1280x960 --snap-pixels 6 --script " +
+                              quote(FIRE_WINDOW_TEST_DIR "/grid_on_pawn.script") + " --record " + quote(record) +
+                              " --export " + quote(exported),
+                          dir);
+  INFO("xvfb-run exit: " << app.runner_exit << "\nstdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  const auto json = nlohmann::json::parse(app.out);
+  // 4 + 3 + 20 curves split into 64 by their crossings; the 28th stroke undone.
+  CHECK(json["faces"] == 24);
+  CHECK(json["edges"] == 64);
+  CHECK(app.err.find("exported") != std::string::npos);
+  const auto log = fire::read_text_file(record);
+  REQUIRE(log);
+  CHECK(log->find(" cmd undo\n") != std::string::npos);
+  for (int run_index = 0; run_index < 2; ++run_index) {
+    const Run replay = run(quote(FIRE_BINARY) + " replay " + quote(record) + " --hash", dir);
+    REQUIRE(replay.exit_code == 0);
+    CHECK(replay.out == json["hash"].get<std::string>() + "\n");
+  }
+  fs::remove_all(dir);
+}
+
 TEST_CASE("fire app: the stroke in progress is drawn before it becomes a curve", "[app][window][sketch]") {
   REQUIRE(has_xvfb());
   const fs::path dir = scratch("stroke");
