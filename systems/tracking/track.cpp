@@ -260,6 +260,13 @@ constexpr int kMaxLostInARow = 3;
 constexpr double kLostPenalty = 4.6;         // -log of a report's chance to be lost (about 1 %)
 constexpr double kDefaultJitterUs = 1000, kMinJitterUs = 100;
 constexpr size_t kJitterWindow = 101;
+constexpr double kLateKnee = 3;  // jitters: beyond it a late report costs linearly, not quadratically
+
+// The cost of a report `miss` jitters from the clock's line. Bluetooth holds reports back (a late one
+// delays those behind it; a burst delivers a held report with the next) but never delivers one before
+// its time, so lateness has a long tail and earliness none: Huber on the late side only. Without it a
+// burst of held reports is cheaper to explain as a lost report, and the numbering stays one ahead.
+double misfit_cost(double miss) { return miss <= kLateKnee ? 0.5 * miss * miss : kLateKnee * (miss - 0.5 * kLateKnee); }
 
 }  // namespace
 
@@ -305,7 +312,7 @@ double FrameNumbering::settle(std::span<const double> waiting) {
         for (int step = 0; step <= kMaxLostInARow && d + step <= max_skip; ++step) {
           const double n = previous + static_cast<double>(i + 1) + d + step;
           const double miss = (waiting[i] - (line0 + slope * n)) / sigma;
-          const double c = cost[size_t(d)] + 0.5 * miss * miss + kLostPenalty * step;
+          const double c = cost[size_t(d)] + misfit_cost(miss) + kLostPenalty * step;
           if (c < next[size_t(d + step)]) {
             next[size_t(d + step)] = c;
             from[i][size_t(d + step)] = d;
