@@ -216,7 +216,7 @@ Measurement run(const Config& c, double seconds) {
       committed = committed || w.history.undo_depth() > edits;
       if (committed && u.bytes == 0 && w.surface.settled) break;
       bytes += double(u.bytes);
-      surface_bytes += double(u.surface_vertices) * 24 + (u.surface_topology ? double(w.surface.quad_count()) * 24 : 0);
+      surface_bytes += double(u.surface_vertices) * 24 + double(u.surface_quads) * 24;
       if (u.bytes) {
         r.commit_frame_ms.add(ms_between(before, WallClock::now()));
         r.commit_stages.add(app.stages());

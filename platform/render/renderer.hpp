@@ -14,9 +14,16 @@
 //   copied when the edge is new to the renderer, its slot's generation, offset or count moved, or it is
 //   stamped (engine/change.hpp) after the network frame of the previous upload;
 // - network vertices: by slot, when new or their position changed;
-// - surface: all vertices and the triangle indices when topology_version moved (or on first sight),
-//   else only SurfaceLevels::changed when SurfaceLevels::frame is newer than the last frame uploaded.
-// Buffers are host-visible; growing one re-uploads its whole content (counted as well).
+// - surface: in blocks, one per patch (SurfaceLevels' quads grouped by network face), each holding its
+//   patch's vertices (those on a patch border once per patch) and triangles. When topology_version moved
+//   (or on first sight) a patch whose key and quads, renumbered in the order they appear, are those of a
+//   block keeps that block; the others get a freed block that fits or space at the end, and their
+//   triangles are copied. Then, and when SurfaceLevels::frame is newer than the last frame uploaded, the
+//   vertices in SurfaceLevels::changed are converted to float and copied where they differ from what the
+//   block holds: a commit copies the patches it changed, not the surface (the fit moves far-away limit
+//   points by less than a float's precision).
+// Buffers are host-visible; growing one re-uploads its whole content (counted as well). The surface's grow
+// by half again, and are laid out afresh when freed blocks outnumber the used ones.
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -63,7 +70,7 @@ struct UploadStats {
   uint32_t edges = 0;              // edges whose points were copied
   uint32_t vertices = 0;           // network vertex markers copied
   uint32_t surface_vertices = 0;   // surface vertices copied
-  bool surface_topology = false;   // triangle indices copied
+  uint32_t surface_quads = 0;      // surface quads whose triangle indices were copied
 };
 
 class Renderer {
@@ -128,6 +135,10 @@ class Renderer {
   Status upload_points(const Mesh& network);
   Status upload_vertices(const Mesh& network);
   Status upload_surface(const SurfaceLevels& surface);
+  Status layout_surface(const SurfaceLevels& surface);
+  // Makes the surface buffers hold the blocks; where one had to grow, every block is copied again.
+  Status reserve_surface(std::vector<uint8_t>& placed);
+  void write_surface_vertices(const SurfaceLevels& surface, ChangedRange changed);
 
   Context& context_;
   RenderSettings settings_;
@@ -157,12 +168,23 @@ class Renderer {
   std::vector<uint8_t> vertex_live_;
   std::vector<std::pair<uint32_t, uint32_t>> marker_draws_;  // runs of live vertex slots (first, count)
 
-  // Surface: interleaved float position and normal per vertex, 6 indices per quad.
+  // Surface: interleaved float position and normal per vertex, 6 indices per quad, in blocks per patch.
+  struct Block {
+    uint32_t key = kNone;
+    uint32_t first_vertex = 0, vertex_count = 0, first_quad = 0, quad_count = 0;  // where it lies in the buffers
+    std::vector<uint32_t> vertices;  // the surface's vertex held at each of the block's vertices
+    std::vector<uint32_t> quads;     // 4 block vertices per quad: the patch's topology
+  };
   Buffer surface_vertices_, surface_indices_;
+  std::vector<glm::vec3> surface_vertex_copy_;  // what surface_vertices_ holds, up to surface_vertex_end_
+  std::vector<uint32_t> surface_index_copy_;    // what surface_indices_ holds, up to 6 * surface_quad_end_
+  std::vector<Block> blocks_, free_blocks_;     // free blocks hold their ranges only
+  uint32_t surface_vertex_end_ = 0, surface_quad_end_ = 0;  // the buffers' used extent
+  std::vector<uint32_t> block_vertex_;  // scratch: per surface vertex its block vertex, kNone outside the patch
+  std::vector<std::pair<uint32_t, uint32_t>> surface_draws_;  // (first index, index count), runs of blocks
   uint64_t surface_topology_ = 0;
   Frame surface_frame_ = 0;
   bool surface_seen_ = false;
-  uint32_t surface_index_count_ = 0;
   bool surface_settled_ = true;
 
   Buffer stroke_;

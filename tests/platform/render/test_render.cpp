@@ -217,7 +217,7 @@ TEST_CASE("uploads copy only what changed and the image equals a fresh upload's"
   CHECK(r.last_upload().bytes ==
         12 * (points + vertices) + 24ull * scene.surface.vertex_count() + 24ull * scene.surface.quad_count());
   CHECK(r.last_upload().edges == net.edge_count());
-  CHECK(r.last_upload().surface_topology);
+  CHECK(r.last_upload().surface_quads == scene.surface.quad_count());
 
   net.begin_frame(net.frame() + 1);
   REQUIRE(r.upload(net, scene.surface));
@@ -242,10 +242,49 @@ TEST_CASE("uploads copy only what changed and the image equals a fresh upload's"
   scene.surface.changed = {100, 140};
   REQUIRE(r.upload(net, scene.surface));
   CHECK(r.last_upload().bytes == 40 * 24);
-  CHECK_FALSE(r.last_upload().surface_topology);
+  CHECK(r.last_upload().surface_quads == 0);
   // The same frame again: nothing new.
   REQUIRE(r.upload(net, scene.surface));
   CHECK(r.last_upload().bytes == 0);
+
+  // A new topology version with the same quads and values: the block is kept, nothing is copied.
+  ++scene.surface.topology_version;
+  scene.surface.frame = 3;
+  scene.surface.changed = {0, scene.surface.vertex_count()};
+  REQUIRE(r.upload(net, scene.surface));
+  CHECK(r.last_upload().bytes == 0);
+
+  // The quads in patches of 64: each patch gets its block, its triangles copied once.
+  const uint32_t quads = scene.surface.quad_count();
+  for (uint32_t q = 0, key = 0; q < quads; q += 64, ++key) {
+    scene.surface.patch_offsets.push_back(q);
+    scene.surface.patch_keys.push_back(key);
+  }
+  scene.surface.patch_offsets.push_back(quads);
+  REQUIRE(scene.surface.patch_count() >= 4);
+  ++scene.surface.topology_version;
+  scene.surface.frame = 4;
+  REQUIRE(r.upload(net, scene.surface));
+  CHECK(r.last_upload().surface_quads == quads);
+  // One quad of patch 2 starts at another corner (its diagonal flips): patch 2's triangles are copied
+  // into the block it frees, the same vertices in the same place, so no vertex is.
+  uint32_t* quad = &scene.surface.quads[4 * size_t(scene.surface.patch_offsets[2] + 5)];
+  std::rotate(quad, quad + 1, quad + 4);
+  ++scene.surface.topology_version;
+  scene.surface.frame = 5;
+  REQUIRE(r.upload(net, scene.surface));
+  CHECK(r.last_upload().surface_quads == 64);
+  CHECK(r.last_upload().surface_vertices == 0);
+  CHECK(r.last_upload().bytes == 64 * 24);
+  // Moving one surface vertex copies it once per patch that holds it (one to four).
+  const uint32_t v = scene.surface.quads[4 * size_t(scene.surface.patch_offsets[3])];
+  scene.surface.positions[v].z() += 0.003;
+  scene.surface.frame = 6;
+  scene.surface.changed = {v, v + 1};
+  REQUIRE(r.upload(net, scene.surface));
+  CHECK(r.last_upload().surface_vertices >= 1);
+  CHECK(r.last_upload().surface_vertices <= 4);
+  CHECK(r.last_upload().bytes == 24ull * r.last_upload().surface_vertices);
 
   const Camera camera = frame_box(box_of(scene), View::iso, kWidth, kHeight);
   REQUIRE(r.draw(camera));
@@ -255,13 +294,6 @@ TEST_CASE("uploads copy only what changed and the image equals a fresh upload's"
   REQUIRE((*fresh)->upload(net, scene.surface));
   REQUIRE((*fresh)->draw(camera));
   CHECK(after_edits.rgba == (*fresh)->image().rgba);
-
-  // A new topology (a version bump) sends everything of the surface again.
-  ++scene.surface.topology_version;
-  scene.surface.frame = 3;
-  REQUIRE(r.upload(net, scene.surface));
-  CHECK(r.last_upload().surface_topology);
-  CHECK(r.last_upload().surface_vertices == scene.surface.vertex_count());
   CHECK(context->validation_message_count() == 0);
 }
 
