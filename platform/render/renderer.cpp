@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <string>
 #include <unordered_map>
 
 // SPIR-V compiled from shaders/ at build time (platform/render/CMakeLists.txt).
-#include "shaders/background_frag.h"
-#include "shaders/background_vert.h"
 #include "shaders/curve_vert.h"
 #include "shaders/flat_frag.h"
 #include "shaders/marker_frag.h"
@@ -57,15 +57,32 @@ struct PipelineDesc {
 Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const RenderSettings& settings) {
   if (settings.width == 0 || settings.height == 0 || settings.width > 8192 || settings.height > 8192)
     return Result<std::unique_ptr<Renderer>>::failure("image size must be 1 to 8192 pixels a side");
-  std::unique_ptr<Renderer> r(new Renderer(context, settings));
+  RenderSettings chosen = settings;
+  if (chosen.samples == 0) {
+    if (const char* env = std::getenv("FIRE_SAMPLES"); env && *env) {
+      const std::string value = env;
+      if (value != "1" && value != "2" && value != "4" && value != "8")
+        return Result<std::unique_ptr<Renderer>>::failure("FIRE_SAMPLES must be 1, 2, 4 or 8, not '" + value + "'");
+      chosen.samples = uint32_t(std::stoul(value));
+    } else {
+      chosen.samples = context.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? 1 : 4;
+    }
+  }
+  if (chosen.samples != 1 && chosen.samples != 2 && chosen.samples != 4 && chosen.samples != 8)
+    return Result<std::unique_ptr<Renderer>>::failure("samples per pixel must be 0 (by device), 1, 2, 4 or 8");
+  std::unique_ptr<Renderer> r(new Renderer(context, chosen));
   if (Status s = r->init(); !s) return Result<std::unique_ptr<Renderer>>::failure("Vulkan: " + s.error);
   return r;
 }
 
 Status Renderer::init() {
   const VkPhysicalDeviceLimits& limits = context_.properties().limits;
-  if (limits.framebufferColorSampleCounts & limits.framebufferDepthSampleCounts & VK_SAMPLE_COUNT_4_BIT)
-    samples_ = VK_SAMPLE_COUNT_4_BIT;
+  const VkSampleCountFlags supported = limits.framebufferColorSampleCounts & limits.framebufferDepthSampleCounts;
+  for (VkSampleCountFlagBits n : {VK_SAMPLE_COUNT_8_BIT, VK_SAMPLE_COUNT_4_BIT, VK_SAMPLE_COUNT_2_BIT})
+    if (uint32_t(n) <= settings_.samples && (supported & n)) {
+      samples_ = n;
+      break;
+    }
   VkFormatProperties depth_props;
   vkGetPhysicalDeviceFormatProperties(context_.physical_device(), depth_format_, &depth_props);
   if (!(depth_props.optimalTilingFeatures & VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT))
@@ -188,7 +205,7 @@ Renderer::~Renderer() {
                     &reference_indices_, &stroke_, &pen_})
     destroy(*b);
   for (Target* t : {&color_, &resolve_, &depth_}) destroy(*t);
-  for (VkPipeline p : {background_, surface_, reference_pipeline_, curves_, markers_, wireframe_, pen_face_})
+  for (VkPipeline p : {surface_, reference_pipeline_, curves_, markers_, wireframe_, pen_face_})
     if (p) vkDestroyPipeline(device, p, nullptr);
   if (layout_) vkDestroyPipelineLayout(device, layout_, nullptr);
   if (fence_) vkDestroyFence(device, fence_, nullptr);
@@ -291,7 +308,6 @@ Status Renderer::create_pipelines() {
   };
 
   const auto instance = VK_VERTEX_INPUT_RATE_INSTANCE;
-  PipelineDesc background{background_vert, background_frag, {}, {}, false, false, false};
   PipelineDesc surface{surface_vert, surface_frag, {{0, 24, VK_VERTEX_INPUT_RATE_VERTEX}},
                        {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}, {1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12}}};
   PipelineDesc reference = surface;
@@ -304,7 +320,6 @@ Status Renderer::create_pipelines() {
   PipelineDesc curves{curve_vert, flat_frag, {{0, 12, instance}},
                       {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}, {1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12}}};
   PipelineDesc markers{marker_vert, marker_frag, {{0, 12, instance}}, {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}}};
-  FIRE_TRY(build(background, background_));
   FIRE_TRY(build(surface, surface_));
   FIRE_TRY(build(reference, reference_pipeline_));
   FIRE_TRY(build(pen_face, pen_face_));
@@ -651,7 +666,9 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
   VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
   color.imageView = color_.image ? color_.view : resolve_.view;
   color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-  color.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+  color.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;  // the background: a clear, no full-screen shading on lavapipe
+  const glm::vec4 background = linear(Palette::background);
+  color.clearValue.color = {{background.r, background.g, background.b, 1.0f}};
   color.storeOp = color_.image ? VK_ATTACHMENT_STORE_OP_DONT_CARE : VK_ATTACHMENT_STORE_OP_STORE;
   if (color_.image) {
     color.resolveMode = VK_RESOLVE_MODE_AVERAGE_BIT;
@@ -689,14 +706,6 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
   };
   const VkDeviceSize zero = 0;
 
-  {  // background: top colour in `color`, bottom colour in `light`
-    PushConstants bg = pc;
-    bg.color = linear(Palette::background_top);
-    bg.light = linear(Palette::background_bottom);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, background_);
-    vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof bg, &bg);
-    vkCmdDraw(cmd, 3, 1, 0, 0);
-  }
   if (!surface_draws_.empty() && options.surface) {
     pc.color = linear(surface_settled_ ? Palette::surface : Palette::provisional_surface);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, surface_);

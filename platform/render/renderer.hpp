@@ -1,8 +1,8 @@
 #pragma once
 // The renderer: reads the curve network's pools and SurfaceLevels and draws them into an offscreen
-// target (4x multisampled colour and depth, resolved and read back to the CPU).
+// target (colour and depth, multisampled on a GPU and resolved; read back to the CPU).
 //
-// What it draws, back to front: a neutral gradient background; the surface, lit (two-sided Blinn-Phong)
+// What it draws, back to front: a neutral background (cleared); the surface, lit (two-sided Blinn-Phong)
 // and tinted while it is provisional (SurfaceLevels::settled false); every live edge's polyline as a
 // screen-space line pulled slightly towards the camera so it shows on the surface it lies on; the
 // network's vertices as round markers; an optional see-through reference mesh; the pen's feedback
@@ -40,12 +40,15 @@ namespace fire::render {
 
 struct RenderSettings {
   uint32_t width = 1280, height = 720;
+  // Samples per pixel (1, 2, 4 or 8; the largest the device has, up to this). 0: the environment's
+  // FIRE_SAMPLES if set, else by device: 1 on a CPU device (lavapipe, where 4x costs 2.6 times the frame,
+  // perf/RESULTS.md), 4 on a GPU.
+  uint32_t samples = 0;
 };
 
 // Colours of the scene, sRGB 0..255: shared with the tests, which find the curves and the background by them.
 struct Palette {
-  static constexpr uint8_t background_top[3] = {72, 76, 82};
-  static constexpr uint8_t background_bottom[3] = {30, 32, 36};
+  static constexpr uint8_t background[3] = {46, 49, 54};
   static constexpr uint8_t curve[3] = {255, 140, 26};
   static constexpr uint8_t surface[3] = {196, 200, 206};
   static constexpr uint8_t provisional_surface[3] = {132, 196, 214};  // light teal: not settled yet
@@ -151,7 +154,7 @@ class Renderer {
   VkCommandBuffer commands_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  VkPipeline background_ = VK_NULL_HANDLE, surface_ = VK_NULL_HANDLE, reference_pipeline_ = VK_NULL_HANDLE,
+  VkPipeline surface_ = VK_NULL_HANDLE, reference_pipeline_ = VK_NULL_HANDLE,
              curves_ = VK_NULL_HANDLE, markers_ = VK_NULL_HANDLE, wireframe_ = VK_NULL_HANDLE,
              pen_face_ = VK_NULL_HANDLE;
 
