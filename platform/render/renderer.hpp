@@ -20,10 +20,10 @@
 //   block keeps that block; the others get a freed block that fits or space at the end, and their
 //   triangles are copied. Then, and when SurfaceLevels::frame is newer than the last frame uploaded, the
 //   vertices in SurfaceLevels::changed are converted to float and copied where they differ from what the
-//   block holds: a commit copies the patches it changed, not the surface (the fit moves far-away limit
-//   points by less than a float's precision).
-// Buffers are host-visible; growing one re-uploads its whole content (counted as well). The surface's grow
-// by half again, and are laid out afresh when freed blocks outnumber the used ones.
+//   block holds: a commit copies the triangles of the patches it changed and the vertices whose values
+//   moved (the limit fit moves most of them a little at every commit: perf/RESULTS.md).
+// Buffers are host-visible; growing one re-uploads its whole content (counted as well). The surface's
+// buffers grow by half again, and are laid out afresh when freed blocks outnumber the used ones.
 #include <cstdint>
 #include <memory>
 #include <span>
