@@ -288,7 +288,7 @@ int main(int argc, char** argv) {
                 fps >= target ? "met" : "missed");
   }
   std::printf("\nIdle fps with parts of the scene hidden (the app's keys 1 and 2; %d s each; left: the clear, "
-              "the resolve if multisampled, blit, HUD, present):\n\n| network | L | all | surface hidden | curves hidden | both hidden |\n"
+              "the resolve if multisampled, HUD, present):\n\n| network | L | all | surface hidden | curves hidden | both hidden |\n"
               "|---|---|---|---|---|---|\n", kToggleSeconds);
   for (const Measurement& r : results)
     std::printf("| %s | %u | %.1f | %.1f | %.1f | %.1f |\n", r.name.c_str(), r.config.levels,

@@ -70,6 +70,8 @@ Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const Rende
   }
   if (chosen.samples != 1 && chosen.samples != 2 && chosen.samples != 4 && chosen.samples != 8)
     return Result<std::unique_ptr<Renderer>>::failure("samples per pixel must be 0 (by device), 1, 2, 4 or 8");
+  if (chosen.color_format != VK_FORMAT_R8G8B8A8_SRGB && chosen.color_format != VK_FORMAT_B8G8R8A8_SRGB)
+    return Result<std::unique_ptr<Renderer>>::failure("the colour format must be R8G8B8A8_SRGB or B8G8R8A8_SRGB");
   std::unique_ptr<Renderer> r(new Renderer(context, chosen));
   if (Status s = r->init(); !s) return Result<std::unique_ptr<Renderer>>::failure("Vulkan: " + s.error);
   return r;
@@ -638,8 +640,8 @@ Status Renderer::set_reference(std::span<const Vec3> positions, std::span<const 
   return Status::success();
 }
 
-void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options) {
-
+void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options, VkImage target,
+                      VkImageView target_view) {
   // Every target starts undefined: the frame clears or overwrites all of it.
   auto to_attachment = [](VkImage image, VkImageLayout layout, VkImageAspectFlags aspect, VkPipelineStageFlags2 stage,
                           VkAccessFlags2 access) {
@@ -650,7 +652,7 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
   std::vector<VkImageMemoryBarrier2> barriers;
   const VkPipelineStageFlags2 color_stage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
   const VkAccessFlags2 color_access = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT;
-  barriers.push_back(to_attachment(resolve_.image, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_ASPECT_COLOR_BIT,
+  barriers.push_back(to_attachment(target, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_ASPECT_COLOR_BIT,
                                    color_stage, color_access));
   if (color_.image)
     barriers.push_back(to_attachment(color_.image, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_ASPECT_COLOR_BIT,
@@ -664,7 +666,7 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
   vkCmdPipelineBarrier2(cmd, &dependency);
 
   VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-  color.imageView = color_.image ? color_.view : resolve_.view;
+  color.imageView = color_.image ? color_.view : target_view;
   color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
   color.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;  // the background: a clear, no full-screen shading on lavapipe
   const glm::vec4 background = linear(Palette::background);
@@ -672,7 +674,7 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
   color.storeOp = color_.image ? VK_ATTACHMENT_STORE_OP_DONT_CARE : VK_ATTACHMENT_STORE_OP_STORE;
   if (color_.image) {
     color.resolveMode = VK_RESOLVE_MODE_AVERAGE_BIT;
-    color.resolveImageView = resolve_.view;
+    color.resolveImageView = target_view;
     color.resolveImageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
   }
   VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
@@ -775,22 +777,6 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
     vkCmdDraw(cmd, 6, 1, 0, 0);
   }
   vkCmdEndRendering(cmd);
-
-  // The resolved image ready to be copied (readback) or blitted (present).
-  VkImageMemoryBarrier2 to_copy{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-  to_copy.srcStageMask = color_stage;
-  to_copy.srcAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
-  to_copy.dstStageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;  // a copy (readback) or a blit (present)
-  to_copy.dstAccessMask = VK_ACCESS_2_TRANSFER_READ_BIT;
-  to_copy.oldLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-  to_copy.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-  to_copy.srcQueueFamilyIndex = to_copy.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  to_copy.image = resolve_.image;
-  to_copy.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-  dependency = {VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-  dependency.imageMemoryBarrierCount = 1;
-  dependency.pImageMemoryBarriers = &to_copy;
-  vkCmdPipelineBarrier2(cmd, &dependency);
 }
 
 Status Renderer::draw(const Camera& camera, const DrawOptions& options) {
@@ -801,7 +787,21 @@ Status Renderer::draw(const Camera& camera, const DrawOptions& options) {
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   FIRE_VK_TRY(vkBeginCommandBuffer(cmd, &begin));
-  record(cmd, camera, options);
+  record(cmd, camera, options, resolve_.image, resolve_.view);
+  VkImageMemoryBarrier2 to_copy{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+  to_copy.srcStageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+  to_copy.srcAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
+  to_copy.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+  to_copy.dstAccessMask = VK_ACCESS_2_TRANSFER_READ_BIT;
+  to_copy.oldLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+  to_copy.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+  to_copy.srcQueueFamilyIndex = to_copy.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  to_copy.image = resolve_.image;
+  to_copy.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+  VkDependencyInfo to_copy_dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  to_copy_dependency.imageMemoryBarrierCount = 1;
+  to_copy_dependency.pImageMemoryBarriers = &to_copy;
+  vkCmdPipelineBarrier2(cmd, &to_copy_dependency);
   VkBufferImageCopy region{};
   region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
   region.imageExtent = {settings_.width, settings_.height, 1};
@@ -834,6 +834,8 @@ Image Renderer::image() const {
   Image out{settings_.width, settings_.height, {}};
   const auto* bytes = static_cast<const uint8_t*>(readback_.mapped);
   out.rgba.assign(bytes, bytes + size_t(settings_.width) * settings_.height * 4);
+  if (color_format_ == VK_FORMAT_B8G8R8A8_SRGB)
+    for (size_t i = 0; i < out.rgba.size(); i += 4) std::swap(out.rgba[i], out.rgba[i + 2]);
   return out;
 }
 

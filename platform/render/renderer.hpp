@@ -44,6 +44,9 @@ struct RenderSettings {
   // FIRE_SAMPLES if set, else by device: 1 on a CPU device (lavapipe, where 4x costs 2.6 times the frame,
   // perf/RESULTS.md), 4 on a GPU.
   uint32_t samples = 0;
+  // The colour format drawn in: the window's swapchain format for the present path (R8G8B8A8_SRGB or
+  // B8G8R8A8_SRGB; image() returns RGBA either way).
+  VkFormat color_format = VK_FORMAT_R8G8B8A8_SRGB;
 };
 
 // Colours of the scene, sRGB 0..255: shared with the tests, which find the curves and the background by them.
@@ -100,10 +103,12 @@ class Renderer {
   // Draws one frame and waits for it; the result is then in image().
   Status draw(const Camera& camera, const DrawOptions& options = {});
   Image image() const;
-  // The present path (present.hpp): records the frame into `cmd` without submitting it. The resolved image,
-  // color_image(), is left in TRANSFER_SRC_OPTIMAL, its writes made visible to transfers.
-  void record(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options);
-  VkImage color_image() const { return resolve_.image; }
+  // The present path (present.hpp): records the frame into `cmd` without submitting it, drawn (or resolved)
+  // straight into `target`, an image of color_format() and width() x height() (a swapchain image: no copy of
+  // the frame on the way). `target` is left in COLOR_ATTACHMENT_OPTIMAL, written at COLOR_ATTACHMENT_OUTPUT.
+  void record(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options, VkImage target,
+              VkImageView target_view);
+  VkFormat color_format() const { return color_format_; }
   // New target size (a resized window); waits for the device first. Uploaded data is kept.
   Status resize(uint32_t width, uint32_t height);
 
@@ -124,7 +129,8 @@ class Renderer {
   };
 
  private:
-  explicit Renderer(Context& context, const RenderSettings& settings) : context_(context), settings_(settings) {}
+  explicit Renderer(Context& context, const RenderSettings& settings)
+      : context_(context), settings_(settings), color_format_(settings.color_format) {}
   Status init();
   Status create_targets();
   Status create_target(Target& target, VkFormat format, VkImageUsageFlags usage, VkSampleCountFlagBits samples,

@@ -322,6 +322,17 @@ TEST_CASE("samples per pixel: by device, by setting or by FIRE_SAMPLES; 4x draws
   CHECK(a.rgba != b.rgba);  // the edges are smoothed: 4x did run
 }
 
+TEST_CASE("drawn in a window's B8G8R8A8_SRGB, the image reads back as the RGBA one") {
+  auto context = make_context();
+  const Scene scene = demo_scene();
+  auto rgba = Renderer::create(*context, {kWidth, kHeight, 1, VK_FORMAT_R8G8B8A8_SRGB});
+  auto bgra = Renderer::create(*context, {kWidth, kHeight, 1, VK_FORMAT_B8G8R8A8_SRGB});
+  REQUIRE(rgba);
+  REQUIRE(bgra);
+  CHECK(render_scene(*context, **bgra, scene, View::iso).rgba == render_scene(*context, **rgba, scene, View::iso).rgba);
+  CHECK_FALSE(Renderer::create(*context, {kWidth, kHeight, 1, VK_FORMAT_R8G8B8A8_UNORM}));
+}
+
 TEST_CASE("a provisional surface is tinted, a settled one is neutral grey") {
   auto context = make_context();
   auto renderer = Renderer::create(*context, {kWidth, kHeight});
