@@ -66,7 +66,7 @@ uint64_t vertices_to_copy(const SurfaceLevels& before, const SurfaceLevels& afte
 
 }  // namespace
 
-TEST_CASE("a one-curve commit copies the patches it changed, not the surface, and draws as a fresh upload does") {
+TEST_CASE("a one-curve commit copies the triangles of the patches it changed and the vertices that moved, and its image is a fresh upload's") {
   constexpr int kNx = 12, kNy = 6;  // 72 faces
   World w;
   w.log.events = perf::grid_drawing(kNx, kNy);
@@ -127,12 +127,15 @@ TEST_CASE("a one-curve commit copies the patches it changed, not the surface, an
   REQUIRE(w.mesh.face_count() == faces + 1);
   REQUIRE(w.surface.settled);
 
-  // The split cell became two faces and its two neighbours across the split edges gained a side: 4 of 73
-  // patches have new triangles. The fit (systems/reconstruct/fit.hpp) moves every limit point a little, so
-  // most vertices are copied again (perf/RESULTS.md); exactly those whose float values moved are.
+  // The split cell became two 4-sided faces and its two neighbours across the split edges gained a side: the
+  // new face's and the neighbours' triangles are copied (16 quads per side at level 2); the half that kept the
+  // split face's slot keeps its block, a 4-sided face's quads being the same. The fit (systems/reconstruct/
+  // fit.hpp) moves every limit point a little, so most vertices are copied again (perf/RESULTS.md); exactly
+  // those whose float values moved are.
   INFO("commit copied " << commit << " surface bytes (" << vertices << " vertices, " << surface_quads
                         << " quads), the whole surface is " << whole);
-  CHECK(surface_quads * 8 < w.surface.quad_count());
+  CHECK(surface_quads == 16 * (4 + 5 + 5));
+  CHECK(surface_quads * 20 < w.surface.quad_count());
   CHECK(vertices == vertices_to_copy(before, w.surface));
   CHECK(commit < whole);
 
