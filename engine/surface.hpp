@@ -4,7 +4,8 @@
 // SurfaceMesh: a polygon surface, what export writes and the file readers return.
 // SurfaceLevels: the live surface that refine and subdivide write and the renderer, the exporters and
 // `fire eval` read: the last subdivision level's limit positions and normals, its quads as one flat
-// index array, a topology version, the range changed in the last write, and whether it has settled.
+// index array, the quads grouped by the network face they come from, a topology version, the range
+// changed in the last write, and whether it has settled.
 #include <cstdint>
 #include <vector>
 
@@ -28,6 +29,12 @@ struct SurfaceLevels {
   std::vector<Vec3> positions;  // limit position per vertex of that level
   std::vector<Vec3> normals;    // unit limit normal per vertex
   std::vector<uint32_t> quads;  // 4 vertex indices per quad, counter-clockwise seen from the front
+  // Quads by patch: patch p owns quads [patch_offsets[p], patch_offsets[p+1]) and is named by
+  // patch_keys[p] (the subdivide system: its network face slot), so that a reader holding a copy (the
+  // renderer) keeps the patches a commit left alone although the numbering around them moved. Empty
+  // (assign_quads, a loaded snapshot): the whole surface is one patch. Outside surface_hash, not saved.
+  std::vector<uint32_t> patch_offsets;
+  std::vector<uint32_t> patch_keys;
   // Bumped whenever `quads` or the vertex count change; a reader holding index buffers re-uploads them.
   uint64_t topology_version = 0;
   Frame frame = 0;              // frame of the last write
@@ -38,6 +45,11 @@ struct SurfaceLevels {
 
   uint32_t vertex_count() const { return static_cast<uint32_t>(positions.size()); }
   uint32_t quad_count() const { return static_cast<uint32_t>(quads.size() / 4); }
+  uint32_t patch_count() const { return patch_keys.empty() ? 1u : static_cast<uint32_t>(patch_keys.size()); }
+  // Quads [first, end) of patch p and its key (kNone for the whole surface as one patch).
+  uint32_t patch_begin(uint32_t p) const { return patch_keys.empty() ? 0 : patch_offsets[p]; }
+  uint32_t patch_end(uint32_t p) const { return patch_keys.empty() ? quad_count() : patch_offsets[p + 1]; }
+  uint32_t patch_key(uint32_t p) const { return patch_keys.empty() ? kNone : patch_keys[p]; }
   bool empty() const { return quads.empty(); }
 };
 
@@ -65,7 +77,8 @@ inline SurfaceMesh to_surface_mesh(const SurfaceLevels& s) {
 
 // Replaces `out` with a quad mesh (every face must have 4 vertices, normals present) written at `now`:
 // positions always count as changed; the topology version moves only when the quads or the vertex
-// count differ from what `out` held. Returns false, leaving `out` alone, when a face is not a quad.
+// count differ from what `out` held; the patches are cleared (one patch). Returns false, leaving `out`
+// alone, when a face is not a quad.
 inline bool assign_quads(const SurfaceMesh& mesh, Frame now, SurfaceLevels& out) {
   for (size_t f = 0; f < mesh.face_count(); ++f)
     if (mesh.face_size(f) != 4) return false;
@@ -75,6 +88,8 @@ inline bool assign_quads(const SurfaceMesh& mesh, Frame now, SurfaceLevels& out)
     out.quads = mesh.face_vertices;
     ++out.topology_version;
   }
+  out.patch_offsets.clear();
+  out.patch_keys.clear();
   out.positions = mesh.positions;
   out.normals = mesh.normals;
   out.frame = now;

@@ -64,6 +64,7 @@ struct Stages {
 
 struct Measurement {
   std::string name, device;
+  uint32_t samples = 1;  // per pixel, as the renderer chose them
   Config config;
   size_t faces_before = 0, faces_after = 0, quads = 0;
   double scene_bytes = 0;  // the first frame's upload: everything
@@ -125,6 +126,7 @@ Measurement run(const Config& c, double seconds) {
     return r;
   }
   r.device = app.context().device_name();
+  r.samples = uint32_t(app.renderer().samples());
   const render::Orbit orbit = frame_orbit(cli::scene_box(w.mesh, w.surface, {}), app.width(), app.height());
   // The app's loop without its input handling: events are drained, none is made.
   auto frame = [&] {
@@ -216,7 +218,7 @@ Measurement run(const Config& c, double seconds) {
       committed = committed || w.history.undo_depth() > edits;
       if (committed && u.bytes == 0 && w.surface.settled) break;
       bytes += double(u.bytes);
-      surface_bytes += double(u.surface_vertices) * 24 + (u.surface_topology ? double(w.surface.quad_count()) * 24 : 0);
+      surface_bytes += double(u.surface_vertices) * 24 + double(u.surface_quads) * 24;
       if (u.bytes) {
         r.commit_frame_ms.add(ms_between(before, WallClock::now()));
         r.commit_stages.add(app.stages());
@@ -274,8 +276,8 @@ int main(int argc, char** argv) {
     }
   }
 
-  std::printf("# bench_render: the app frame on %s, 1280x720, wall time between presents\n\n",
-              results.front().device.c_str());
+  std::printf("# bench_render: the app frame on %s, %u sample(s) per pixel, 1280x720, wall time between presents\n\n",
+              results.front().device.c_str(), results.front().samples);
   std::printf("| network | L | surface quads | frames | s | mean fps | p50 ms | p99 ms | max ms | CPU ms per frame | "
               "target |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const Measurement& r : results) {
@@ -285,8 +287,8 @@ int main(int argc, char** argv) {
                 r.frame_ms.percentile(50), r.frame_ms.percentile(99), r.frame_ms.max(), r.cpu_ms_per_frame, target,
                 fps >= target ? "met" : "missed");
   }
-  std::printf("\nIdle fps with parts of the scene hidden (the app's keys 1 and 2; %d s each; left: background, "
-              "resolve, blit, HUD, present):\n\n| network | L | all | surface hidden | curves hidden | both hidden |\n"
+  std::printf("\nIdle fps with parts of the scene hidden (the app's keys 1 and 2; %d s each; left: the clear, "
+              "the resolve if multisampled, HUD, present):\n\n| network | L | all | surface hidden | curves hidden | both hidden |\n"
               "|---|---|---|---|---|---|\n", kToggleSeconds);
   for (const Measurement& r : results)
     std::printf("| %s | %u | %.1f | %.1f | %.1f | %.1f |\n", r.name.c_str(), r.config.levels,

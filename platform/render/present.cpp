@@ -38,47 +38,45 @@ Status Presenter::init(uint32_t width, uint32_t height) {
   std::vector<VkSurfaceFormatKHR> formats(count);
   FIRE_VK_TRY(vkGetPhysicalDeviceSurfaceFormatsKHR(context_.physical_device(), surface_, &count, formats.data()));
   if (formats.empty()) return Status::failure("the window's surface offers no image format");
-  // sRGB like the renderer's target, so the blit copies colours unchanged; else the first offered.
-  format_ = formats.front();
+  // The renderer draws straight into the swapchain's images: an 8-bit sRGB format it can draw in.
+  format_.format = VK_FORMAT_UNDEFINED;
   for (const VkSurfaceFormatKHR& f : formats)
     if ((f.format == VK_FORMAT_B8G8R8A8_SRGB || f.format == VK_FORMAT_R8G8B8A8_SRGB) &&
         f.colorSpace == VK_COLOR_SPACE_SRGB_NONLINEAR_KHR) {
       format_ = f;
       break;
     }
-  VkFormatProperties props;
-  vkGetPhysicalDeviceFormatProperties(context_.physical_device(), format_.format, &props);
-  if (!(props.optimalTilingFeatures & VK_FORMAT_FEATURE_BLIT_DST_BIT))
-    return Status::failure("the window's image format cannot be a blit destination");
+  if (format_.format == VK_FORMAT_UNDEFINED)
+    return Status::failure("the window's surface offers neither B8G8R8A8_SRGB nor R8G8B8A8_SRGB images");
 
   VkAttachmentDescription attachment{};
   attachment.format = format_.format;
   attachment.samples = VK_SAMPLE_COUNT_1_BIT;
-  attachment.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;  // the blitted scene
+  attachment.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;  // the scene the renderer drew
   attachment.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
   attachment.stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;
   attachment.stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
-  attachment.initialLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+  attachment.initialLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
   attachment.finalLayout = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
   VkAttachmentReference reference{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
   VkSubpassDescription subpass{};
   subpass.pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
   subpass.colorAttachmentCount = 1;
   subpass.pColorAttachments = &reference;
-  VkSubpassDependency after_blit{};
-  after_blit.srcSubpass = VK_SUBPASS_EXTERNAL;
-  after_blit.dstSubpass = 0;
-  after_blit.srcStageMask = VK_PIPELINE_STAGE_TRANSFER_BIT;
-  after_blit.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-  after_blit.dstStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
-  after_blit.dstAccessMask = VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+  VkSubpassDependency after_scene{};
+  after_scene.srcSubpass = VK_SUBPASS_EXTERNAL;
+  after_scene.dstSubpass = 0;
+  after_scene.srcStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
+  after_scene.srcAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+  after_scene.dstStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
+  after_scene.dstAccessMask = VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
   VkRenderPassCreateInfo pass{VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO};
   pass.attachmentCount = 1;
   pass.pAttachments = &attachment;
   pass.subpassCount = 1;
   pass.pSubpasses = &subpass;
   pass.dependencyCount = 1;
-  pass.pDependencies = &after_blit;
+  pass.pDependencies = &after_scene;
   FIRE_VK_TRY(vkCreateRenderPass(device, &pass, nullptr, &overlay_pass_));
 
   FIRE_TRY(context_.create_commands(pool_, commands_, fence_, true));
@@ -99,8 +97,6 @@ Status Presenter::create_swapchain(uint32_t width, uint32_t height) {
   destroy_swapchain_views();
   extent_ = extent;
   if (extent.width == 0 || extent.height == 0) return Status::success();  // minimised: no swapchain until restored
-  if (!(caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_DST_BIT))
-    return Status::failure("the window's images cannot be a transfer destination (needed to show the rendered frame)");
   can_capture_ = caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
 
   uint32_t min_images = std::max(caps.minImageCount + 1, 2u);  // one to draw while one is shown
@@ -112,8 +108,7 @@ Status Presenter::create_swapchain(uint32_t width, uint32_t height) {
   info.imageColorSpace = format_.colorSpace;
   info.imageExtent = extent;
   info.imageArrayLayers = 1;
-  info.imageUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
-                    (can_capture_ ? VK_IMAGE_USAGE_TRANSFER_SRC_BIT : 0);
+  info.imageUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | (can_capture_ ? VK_IMAGE_USAGE_TRANSFER_SRC_BIT : 0);
   info.imageSharingMode = VK_SHARING_MODE_EXCLUSIVE;
   info.preTransform = caps.currentTransform;
   info.compositeAlpha = VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR;
@@ -262,6 +257,8 @@ Result<bool> Presenter::frame(Renderer& renderer, const Camera& camera, const Dr
   VkDevice device = context_.device();
   if (!swapchain_ || extent_.width == 0 || extent_.height == 0) return false;
   if (capture && !can_capture_) return Result<bool>::failure("the window's images cannot be read back for a screenshot");
+  if (renderer.color_format() != format_.format)
+    return Result<bool>::failure("the renderer draws in another format than the window's images (RenderSettings::color_format)");
   if (Status s = wait(); !s) return Result<bool>::failure(s.error);
   if (renderer.width() != extent_.width || renderer.height() != extent_.height)
     if (Status s = renderer.resize(extent_.width, extent_.height); !s) return Result<bool>::failure(s.error);
@@ -280,17 +277,10 @@ Result<bool> Presenter::frame(Renderer& renderer, const Camera& camera, const Dr
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   if (VkResult r = vkBeginCommandBuffer(cmd, &begin); r != VK_SUCCESS) return fail("vkBeginCommandBuffer", r);
 
-  renderer.record(cmd, camera, options);
   const VkImage image = images_[index];
-  // The acquire semaphore's wait (at the submit) orders this after the presentation engine's read.
-  barrier(cmd, image_barrier(image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                             VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, 0, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
-                             VK_ACCESS_2_TRANSFER_WRITE_BIT));
-  VkImageBlit blit{};
-  blit.srcSubresource = blit.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-  blit.srcOffsets[1] = blit.dstOffsets[1] = {int32_t(extent_.width), int32_t(extent_.height), 1};
-  vkCmdBlitImage(cmd, renderer.color_image(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, image,
-                 VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit, VK_FILTER_NEAREST);
+  // Drawn straight into the swapchain image: the acquire semaphore's wait (at the submit, before colour
+  // output) orders this after the presentation engine's read.
+  renderer.record(cmd, camera, options, image, views_[index]);
 
   VkRenderPassBeginInfo pass{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
   pass.renderPass = overlay_pass_;
@@ -305,7 +295,7 @@ Result<bool> Presenter::frame(Renderer& renderer, const Camera& camera, const Dr
 
   VkSemaphoreSubmitInfo wait_acquire{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
   wait_acquire.semaphore = acquired_;
-  wait_acquire.stageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;
+  wait_acquire.stageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
   VkSemaphoreSubmitInfo signal_rendered{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
   signal_rendered.semaphore = rendered_[index];
   signal_rendered.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;

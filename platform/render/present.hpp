@@ -1,7 +1,7 @@
 #pragma once
-// The present path, beside the offscreen one: the renderer's frame blitted into a window's swapchain image,
-// an overlay (the app's HUD) drawn over it in a render pass, then presented with FIFO, i.e. vsync, which
-// paces the display.
+// The present path, beside the offscreen one: the renderer's frame drawn straight into a window's swapchain
+// image (the renderer made with RenderSettings::color_format = format()), an overlay (the app's HUD) drawn
+// over it in a render pass, then presented with FIFO, i.e. vsync, which paces the display.
 //
 // One frame in flight: the renderer has one target and host-visible buffers that upload() writes, so a
 // frame waits for the previous one (wait()) before anything of the renderer is touched.
@@ -27,7 +27,7 @@ class Presenter {
 
   // Waits for the previous frame's commands, after which the renderer's buffers may be written.
   Status wait();
-  // Draws over the blitted scene, inside overlay_pass().
+  // Draws over the scene, inside overlay_pass().
   using Overlay = std::function<void(VkCommandBuffer)>;
   // Acquires an image, records the renderer's frame (resized to the swapchain first if needed) and the
   // overlay, submits and presents. False: the swapchain no longer fits the window (out of date, suboptimal or
@@ -42,6 +42,7 @@ class Presenter {
   Status run_once(const std::function<void(VkCommandBuffer)>& record);
 
   VkRenderPass overlay_pass() const { return overlay_pass_; }
+  VkFormat format() const { return format_.format; }  // of the window's images: the renderer must draw in it
   // Whether the window's images encode to sRGB on write (colours drawn into them are then linear).
   bool srgb() const { return format_.format == VK_FORMAT_B8G8R8A8_SRGB || format_.format == VK_FORMAT_R8G8B8A8_SRGB; }
 

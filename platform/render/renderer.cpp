@@ -2,11 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <string>
+#include <unordered_map>
 
 // SPIR-V compiled from shaders/ at build time (platform/render/CMakeLists.txt).
-#include "shaders/background_frag.h"
-#include "shaders/background_vert.h"
 #include "shaders/curve_vert.h"
 #include "shaders/flat_frag.h"
 #include "shaders/marker_frag.h"
@@ -56,15 +57,34 @@ struct PipelineDesc {
 Result<std::unique_ptr<Renderer>> Renderer::create(Context& context, const RenderSettings& settings) {
   if (settings.width == 0 || settings.height == 0 || settings.width > 8192 || settings.height > 8192)
     return Result<std::unique_ptr<Renderer>>::failure("image size must be 1 to 8192 pixels a side");
-  std::unique_ptr<Renderer> r(new Renderer(context, settings));
+  RenderSettings chosen = settings;
+  if (chosen.samples == 0) {
+    if (const char* env = std::getenv("FIRE_SAMPLES"); env && *env) {
+      const std::string value = env;
+      if (value != "1" && value != "2" && value != "4" && value != "8")
+        return Result<std::unique_ptr<Renderer>>::failure("FIRE_SAMPLES must be 1, 2, 4 or 8, not '" + value + "'");
+      chosen.samples = uint32_t(std::stoul(value));
+    } else {
+      chosen.samples = context.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? 1 : 4;
+    }
+  }
+  if (chosen.samples != 1 && chosen.samples != 2 && chosen.samples != 4 && chosen.samples != 8)
+    return Result<std::unique_ptr<Renderer>>::failure("samples per pixel must be 0 (by device), 1, 2, 4 or 8");
+  if (chosen.color_format != VK_FORMAT_R8G8B8A8_SRGB && chosen.color_format != VK_FORMAT_B8G8R8A8_SRGB)
+    return Result<std::unique_ptr<Renderer>>::failure("the colour format must be R8G8B8A8_SRGB or B8G8R8A8_SRGB");
+  std::unique_ptr<Renderer> r(new Renderer(context, chosen));
   if (Status s = r->init(); !s) return Result<std::unique_ptr<Renderer>>::failure("Vulkan: " + s.error);
   return r;
 }
 
 Status Renderer::init() {
   const VkPhysicalDeviceLimits& limits = context_.properties().limits;
-  if (limits.framebufferColorSampleCounts & limits.framebufferDepthSampleCounts & VK_SAMPLE_COUNT_4_BIT)
-    samples_ = VK_SAMPLE_COUNT_4_BIT;
+  const VkSampleCountFlags supported = limits.framebufferColorSampleCounts & limits.framebufferDepthSampleCounts;
+  for (VkSampleCountFlagBits n : {VK_SAMPLE_COUNT_8_BIT, VK_SAMPLE_COUNT_4_BIT, VK_SAMPLE_COUNT_2_BIT})
+    if (uint32_t(n) <= settings_.samples && (supported & n)) {
+      samples_ = n;
+      break;
+    }
   VkFormatProperties depth_props;
   vkGetPhysicalDeviceFormatProperties(context_.physical_device(), depth_format_, &depth_props);
   if (!(depth_props.optimalTilingFeatures & VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT))
@@ -187,7 +207,7 @@ Renderer::~Renderer() {
                     &reference_indices_, &stroke_, &pen_})
     destroy(*b);
   for (Target* t : {&color_, &resolve_, &depth_}) destroy(*t);
-  for (VkPipeline p : {background_, surface_, reference_pipeline_, curves_, markers_, wireframe_, pen_face_})
+  for (VkPipeline p : {surface_, reference_pipeline_, curves_, markers_, wireframe_, pen_face_})
     if (p) vkDestroyPipeline(device, p, nullptr);
   if (layout_) vkDestroyPipelineLayout(device, layout_, nullptr);
   if (fence_) vkDestroyFence(device, fence_, nullptr);
@@ -290,7 +310,6 @@ Status Renderer::create_pipelines() {
   };
 
   const auto instance = VK_VERTEX_INPUT_RATE_INSTANCE;
-  PipelineDesc background{background_vert, background_frag, {}, {}, false, false, false};
   PipelineDesc surface{surface_vert, surface_frag, {{0, 24, VK_VERTEX_INPUT_RATE_VERTEX}},
                        {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}, {1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12}}};
   PipelineDesc reference = surface;
@@ -303,7 +322,6 @@ Status Renderer::create_pipelines() {
   PipelineDesc curves{curve_vert, flat_frag, {{0, 12, instance}},
                       {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}, {1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12}}};
   PipelineDesc markers{marker_vert, marker_frag, {{0, 12, instance}}, {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}}};
-  FIRE_TRY(build(background, background_));
   FIRE_TRY(build(surface, surface_));
   FIRE_TRY(build(reference, reference_pipeline_));
   FIRE_TRY(build(pen_face, pen_face_));
@@ -388,45 +406,166 @@ Status Renderer::upload_vertices(const Mesh& network) {
 Status Renderer::upload_surface(const SurfaceLevels& s) {
   surface_settled_ = s.settled;
   if (s.empty()) {
-    surface_index_count_ = 0;
-    surface_seen_ = false;  // whatever comes next is uploaded whole
+    blocks_.clear();
+    free_blocks_.clear();
+    surface_draws_.clear();
+    surface_vertex_end_ = surface_quad_end_ = 0;
+    surface_seen_ = false;  // whatever comes next is laid out afresh
     return Status::success();
   }
-  bool full = !surface_seen_ || s.topology_version != surface_topology_;
-  bool grown = false;
-  FIRE_TRY(reserve(surface_vertices_, VkDeviceSize(s.vertex_count()) * 24, kVertex, grown));
-  full = full || grown;
-  FIRE_TRY(reserve(surface_indices_, VkDeviceSize(s.quad_count()) * 24, kIndex, grown));
-  full = full || grown;
-  auto write_vertices = [&](uint32_t begin, uint32_t end) {
-    std::vector<glm::vec3> interleaved;
-    interleaved.reserve(size_t(end - begin) * 2);
-    for (uint32_t v = begin; v < end; ++v) {
-      interleaved.push_back(to_float(s.positions[v]));
-      interleaved.push_back(to_float(s.normals[v]));
-    }
-    copy_into(surface_vertices_, VkDeviceSize(begin) * 24, interleaved.data(), interleaved.size() * sizeof(glm::vec3));
-    stats_.surface_vertices += end - begin;
-  };
-  if (full) {
-    write_vertices(0, s.vertex_count());
-    std::vector<uint32_t> triangles;
-    triangles.reserve(size_t(s.quad_count()) * 6);
-    for (uint32_t q = 0; q < s.quad_count(); ++q) {
-      const uint32_t* c = &s.quads[size_t(q) * 4];
-      triangles.insert(triangles.end(), {c[0], c[1], c[2], c[0], c[2], c[3]});
-    }
-    copy_into(surface_indices_, 0, triangles.data(), triangles.size() * sizeof(uint32_t));
-    surface_index_count_ = uint32_t(triangles.size());
-    stats_.surface_topology = true;
+  if (!surface_seen_ || s.topology_version != surface_topology_) {
+    FIRE_TRY(layout_surface(s));
   } else if (s.frame != surface_frame_) {
-    const uint32_t end = std::min(s.changed.end, s.vertex_count());
-    if (s.changed.begin < end) write_vertices(s.changed.begin, end);
+    write_surface_vertices(s, s.changed);
   }
   surface_seen_ = true;
   surface_topology_ = s.topology_version;
   surface_frame_ = s.frame;
   return Status::success();
+}
+
+Status Renderer::layout_surface(const SurfaceLevels& s) {
+  // The blocks held so far, by key; a key seen twice (never from the subdivide system) keeps its first.
+  std::vector<Block> old = std::move(blocks_);
+  std::unordered_map<uint32_t, size_t> old_by_key;
+  for (size_t i = 0; i < old.size(); ++i) old_by_key.emplace(old[i].key, i);
+  std::vector<uint8_t> old_kept(old.size(), 0);
+  blocks_.clear();
+  block_vertex_.assign(s.vertex_count(), kNone);
+  for (uint32_t p = 0; p < s.patch_count(); ++p) {
+    Block b;
+    b.key = s.patch_key(p);
+    for (size_t i = 4 * size_t(s.patch_begin(p)); i < 4 * size_t(s.patch_end(p)); ++i) {
+      uint32_t& local = block_vertex_[s.quads[i]];
+      if (local == kNone) {
+        local = uint32_t(b.vertices.size());
+        b.vertices.push_back(s.quads[i]);
+      }
+      b.quads.push_back(local);
+    }
+    for (uint32_t v : b.vertices) block_vertex_[v] = kNone;
+    b.vertex_count = uint32_t(b.vertices.size());
+    b.quad_count = uint32_t(b.quads.size() / 4);
+    b.first_quad = kNone;  // to be placed
+    if (auto it = old_by_key.find(b.key); it != old_by_key.end() && !old_kept[it->second] && old[it->second].quads == b.quads) {
+      b.first_vertex = old[it->second].first_vertex;
+      b.first_quad = old[it->second].first_quad;
+      old_kept[it->second] = 1;
+    }
+    blocks_.push_back(std::move(b));
+  }
+  for (size_t i = 0; i < old.size(); ++i)
+    if (!old_kept[i]) free_blocks_.push_back({kNone, old[i].first_vertex, old[i].vertex_count, old[i].first_quad, old[i].quad_count, {}, {}});
+
+  // Laid out afresh once the freed quads outnumber the used ones: the buffers stay within about twice the
+  // surface, for one whole upload now and then.
+  uint64_t used = 0, freed = 0;
+  for (const Block& b : blocks_) used += b.quad_count;
+  for (const Block& f : free_blocks_) freed += f.quad_count;
+  if (freed > used) {
+    free_blocks_.clear();
+    surface_vertex_end_ = surface_quad_end_ = 0;
+    for (Block& b : blocks_) b.first_quad = kNone;
+  }
+  std::vector<uint8_t> placed(blocks_.size(), 0);  // blocks whose triangles must be copied
+  for (size_t k = 0; k < blocks_.size(); ++k) {
+    Block& b = blocks_[k];
+    if (b.first_quad != kNone) continue;
+    placed[k] = 1;
+    size_t best = free_blocks_.size();  // the smallest freed block that holds it
+    for (size_t i = 0; i < free_blocks_.size(); ++i) {
+      const Block& f = free_blocks_[i];
+      if (f.vertex_count >= b.vertex_count && f.quad_count >= b.quad_count &&
+          (best == free_blocks_.size() || f.quad_count < free_blocks_[best].quad_count))
+        best = i;
+    }
+    if (best < free_blocks_.size()) {
+      Block& f = free_blocks_[best];
+      b.first_vertex = f.first_vertex;
+      b.first_quad = f.first_quad;
+      f.first_vertex += b.vertex_count;
+      f.vertex_count -= b.vertex_count;
+      f.first_quad += b.quad_count;
+      f.quad_count -= b.quad_count;
+      if (f.vertex_count == 0 || f.quad_count == 0) free_blocks_.erase(free_blocks_.begin() + ptrdiff_t(best));
+    } else {
+      b.first_vertex = surface_vertex_end_;
+      b.first_quad = surface_quad_end_;
+      surface_vertex_end_ += b.vertex_count;
+      surface_quad_end_ += b.quad_count;
+    }
+  }
+  // Space never written holds NaN in the copy, so that every vertex placed there differs from it.
+  surface_vertex_copy_.resize(2 * size_t(surface_vertex_end_), glm::vec3(std::nanf("")));
+  surface_index_copy_.resize(6 * size_t(surface_quad_end_));
+  FIRE_TRY(reserve_surface(placed));
+
+  for (size_t k = 0; k < blocks_.size(); ++k) {
+    if (!placed[k]) continue;
+    const Block& b = blocks_[k];
+    uint32_t* out = &surface_index_copy_[6 * size_t(b.first_quad)];
+    for (size_t q = 0; q < b.quad_count; ++q) {
+      const uint32_t* c = &b.quads[4 * q];
+      const uint32_t o = b.first_vertex;
+      for (uint32_t corner : {c[0], c[1], c[2], c[0], c[2], c[3]}) *out++ = o + corner;
+    }
+    copy_into(surface_indices_, VkDeviceSize(b.first_quad) * 24, &surface_index_copy_[6 * size_t(b.first_quad)],
+              VkDeviceSize(b.quad_count) * 24);
+    stats_.surface_quads += b.quad_count;
+  }
+  write_surface_vertices(s, {0, s.vertex_count()});
+
+  std::vector<std::pair<uint32_t, uint32_t>> ranges;  // (first quad, quads) per block, then in buffer order
+  for (const Block& b : blocks_) ranges.emplace_back(b.first_quad, b.quad_count);
+  std::sort(ranges.begin(), ranges.end());
+  surface_draws_.clear();
+  for (const auto& [first, count] : ranges) {
+    if (!surface_draws_.empty() && surface_draws_.back().first + surface_draws_.back().second == 6 * first)
+      surface_draws_.back().second += 6 * count;
+    else
+      surface_draws_.emplace_back(6 * first, 6 * count);
+  }
+  return Status::success();
+}
+
+Status Renderer::reserve_surface(std::vector<uint8_t>& placed) {
+  // Half again what is needed when growing, so that appended blocks reallocate now and then only.
+  auto room = [](VkDeviceSize need, const Buffer& b) { return need <= b.capacity ? need : need + need / 2; };
+  bool grown = false;
+  FIRE_TRY(reserve(surface_vertices_, room(VkDeviceSize(surface_vertex_end_) * 24, surface_vertices_), kVertex, grown));
+  if (grown) std::fill(surface_vertex_copy_.begin(), surface_vertex_copy_.end(), glm::vec3(std::nanf("")));
+  FIRE_TRY(reserve(surface_indices_, room(VkDeviceSize(surface_quad_end_) * 24, surface_indices_), kIndex, grown));
+  if (grown) std::fill(placed.begin(), placed.end(), 1);
+  return Status::success();
+}
+
+void Renderer::write_surface_vertices(const SurfaceLevels& s, ChangedRange changed) {
+  changed.end = std::min(changed.end, s.vertex_count());
+  for (const Block& b : blocks_) {
+    glm::vec3* held = &surface_vertex_copy_[2 * size_t(b.first_vertex)];
+    uint32_t run = kNone;  // first vertex of the run of differing ones being gathered
+    auto flush = [&](uint32_t end) {
+      copy_into(surface_vertices_, VkDeviceSize(b.first_vertex + run) * 24, &held[2 * size_t(run)],
+                VkDeviceSize(end - run) * 24);
+      stats_.surface_vertices += end - run;
+      run = kNone;
+    };
+    for (uint32_t i = 0; i < b.vertex_count; ++i) {
+      const uint32_t v = b.vertices[i];
+      bool differs = false;
+      if (v >= changed.begin && v < changed.end) {
+        const glm::vec3 p = to_float(s.positions[v]), n = to_float(s.normals[v]);
+        if (held[2 * i] != p || held[2 * i + 1] != n) {
+          held[2 * i] = p;
+          held[2 * i + 1] = n;
+          differs = true;
+        }
+      }
+      if (differs && run == kNone) run = i;
+      if (!differs && run != kNone) flush(i);
+    }
+    if (run != kNone) flush(b.vertex_count);
+  }
 }
 
 Status Renderer::set_stroke(std::span<const Vec3> points) {
@@ -501,8 +640,8 @@ Status Renderer::set_reference(std::span<const Vec3> positions, std::span<const 
   return Status::success();
 }
 
-void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options) {
-
+void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options, VkImage target,
+                      VkImageView target_view) {
   // Every target starts undefined: the frame clears or overwrites all of it.
   auto to_attachment = [](VkImage image, VkImageLayout layout, VkImageAspectFlags aspect, VkPipelineStageFlags2 stage,
                           VkAccessFlags2 access) {
@@ -513,7 +652,7 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
   std::vector<VkImageMemoryBarrier2> barriers;
   const VkPipelineStageFlags2 color_stage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
   const VkAccessFlags2 color_access = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT;
-  barriers.push_back(to_attachment(resolve_.image, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_ASPECT_COLOR_BIT,
+  barriers.push_back(to_attachment(target, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_ASPECT_COLOR_BIT,
                                    color_stage, color_access));
   if (color_.image)
     barriers.push_back(to_attachment(color_.image, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_ASPECT_COLOR_BIT,
@@ -527,13 +666,15 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
   vkCmdPipelineBarrier2(cmd, &dependency);
 
   VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-  color.imageView = color_.image ? color_.view : resolve_.view;
+  color.imageView = color_.image ? color_.view : target_view;
   color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-  color.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+  color.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;  // the background: a clear, no full-screen shading on lavapipe
+  const glm::vec4 background = linear(Palette::background);
+  color.clearValue.color = {{background.r, background.g, background.b, 1.0f}};
   color.storeOp = color_.image ? VK_ATTACHMENT_STORE_OP_DONT_CARE : VK_ATTACHMENT_STORE_OP_STORE;
   if (color_.image) {
     color.resolveMode = VK_RESOLVE_MODE_AVERAGE_BIT;
-    color.resolveImageView = resolve_.view;
+    color.resolveImageView = target_view;
     color.resolveImageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
   }
   VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
@@ -567,29 +708,21 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
   };
   const VkDeviceSize zero = 0;
 
-  {  // background: top colour in `color`, bottom colour in `light`
-    PushConstants bg = pc;
-    bg.color = linear(Palette::background_top);
-    bg.light = linear(Palette::background_bottom);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, background_);
-    vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof bg, &bg);
-    vkCmdDraw(cmd, 3, 1, 0, 0);
-  }
-  if (surface_index_count_ && options.surface) {
+  if (!surface_draws_.empty() && options.surface) {
     pc.color = linear(surface_settled_ ? Palette::surface : Palette::provisional_surface);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, surface_);
     push();
     vkCmdBindVertexBuffers(cmd, 0, 1, &surface_vertices_.buffer, &zero);
     vkCmdBindIndexBuffer(cmd, surface_indices_.buffer, 0, VK_INDEX_TYPE_UINT32);
-    vkCmdDrawIndexed(cmd, surface_index_count_, 1, 0, 0, 0);
+    for (const auto& [first, count] : surface_draws_) vkCmdDrawIndexed(cmd, count, 1, first, 0, 0);
   }
-  if (surface_index_count_ && options.wireframe && wireframe_) {
+  if (!surface_draws_.empty() && options.wireframe && wireframe_) {
     pc.color = linear(Palette::wireframe);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, wireframe_);
     push();
     vkCmdBindVertexBuffers(cmd, 0, 1, &surface_vertices_.buffer, &zero);
     vkCmdBindIndexBuffer(cmd, surface_indices_.buffer, 0, VK_INDEX_TYPE_UINT32);
-    vkCmdDrawIndexed(cmd, surface_index_count_, 1, 0, 0, 0);
+    for (const auto& [first, count] : surface_draws_) vkCmdDrawIndexed(cmd, count, 1, first, 0, 0);
   }
   if (!curve_draws_.empty() && options.curves) {
     pc.color = linear(Palette::curve);
@@ -644,22 +777,6 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
     vkCmdDraw(cmd, 6, 1, 0, 0);
   }
   vkCmdEndRendering(cmd);
-
-  // The resolved image ready to be copied (readback) or blitted (present).
-  VkImageMemoryBarrier2 to_copy{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-  to_copy.srcStageMask = color_stage;
-  to_copy.srcAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
-  to_copy.dstStageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;  // a copy (readback) or a blit (present)
-  to_copy.dstAccessMask = VK_ACCESS_2_TRANSFER_READ_BIT;
-  to_copy.oldLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-  to_copy.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-  to_copy.srcQueueFamilyIndex = to_copy.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  to_copy.image = resolve_.image;
-  to_copy.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-  dependency = {VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-  dependency.imageMemoryBarrierCount = 1;
-  dependency.pImageMemoryBarriers = &to_copy;
-  vkCmdPipelineBarrier2(cmd, &dependency);
 }
 
 Status Renderer::draw(const Camera& camera, const DrawOptions& options) {
@@ -670,7 +787,21 @@ Status Renderer::draw(const Camera& camera, const DrawOptions& options) {
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   FIRE_VK_TRY(vkBeginCommandBuffer(cmd, &begin));
-  record(cmd, camera, options);
+  record(cmd, camera, options, resolve_.image, resolve_.view);
+  VkImageMemoryBarrier2 to_copy{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+  to_copy.srcStageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+  to_copy.srcAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
+  to_copy.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+  to_copy.dstAccessMask = VK_ACCESS_2_TRANSFER_READ_BIT;
+  to_copy.oldLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+  to_copy.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+  to_copy.srcQueueFamilyIndex = to_copy.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  to_copy.image = resolve_.image;
+  to_copy.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+  VkDependencyInfo to_copy_dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  to_copy_dependency.imageMemoryBarrierCount = 1;
+  to_copy_dependency.pImageMemoryBarriers = &to_copy;
+  vkCmdPipelineBarrier2(cmd, &to_copy_dependency);
   VkBufferImageCopy region{};
   region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
   region.imageExtent = {settings_.width, settings_.height, 1};
@@ -703,6 +834,8 @@ Image Renderer::image() const {
   Image out{settings_.width, settings_.height, {}};
   const auto* bytes = static_cast<const uint8_t*>(readback_.mapped);
   out.rgba.assign(bytes, bytes + size_t(settings_.width) * settings_.height * 4);
+  if (color_format_ == VK_FORMAT_B8G8R8A8_SRGB)
+    for (size_t i = 0; i < out.rgba.size(); i += 4) std::swap(out.rgba[i], out.rgba[i + 2]);
   return out;
 }
 

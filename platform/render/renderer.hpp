@@ -1,8 +1,8 @@
 #pragma once
 // The renderer: reads the curve network's pools and SurfaceLevels and draws them into an offscreen
-// target (4x multisampled colour and depth, resolved and read back to the CPU).
+// target (colour and depth, multisampled on a GPU and resolved; read back to the CPU).
 //
-// What it draws, back to front: a neutral gradient background; the surface, lit (two-sided Blinn-Phong)
+// What it draws, back to front: a neutral background (cleared); the surface, lit (two-sided Blinn-Phong)
 // and tinted while it is provisional (SurfaceLevels::settled false); every live edge's polyline as a
 // screen-space line pulled slightly towards the camera so it shows on the surface it lies on; the
 // network's vertices as round markers; an optional see-through reference mesh; the pen's feedback
@@ -14,9 +14,16 @@
 //   copied when the edge is new to the renderer, its slot's generation, offset or count moved, or it is
 //   stamped (engine/change.hpp) after the network frame of the previous upload;
 // - network vertices: by slot, when new or their position changed;
-// - surface: all vertices and the triangle indices when topology_version moved (or on first sight),
-//   else only SurfaceLevels::changed when SurfaceLevels::frame is newer than the last frame uploaded.
-// Buffers are host-visible; growing one re-uploads its whole content (counted as well).
+// - surface: in blocks, one per patch (SurfaceLevels' quads grouped by network face), each holding its
+//   patch's vertices (those on a patch border once per patch) and triangles. When topology_version moved
+//   (or on first sight) a patch whose key and quads, renumbered in the order they appear, are those of a
+//   block keeps that block; the others get a freed block that fits or space at the end, and their
+//   triangles are copied. Then, and when SurfaceLevels::frame is newer than the last frame uploaded, the
+//   vertices in SurfaceLevels::changed are converted to float and copied where they differ from what the
+//   block holds: a commit copies the triangles of the patches it changed and the vertices whose values
+//   moved (the limit fit moves most of them a little at every commit: perf/RESULTS.md).
+// Buffers are host-visible; growing one re-uploads its whole content (counted as well). The surface's
+// buffers grow by half again, and are laid out afresh when freed blocks outnumber the used ones.
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -33,12 +40,18 @@ namespace fire::render {
 
 struct RenderSettings {
   uint32_t width = 1280, height = 720;
+  // Samples per pixel (1, 2, 4 or 8; the largest the device has, up to this). 0: the environment's
+  // FIRE_SAMPLES if set, else by device: 1 on a CPU device (lavapipe, where 4x costs 2.6 times the frame,
+  // perf/RESULTS.md), 4 on a GPU.
+  uint32_t samples = 0;
+  // The colour format drawn in: the window's swapchain format for the present path (R8G8B8A8_SRGB or
+  // B8G8R8A8_SRGB; image() returns RGBA either way).
+  VkFormat color_format = VK_FORMAT_R8G8B8A8_SRGB;
 };
 
 // Colours of the scene, sRGB 0..255: shared with the tests, which find the curves and the background by them.
 struct Palette {
-  static constexpr uint8_t background_top[3] = {72, 76, 82};
-  static constexpr uint8_t background_bottom[3] = {30, 32, 36};
+  static constexpr uint8_t background[3] = {46, 49, 54};
   static constexpr uint8_t curve[3] = {255, 140, 26};
   static constexpr uint8_t surface[3] = {196, 200, 206};
   static constexpr uint8_t provisional_surface[3] = {132, 196, 214};  // light teal: not settled yet
@@ -63,7 +76,7 @@ struct UploadStats {
   uint32_t edges = 0;              // edges whose points were copied
   uint32_t vertices = 0;           // network vertex markers copied
   uint32_t surface_vertices = 0;   // surface vertices copied
-  bool surface_topology = false;   // triangle indices copied
+  uint32_t surface_quads = 0;      // surface quads whose triangle indices were copied
 };
 
 class Renderer {
@@ -90,10 +103,12 @@ class Renderer {
   // Draws one frame and waits for it; the result is then in image().
   Status draw(const Camera& camera, const DrawOptions& options = {});
   Image image() const;
-  // The present path (present.hpp): records the frame into `cmd` without submitting it. The resolved image,
-  // color_image(), is left in TRANSFER_SRC_OPTIMAL, its writes made visible to transfers.
-  void record(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options);
-  VkImage color_image() const { return resolve_.image; }
+  // The present path (present.hpp): records the frame into `cmd` without submitting it, drawn (or resolved)
+  // straight into `target`, an image of color_format() and width() x height() (a swapchain image: no copy of
+  // the frame on the way). `target` is left in COLOR_ATTACHMENT_OPTIMAL, written at COLOR_ATTACHMENT_OUTPUT.
+  void record(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options, VkImage target,
+              VkImageView target_view);
+  VkFormat color_format() const { return color_format_; }
   // New target size (a resized window); waits for the device first. Uploaded data is kept.
   Status resize(uint32_t width, uint32_t height);
 
@@ -114,7 +129,8 @@ class Renderer {
   };
 
  private:
-  explicit Renderer(Context& context, const RenderSettings& settings) : context_(context), settings_(settings) {}
+  explicit Renderer(Context& context, const RenderSettings& settings)
+      : context_(context), settings_(settings), color_format_(settings.color_format) {}
   Status init();
   Status create_targets();
   Status create_target(Target& target, VkFormat format, VkImageUsageFlags usage, VkSampleCountFlagBits samples,
@@ -128,6 +144,10 @@ class Renderer {
   Status upload_points(const Mesh& network);
   Status upload_vertices(const Mesh& network);
   Status upload_surface(const SurfaceLevels& surface);
+  Status layout_surface(const SurfaceLevels& surface);
+  // Makes the surface buffers hold the blocks; where one had to grow, every block is copied again.
+  Status reserve_surface(std::vector<uint8_t>& placed);
+  void write_surface_vertices(const SurfaceLevels& surface, ChangedRange changed);
 
   Context& context_;
   RenderSettings settings_;
@@ -140,7 +160,7 @@ class Renderer {
   VkCommandBuffer commands_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  VkPipeline background_ = VK_NULL_HANDLE, surface_ = VK_NULL_HANDLE, reference_pipeline_ = VK_NULL_HANDLE,
+  VkPipeline surface_ = VK_NULL_HANDLE, reference_pipeline_ = VK_NULL_HANDLE,
              curves_ = VK_NULL_HANDLE, markers_ = VK_NULL_HANDLE, wireframe_ = VK_NULL_HANDLE,
              pen_face_ = VK_NULL_HANDLE;
 
@@ -157,12 +177,23 @@ class Renderer {
   std::vector<uint8_t> vertex_live_;
   std::vector<std::pair<uint32_t, uint32_t>> marker_draws_;  // runs of live vertex slots (first, count)
 
-  // Surface: interleaved float position and normal per vertex, 6 indices per quad.
+  // Surface: interleaved float position and normal per vertex, 6 indices per quad, in blocks per patch.
+  struct Block {
+    uint32_t key = kNone;
+    uint32_t first_vertex = 0, vertex_count = 0, first_quad = 0, quad_count = 0;  // where it lies in the buffers
+    std::vector<uint32_t> vertices;  // the surface's vertex held at each of the block's vertices
+    std::vector<uint32_t> quads;     // 4 block vertices per quad: the patch's topology
+  };
   Buffer surface_vertices_, surface_indices_;
+  std::vector<glm::vec3> surface_vertex_copy_;  // what surface_vertices_ holds, up to surface_vertex_end_
+  std::vector<uint32_t> surface_index_copy_;    // what surface_indices_ holds, up to 6 * surface_quad_end_
+  std::vector<Block> blocks_, free_blocks_;     // free blocks hold their ranges only
+  uint32_t surface_vertex_end_ = 0, surface_quad_end_ = 0;  // the buffers' used extent
+  std::vector<uint32_t> block_vertex_;  // scratch: per surface vertex its block vertex, kNone outside the patch
+  std::vector<std::pair<uint32_t, uint32_t>> surface_draws_;  // (first index, index count), runs of blocks
   uint64_t surface_topology_ = 0;
   Frame surface_frame_ = 0;
   bool surface_seen_ = false;
-  uint32_t surface_index_count_ = 0;
   bool surface_settled_ = true;
 
   Buffer stroke_;

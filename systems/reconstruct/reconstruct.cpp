@@ -220,7 +220,10 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
     if (!net.face_alive(f)) continue;
     for (const VertexRef& r : c.faces[f].quads) {
       base.face_vertices.push_back(id(r, f));
-      if (base.face_vertices.size() % 4 == 0) base.face_offsets.push_back(static_cast<uint32_t>(base.face_vertices.size()));
+      if (base.face_vertices.size() % 4 == 0) {
+        base.face_offsets.push_back(static_cast<uint32_t>(base.face_vertices.size()));
+        base.face_source.push_back(f);
+      }
     }
   }
   // Drawn curves: the pieces of each network edge, between its vertices and split points.

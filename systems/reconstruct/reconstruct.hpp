@@ -56,6 +56,9 @@ struct BaseMesh {
   std::vector<Vec3> positions;
   std::vector<uint32_t> face_offsets{0};
   std::vector<uint32_t> face_vertices;
+  // Per base face, the slot of the network face it was made from; a network face's base faces are
+  // consecutive (the subdivide system groups the surface's quads into patches by it).
+  std::vector<uint32_t> face_source;
   std::vector<uint32_t> sharp_edges;  // vertex pairs along network edges marked sharp
   // fire: per vertex, 1 where the border is a corner of the surface (subdivide::BaseTopology::
   // border_corners); empty for thesis, whose border keeps Catmull-Clark's EdgeAndCorner rule.

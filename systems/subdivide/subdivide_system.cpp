@@ -1,5 +1,7 @@
 #include "systems/subdivide/subdivide_system.hpp"
 
+#include "engine/assert.hpp"
+
 namespace fire {
 
 void subdivide_system(const reconstruct::Options& options, const FrameTime& frame, reconstruct::SurfaceBuild& build,
@@ -25,6 +27,20 @@ void subdivide_system(const reconstruct::Options& options, const FrameTime& fram
   }
   surface.level = options.levels;
   surface.settled = true;
+  // Each base quad's descendants are 4^L consecutive last-level quads, in base face order, so a network
+  // face's quads are one range: its patch.
+  const std::vector<uint32_t>& source = build.state.base().face_source;
+  FIRE_ASSERT(!source.empty() && surface.quad_count() == source.size() << (2 * options.levels),
+              "the last level has 4^L quads per base face");
+  const uint32_t per_base_face = 1u << (2 * options.levels);
+  surface.patch_offsets.clear();
+  surface.patch_keys.clear();
+  for (uint32_t f = 0; f < source.size(); ++f)
+    if (f == 0 || source[f] != source[f - 1]) {
+      surface.patch_offsets.push_back(f * per_base_face);
+      surface.patch_keys.push_back(source[f]);
+    }
+  surface.patch_offsets.push_back(surface.quad_count());
 }
 
 }  // namespace fire

@@ -112,6 +112,18 @@ TEST_CASE("random edits through the frame: the settled surface equals a full reb
     REQUIRE(same_bytes(surface.positions, full->positions));
     REQUIRE(same_bytes(surface.normals, full->normals));
     REQUIRE(same_bytes(surface.quads, full->face_vertices));
+    // The quads grouped by network face (what the renderer keeps blocks by): one patch per live face, in
+    // slot order, an n-sided face's n base quads with 4^L quads each.
+    REQUIRE(surface.patch_keys.size() == net.face_count());
+    REQUIRE(surface.patch_offsets.size() == net.face_count() + 1);
+    CHECK(surface.patch_offsets.front() == 0);
+    CHECK(surface.patch_offsets.back() == surface.quad_count());
+    for (uint32_t p = 0; p < surface.patch_count(); ++p) {
+      const uint32_t f = surface.patch_keys[p];
+      REQUIRE(net.face_alive(f));
+      CHECK((p == 0 || surface.patch_keys[p - 1] < f));
+      CHECK(surface.patch_end(p) - surface.patch_begin(p) == 16 * net.face_loop(f).size());
+    }
   }
   INFO("applied " << applied << ", refused " << refused << ", faces recomputed " << faces_recomputed << " of a local bound " << faces_bound
                   << ", topology rebuilds " << topology_rebuilds << ", limit vertices evaluated " << limit_vertices);
