@@ -228,6 +228,7 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
       }
       case EventKind::Command: {
         EditRequest r{RequestKind::Edit, {}, ev.t_us, ev.line};
+        if (ev.command == CommandKind::Mark || ev.command == CommandKind::Register) break;  // the registration system's
         if (ev.command == CommandKind::Undo) r.kind = RequestKind::Undo;
         else if (ev.command == CommandKind::Redo) r.kind = RequestKind::Redo;
         else if (ev.command == CommandKind::Close) {

@@ -141,6 +141,9 @@ int run_replay(const ReplayOptions& o) {
   if (world->rig)
     for (const std::string& problem : describe_device_problems(world->triangulate))
       std::cerr << lines_of << ": device input: " << problem << "\n";
+  if (world->rig)
+    for (const std::string& line : describe_registration(world->registration))
+      std::cerr << lines_of << ": " << line << "\n";
   std::string problem = world->mesh.validate();
   if (!problem.empty()) {
     std::cerr << "fire replay: internal error, the replayed network is invalid: " << problem << "\n";

@@ -18,8 +18,11 @@ std::vector<SystemSpec> session_systems(World& w) {
   systems.push_back({"triangulate", {"frame_events", "rig"}, {"frame_events"}, {}, [&w] {
                        if (w.rig) triangulate_system(w.frame, *w.rig, w.triangulate, w.frame_events);
                      }});
-  systems.push_back({"sketch", {"frame_events", "sketch_settings"}, {"requests", "rejections", "pen_feedback"}, {"mesh", "snap"}, [&w] {
-                       sketch_system(w.frame_events, w.mesh, w.snap, w.sketch_settings, w.sketch, w.requests,
+  systems.push_back({"register", {"frame_events", "rig"}, {"object_events", "rejections"}, {}, [&w] {
+                       register_system(w.frame_events, w.rig.has_value(), w.registration, w.object_events, w.rejections);
+                     }});
+  systems.push_back({"sketch", {"object_events", "sketch_settings"}, {"requests", "rejections", "pen_feedback"}, {"mesh", "snap"}, [&w] {
+                       sketch_system(w.object_events, w.mesh, w.snap, w.sketch_settings, w.sketch, w.requests,
                                      w.rejections, w.pen_feedback);
                      }});
   systems.push_back({"split", {"requests"}, {"mesh", "rejections"}, {}, [&w] {
