@@ -102,6 +102,8 @@ int run_replay(const ReplayOptions& o) {
         return 1;
       }
       world->rig = *rig;
+      world->sketch_settings.vertex_snap = kTrackedVertexSnap;
+      world->sketch_settings.blend_reach = kTrackedBlendReach;
     } else if (has_device_reports(*log)) {
       std::cerr << "fire replay: " << o.log_path << " holds Wii Remote reports; give the rig they were drawn with: "
                 << "--rig RIG.json (from fire calibrate)\n";
