@@ -25,7 +25,6 @@ void touch_mark(const InputEvent& e, RegistrationState& s, std::vector<Rejection
       ++n;
     }
   if (n < kRestSamples) {
-    ++s.rejected;
     rejections.push_back({e.t_us, e.line, what + "the pen was seen " + std::to_string(n) + " time(s) in the " +
                                               std::to_string(kRestWindowUs / 1000) + " ms before the command; rest it on the mark (at least " +
                                               std::to_string(kRestSamples) + " samples)"});
@@ -36,7 +35,6 @@ void touch_mark(const InputEvent& e, RegistrationState& s, std::vector<Rejection
   for (const auto& [t, p] : s.recent)
     if (t > e.t_us - kRestWindowUs && t <= e.t_us) spread = std::max(spread, (p - mean).norm());
   if (spread > kRestSpread) {
-    ++s.rejected;
     rejections.push_back({e.t_us, e.line, what + "the pen moved " + mm(spread) + " from its mean while resting on the mark (at most " +
                                               mm(kRestSpread) + "); hold it still"});
     return;
@@ -48,7 +46,6 @@ void touch_mark(const InputEvent& e, RegistrationState& s, std::vector<Rejection
 
 void register_marks(const InputEvent& e, RegistrationState& s, std::vector<Rejection>& rejections) {
   auto reject = [&](const std::string& why) {
-    ++s.rejected;
     rejections.push_back({e.t_us, e.line, "register: " + why + "; the marks touched are kept"});
   };
   if (s.touched.size() < 3) {
@@ -93,8 +90,7 @@ void register_system(const std::vector<InputEvent>& frame_events, bool tracked, 
   for (const InputEvent& e : frame_events) {
     const bool registering = e.kind == EventKind::Command && (e.command == CommandKind::Mark || e.command == CommandKind::Register);
     if (registering && !tracked) {
-      ++s.rejected;
-      rejections.push_back({e.t_us, e.line, std::string(e.command == CommandKind::Mark ? "mark" : "register") +
+        rejections.push_back({e.t_us, e.line, std::string(e.command == CommandKind::Mark ? "mark" : "register") +
                                                 ": registration needs a tracked pen (a log of device reports, replayed with --rig)"});
     } else if (registering) {
       if (e.command == CommandKind::Mark)
@@ -109,9 +105,6 @@ void register_system(const std::vector<InputEvent>& frame_events, bool tracked, 
       s.recent.emplace_back(e.t_us, e.p);
       const int64_t oldest = e.t_us - kRestWindowUs;
       std::erase_if(s.recent, [&](const auto& r) { return r.first <= oldest; });
-      const bool repeated = s.stroke_open && s.held.size() != 1 && e.p == s.stroke_last;  // held[0] alone: the Down
-      s.stroke_last = e.p;
-      if (repeated) continue;
       if (!s.stroke_open || s.stroke_released) {
         out.push_back(e);
         out.back().p = mapped(s, e.p);
@@ -165,7 +158,6 @@ void RegistrationState::save(SnapshotWriter& out) const {
   out.put(recent);
   out.put(uint8_t(stroke_open));
   out.put(uint8_t(stroke_released));
-  out.put(stroke_last);
   out.put(uint64_t(held.size()));
   for (const InputEvent& e : held) {
     out.put(e.t_us);
@@ -180,7 +172,6 @@ void RegistrationState::save(SnapshotWriter& out) const {
     out.put(r.marks);
     out.put(r.residual);
   }
-  out.put(rejected);
   out.put(touches_dropped);
 }
 
@@ -206,7 +197,6 @@ bool RegistrationState::load(SnapshotReader& in) {
   in.get(recent);
   in.get(open);
   in.get(released);
-  in.get(stroke_last);
   stroke_open = open;
   stroke_released = released;
   in.get(n);
@@ -228,7 +218,6 @@ bool RegistrationState::load(SnapshotReader& in) {
     in.get(r.marks);
     in.get(r.residual);
   }
-  in.get(rejected);
   in.get(touches_dropped);
   if (has > 1 || open > 1 || released > 1) in.fail();
   return in.ok();

@@ -9,8 +9,7 @@
 // rejected in words and keeps the marks touched; a later registration (the object turned) replaces the
 // transform, and curves already drawn stay where they are. Before the first registration samples pass unchanged.
 // A touch is not a curve: a stroke is held back until the pen leaves kTouchRadius around its first sample, and
-// one that never does (the pen resting on a mark) is dropped. A sample equal to the one before it in the stroke
-// (a resting pen's filter settles on one value) is dropped: a curve's consecutive points differ.
+// one that never does (the pen resting on a mark) is dropped.
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -48,9 +47,8 @@ struct RegistrationState {
   // The stroke being drawn: held back (its Down and samples, rig frame) until the pen leaves the touch radius.
   bool stroke_open = false, stroke_released = false;
   std::vector<InputEvent> held;
-  Vec3 stroke_last = Vec3::Zero();  // the stroke's last sample (rig frame): a resting pen may repeat it exactly
   std::vector<Registration> done;  // every registration made, in order
-  uint32_t rejected = 0, touches_dropped = 0;
+  uint32_t touches_dropped = 0;
 
   void save(SnapshotWriter& out) const;
   bool load(SnapshotReader& in);  // false (and `in` failed) on a malformed record

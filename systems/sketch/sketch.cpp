@@ -208,6 +208,8 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
         EditRequest r{RequestKind::Edit, {}, ev.t_us, ev.line};
         r.command.points = std::move(state.stroke);
         state.stroke.clear();
+        // A resting pen's filter can repeat a sample exactly; a curve's consecutive points differ.
+        r.command.points.erase(std::unique(r.command.points.begin(), r.command.points.end()), r.command.points.end());
         if (r.command.points.size() < 2) {
           reject("the stroke has " + std::to_string(r.command.points.size()) + " pen sample(s); a curve needs at least 2");
           break;
@@ -228,7 +230,7 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           r.command.kind = gap <= end_snap ? EditKind::CloseBorder : EditKind::AppendBorder;
           r.command.snap_distance = end_snap;
           blend_ends(r.command.points, mesh.vertices.position[last],
-                     r.command.kind == EditKind::CloseBorder ? first_position : r.command.points.back(), settings.blend_reach);
+                     r.command.kind == EditKind::CloseBorder ? first_position : r.command.points.back(), 1);
         } else {
           Snap s = snap_to_face(mesh, snap, r.command.points.front(), r.command.points.back(), both_snap);
           if (s.face == kNone) {

@@ -24,8 +24,8 @@ struct SketchSettings {
   // polyline point always). A tracked pen never ends exactly on a vertex; a new vertex a millimetre from an old
   // one leaves a sliver of an edge and faces with extra sides.
   double vertex_snap = 0;
-  // A snapped stroke's end corrections spread over this fraction of the stroke from each end (1: the whole
-  // stroke). Under 1 the middle stays where it was drawn, so a curve snapped onto curves that were themselves
+  // A split's end corrections spread over this fraction of the stroke from each end (1: the whole
+  // stroke; a border's always do). Under 1 the middle stays where it was drawn, so a curve snapped onto curves that were themselves
   // moved does not inherit their moves: over a drawing of many curves drawn onto each other they add up.
   double blend_reach = 1;
 };
