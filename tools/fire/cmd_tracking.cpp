@@ -157,6 +157,7 @@ std::string obj_text(const std::vector<Vec3>& positions, const PolygonMesh& mesh
 
 int run_simulate_drawing(const SimulateArgs& a) {
   const std::string command = "simulate drawing";
+  if (!std::isfinite(a.drawing.height_m) || !(a.drawing.height_m > 0)) return fail(command, "--height must be a positive number of metres");
   Result<PolygonMesh> mesh = read_obj(a.mesh_path);
   if (!mesh) return fail(command, mesh.error() + " (choose the object with --mesh)");
   Result<std::vector<Vec3>> placed = object_frame(mesh->positions, a.drawing.height_m);
