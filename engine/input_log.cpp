@@ -110,14 +110,25 @@ Result<InputLog> parse_input_log(std::string_view text, const std::string& sourc
       if (f.size() != 2) return fail(line_no, std::string(kind) + " takes no fields");
     } else if (kind == "cmd") {
       e.kind = EventKind::Command;
-      if (f.size() < 3) return fail(line_no, "cmd needs a command: undo, redo, close, delete x y z or sharp x y z");
+      if (f.size() < 3)
+        return fail(line_no, "cmd needs a command: undo, redo, close, delete x y z, sharp x y z, mark N x y z or register");
       std::string_view c = f[2];
-      if (c == "undo" || c == "redo" || c == "close") {
-        e.command = c == "undo" ? CommandKind::Undo : c == "redo" ? CommandKind::Redo : CommandKind::Close;
+      if (c == "undo" || c == "redo" || c == "close" || c == "register") {
+        e.command = c == "undo"   ? CommandKind::Undo
+                    : c == "redo" ? CommandKind::Redo
+                    : c == "close" ? CommandKind::Close
+                                   : CommandKind::Register;
         if (f.size() != 3) return fail(line_no, "cmd " + std::string(c) + " takes no fields");
       } else if (c == "delete" || c == "sharp") {
         e.command = c == "delete" ? CommandKind::Delete : CommandKind::Sharp;
         if (!parse_point(f, 3, e.p)) return fail(line_no, "cmd " + std::string(c) + " needs three numbers x y z");
+      } else if (c == "mark") {
+        e.command = CommandKind::Mark;
+        int64_t mark = -1;
+        if (f.size() != 7 || !parse_int64(f[3], mark) || mark < 0 || mark > int64_t(UINT32_MAX) || !parse_point(f, 4, e.p) ||
+            !is_finite(e.p))
+          return fail(line_no, "cmd mark needs the mark's number (0 or more) and its finite object coordinates x y z");
+        e.mark = uint32_t(mark);
       } else {
         return fail(line_no, "unknown command '" + std::string(c) + "'");
       }
@@ -186,6 +197,8 @@ std::string format_event(const InputEvent& e) {
         case CommandKind::Close: s += "cmd close"; break;
         case CommandKind::Delete: s += "cmd delete " + point(e.p); break;
         case CommandKind::Sharp: s += "cmd sharp " + point(e.p); break;
+        case CommandKind::Mark: s += "cmd mark " + std::to_string(e.mark) + ' ' + point(e.p); break;
+        case CommandKind::Register: s += "cmd register"; break;
       }
       break;
     case EventKind::Hid: {

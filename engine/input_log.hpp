@@ -10,14 +10,15 @@
 namespace fire {
 
 enum class EventKind : uint8_t { Pen, Down, Up, Command, Hid, Truth, Meta };
-enum class CommandKind : uint8_t { Undo, Redo, Close, Delete, Sharp };
+enum class CommandKind : uint8_t { Undo, Redo, Close, Delete, Sharp, Mark, Register };
 
 struct InputEvent {
   int64_t t_us = 0;
   EventKind kind = EventKind::Pen;
-  Vec3 p = Vec3::Zero();              // Pen sample; Delete and Sharp commands' pick point
+  Vec3 p = Vec3::Zero();              // Pen sample; Delete and Sharp commands' pick point; Mark: the mark in the object's frame
   double snap = 0;                    // Pen: snap radius for a stroke end at this sample; 0: the session's setting
   CommandKind command = CommandKind::Undo;
+  uint32_t mark = 0;                  // Mark command: the mark's number
   int device = 0;                     // Hid
   bool hid_ok = true;                 // Hid: false when the hex was garbled (bytes then empty)
   std::vector<uint8_t> bytes;         // Hid: the report, report id first

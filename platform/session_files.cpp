@@ -6,7 +6,8 @@
 
 namespace fire {
 
-Result<SessionWriter> SessionWriter::create(const std::string& dir, std::string_view settings_json, std::string_view rig_json) {
+Result<SessionWriter> SessionWriter::create(const std::string& dir, std::string_view settings_json, std::string_view rig_json,
+                                            std::string_view marks_json) {
   using R = Result<SessionWriter>;
   if (Status s = make_directory(dir); !s) return R::failure(s.error);
   auto names = list_directory(dir);
@@ -16,6 +17,8 @@ Result<SessionWriter> SessionWriter::create(const std::string& dir, std::string_
   if (Status s = write_file_durable(paths.settings(), settings_json); !s) return R::failure(s.error);
   if (!rig_json.empty())
     if (Status s = write_file_durable(paths.rig(), rig_json); !s) return R::failure(s.error);
+  if (!marks_json.empty())
+    if (Status s = write_file_durable(paths.marks(), marks_json); !s) return R::failure(s.error);
   auto log = AppendFile::open(paths.log());
   if (!log) return R::failure(log.error());
   SessionWriter w(paths, std::move(*log));

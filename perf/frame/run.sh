@@ -24,7 +24,7 @@ echo "tracked drawing (fire simulate sketch --occlusion 0.5, replayed with --rig
 "$build/fire" replay "$tmp/tracked.log" --rig "$tmp/rig.json" --timings
 
 # Each system's function as callgrind names it (the snap system is the index's sync).
-systems=(input_system triangulate_system sketch_system split_system refine_system subdivide_system SnapIndex::sync)
+systems=(input_system triangulate_system register_system sketch_system split_system refine_system subdivide_system SnapIndex::sync)
 echo
 echo "| drawing | system | instructions | D1 misses | LL misses | D1 misses per 1000 instructions |"
 echo "|---|---|---|---|---|---|"

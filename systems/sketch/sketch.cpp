@@ -9,20 +9,39 @@ namespace fire {
 
 namespace {
 
-// Moves a stroke so that it starts at `start` and ends at `end`, spreading each end's correction along the
-// stroke by arc length: snapping then bends the whole curve a little instead of kinking its last sample,
-// and a surface that passes through the curve shows no fold there.
-void blend_ends(std::vector<Vec3>& stroke, const Vec3& start, const Vec3& end) {
+// Moves a stroke so that it starts at `start` and ends at `end`, spreading each end's correction by arc length
+// over the fraction `reach` of the stroke next to that end: snapping bends the curve a little instead of kinking
+// its last sample, and a surface that passes through the curve shows no fold there. With a reach under 1 the
+// stroke's middle stays where the pen drew it (SketchSettings::blend_reach).
+void blend_ends(std::vector<Vec3>& stroke, const Vec3& start, const Vec3& end, double reach) {
   std::vector<double> arc(stroke.size(), 0.0);
   for (size_t i = 1; i < stroke.size(); ++i) arc[i] = arc[i - 1] + (stroke[i] - stroke[i - 1]).norm();
   const double total = arc.back();
   const Vec3 d0 = start - stroke.front(), d1 = end - stroke.back();
   for (size_t i = 0; i < stroke.size(); ++i) {
     const double t = total > 0 ? arc[i] / total : double(i) / double(stroke.size() - 1);
-    stroke[i] += (1.0 - t) * d0 + t * d1;
+    const double w0 = reach >= 1 ? 1.0 - t : std::max(0.0, 1.0 - t / reach);
+    const double w1 = reach >= 1 ? t : std::max(0.0, 1.0 - (1.0 - t) / reach);
+    stroke[i] += w0 * d0 + w1 * d1;
   }
   stroke.front() = start;
   stroke.back() = end;
+}
+
+// The vertex of `face` nearest to p if it lies within `radius`, as a curve end; else `end` as it was.
+CurveEnd at_vertex(const Mesh& mesh, uint32_t face, const CurveEnd& end, const Vec3& p, double radius) {
+  CurveEnd best = end;
+  double nearest = radius;
+  for (uint32_t oriented : mesh.face_loop(face)) {
+    const uint32_t e = edge_of(oriented);
+    const std::span<const Vec3> line = mesh.polyline(e);
+    for (uint32_t k : {uint32_t(0), uint32_t(line.size() - 1)})
+      if (const double d = (line[k] - p).norm(); d < nearest) {
+        nearest = d;
+        best = {e, k};
+      }
+  }
+  return best;
 }
 
 bool border_open(const Mesh& m) { return m.edge_count() > 0 && m.face_count() == 0; }
@@ -189,6 +208,8 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
         EditRequest r{RequestKind::Edit, {}, ev.t_us, ev.line};
         r.command.points = std::move(state.stroke);
         state.stroke.clear();
+        // A resting pen's filter can repeat a sample exactly; a curve's consecutive points differ.
+        r.command.points.erase(std::unique(r.command.points.begin(), r.command.points.end()), r.command.points.end());
         if (r.command.points.size() < 2) {
           reject("the stroke has " + std::to_string(r.command.points.size()) + " pen sample(s); a curve needs at least 2");
           break;
@@ -209,7 +230,7 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           r.command.kind = gap <= end_snap ? EditKind::CloseBorder : EditKind::AppendBorder;
           r.command.snap_distance = end_snap;
           blend_ends(r.command.points, mesh.vertices.position[last],
-                     r.command.kind == EditKind::CloseBorder ? first_position : r.command.points.back());
+                     r.command.kind == EditKind::CloseBorder ? first_position : r.command.points.back(), 1);
         } else {
           Snap s = snap_to_face(mesh, snap, r.command.points.front(), r.command.points.back(), both_snap);
           if (s.face == kNone) {
@@ -219,15 +240,17 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           }
           r.command.kind = EditKind::SplitFace;
           r.command.face = s.face;
-          r.command.start = s.start;
-          r.command.end = s.end;
-          blend_ends(r.command.points, mesh.polyline(s.start.edge)[s.start.point], mesh.polyline(s.end.edge)[s.end.point]);
+          r.command.start = at_vertex(mesh, s.face, s.start, r.command.points.front(), settings.vertex_snap);
+          r.command.end = at_vertex(mesh, s.face, s.end, r.command.points.back(), settings.vertex_snap);
+          blend_ends(r.command.points, mesh.polyline(r.command.start.edge)[r.command.start.point],
+                     mesh.polyline(r.command.end.edge)[r.command.end.point], settings.blend_reach);
         }
         requests.push_back(std::move(r));
         break;
       }
       case EventKind::Command: {
         EditRequest r{RequestKind::Edit, {}, ev.t_us, ev.line};
+        if (ev.command == CommandKind::Mark || ev.command == CommandKind::Register) break;  // the registration system's
         if (ev.command == CommandKind::Undo) r.kind = RequestKind::Undo;
         else if (ev.command == CommandKind::Redo) r.kind = RequestKind::Redo;
         else if (ev.command == CommandKind::Close) {

@@ -20,7 +20,20 @@ struct SketchSettings {
   double snap_distance = 0.01;  // how far a stroke end may be from the polyline it snaps to (model units),
                                 // unless the end's pen sample carries its own radius (InputEvent::snap)
   uint32_t close_samples = 16;  // points on the straight edge made by `cmd close`
+  // A split's end within this distance of one of its face's vertices lands on that vertex (0: off, the nearest
+  // polyline point always). A tracked pen never ends exactly on a vertex; a new vertex a millimetre from an old
+  // one leaves a sliver of an edge and faces with extra sides.
+  double vertex_snap = 0;
+  // A split's end corrections spread over this fraction of the stroke from each end (1: the whole
+  // stroke; a border's always do). Under 1 the middle stays where it was drawn, so a curve snapped onto curves that were themselves
+  // moved does not inherit their moves: over a drawing of many curves drawn onto each other they add up.
+  double blend_reach = 1;
 };
+
+// For a pen tracked by the rig: vertex_snap (metres), a few times the tracked pen's error at rest, and
+// blend_reach. Measured on the simulated drawing in perf/RESULTS.md.
+inline constexpr double kTrackedVertexSnap = 0.003;
+inline constexpr double kTrackedBlendReach = 1.0 / 3;
 
 struct SketchState {
   bool pen_down = false;

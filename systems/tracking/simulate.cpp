@@ -37,7 +37,7 @@ class Random {
 
 // Each scenario draws from its own streams, so a wand and a sketch session with the same seed
 // share the rig (drawn from rig_seed) but no noise.
-enum Scenario : uint64_t { kWandScenario = 1, kSketchScenario = 2 };
+enum Scenario : uint64_t { kWandScenario = 1, kSketchScenario = 2, kDrawingScenario = 3 };
 enum Stream : uint64_t { kRigStream, kClockStream, kStrayStream, kMotionStream, kNoiseStream0, kNoiseStream1,
                          kTimingStream0, kTimingStream1, kOcclusionStream0, kOcclusionStream1, kBurstStream };
 uint64_t stream_of(Scenario scenario, Stream s) { return 64 * scenario + s; }
@@ -223,10 +223,13 @@ std::string rig_options_text(const RigOptions& o) {
          " burst=" + format_double(o.burst);
 }
 
+// Whether the object (or nothing, when empty) hides a light from a camera's centre at time t.
+using Occluded = std::function<bool(double t_s, const Vec3& light, const Vec3& camera_centre)>;
+
 // Runs both cameras over [0, duration) and writes the session: header facts, then every report
-// in host arrival order, each followed by its truth.
+// in host arrival order, each followed by its truth, with `commands` (sorted by time) among them.
 SimulatedSession run_session(const RigOptions& o, Scenario scenario, const SimulatedRig& rig, double duration_s, const Scene& scene,
-                             const Triangles& occluders, std::vector<InputEvent> header) {
+                             const Occluded& occluded, std::vector<InputEvent> header, const std::vector<InputEvent>& commands = {}) {
   SimulatedSession session;
   SimulationStats& stats = session.stats;
   stats.duration_s = duration_s;
@@ -278,7 +281,7 @@ SimulatedSession run_session(const RigOptions& o, Scenario scenario, const Simul
         const Vec3& X = sample.lights[i];
         if ((cam.R * X + cam.t).z() <= 0) continue;
         ++stats.led_images;
-        if (inside(hand, exposure) || (!occluders.empty() && segment_blocked(occluders, X, centre))) {
+        if (inside(hand, exposure) || (occluded && occluded(exposure, X, centre))) {
           ++stats.occluded;
           continue;
         }
@@ -343,7 +346,9 @@ SimulatedSession run_session(const RigOptions& o, Scenario scenario, const Simul
   });
   session.events = std::move(header);
   session.events.reserve(session.events.size() + 2 * reports.size());
+  auto command = commands.begin();
   for (PendingReport& r : reports) {
+    for (; command != commands.end() && command->t_us < r.t_us; ++command) session.events.push_back(*command);
     InputEvent hid;
     hid.t_us = r.t_us;
     hid.kind = EventKind::Hid;
@@ -354,6 +359,7 @@ SimulatedSession run_session(const RigOptions& o, Scenario scenario, const Simul
     values.insert(values.end(), r.scene.truth_values.begin(), r.scene.truth_values.end());
     add_truth(session.events, r.t_us, r.scene.truth_name, std::move(values));
   }
+  session.events.insert(session.events.end(), command, commands.end());
   return session;
 }
 
@@ -670,9 +676,504 @@ Result<SimulatedSession> simulate_sketch(const RigOptions& o, const SketchOption
   add_meta(header, "mesh", sk.mesh_name + " height_m=" + format_double(sk.height_m));
   add_meta(header, "sketch", "strokes=" + std::to_string(strokes.size()) + " speed_m_s=" + format_double(sk.speed_m_s) +
                                  " hold_s=" + format_double(sk.hold_s));
-  Result<SimulatedSession> session = run_session(o, kSketchScenario, *rig, duration, scene, placed->triangles, std::move(header));
+  const Occluded occluded = [&](double, const Vec3& light, const Vec3& centre) {
+    return segment_blocked(placed->triangles, light, centre);
+  };
+  Result<SimulatedSession> session = run_session(o, kSketchScenario, *rig, duration, scene, occluded, std::move(header));
   if (session) session->stats.strokes = static_cast<int>(strokes.size());
   return session;
+}
+
+Result<std::vector<Vec3>> object_frame(std::span<const Vec3> positions, double height_m) {
+  using R = Result<std::vector<Vec3>>;
+  if (positions.empty()) return R::failure("the mesh has no vertices");
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Vec3& p : positions) {
+    if (!p.allFinite()) return R::failure("the mesh has a non-finite vertex");
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  if (!(hi.z() > lo.z())) return R::failure("the mesh is flat along z (its up axis)");
+  if (!(height_m > 0) || !std::isfinite(height_m)) return R::failure("the object height must be positive");
+  const double scale = height_m / (hi.z() - lo.z());
+  const Vec3 base(0.5 * (lo.x() + hi.x()), 0.5 * (lo.y() + hi.y()), lo.z());
+  std::vector<Vec3> out;
+  out.reserve(positions.size());
+  for (const Vec3& p : positions) out.push_back((p - base) * scale);
+  return out;
+}
+
+namespace {
+
+// One way the object stands before the rig: world = R * object + t.
+struct Pose {
+  Eigen::Matrix3d R;
+  Vec3 t;
+  Triangles triangles;  // the control mesh, placed
+  Vec3 operator()(const Vec3& object) const { return R * object + t; }
+};
+
+// A light on the limit surface lies inside the control mesh wherever the surface is convex: the object hides
+// it only beyond this distance toward the camera.
+constexpr double kSurfaceClearance = 0.006;
+constexpr double kImageMargin = 16;  // pixels: a blob this close to the image's edge may leave it
+
+bool hidden(const Pose& pose, const Vec3& light, const Vec3& centre) {
+  const Vec3 u = (centre - light).normalized();
+  return segment_blocked(pose.triangles, light + kSurfaceClearance * u, centre);
+}
+
+bool seen_by_both(const SimulatedRig& rig, const Pose& pose, const Vec3& object_point) {
+  const Vec3 X = pose(object_point);
+  for (const Camera& c : rig.cameras) {
+    if ((c.R * X + c.t).z() <= 0) return false;
+    const Vec2 px = true_projection(c, X);
+    if (px.x() < kImageMargin || px.x() > kWiimoteWidth - 1 - kImageMargin || px.y() < kImageMargin ||
+        px.y() > kWiimoteHeight - 1 - kImageMargin)
+      return false;
+    if (hidden(pose, X, c.centre())) return false;
+  }
+  return true;
+}
+
+// A stroke along network curves: each curve walked from a to b (forward) or back.
+struct Leg {
+  uint32_t curve;
+  bool forward;
+};
+using Chain = std::vector<Leg>;
+
+std::vector<Vec3> chain_points(const DrawingNetwork& net, const Chain& chain) {
+  std::vector<Vec3> out;
+  for (const Leg& leg : chain) {
+    const std::vector<Vec3>& p = net.curves[leg.curve].points;
+    const size_t skip = out.empty() ? 0 : 1;  // the joint is the previous leg's last point
+    if (leg.forward)
+      out.insert(out.end(), p.begin() + static_cast<std::ptrdiff_t>(skip), p.end());
+    else
+      out.insert(out.end(), p.rbegin() + static_cast<std::ptrdiff_t>(skip), p.rend());
+  }
+  return out;
+}
+
+uint32_t chain_start(const DrawingNetwork& net, const Chain& c) {
+  const DrawingCurve& k = net.curves[c.front().curve];
+  return c.front().forward ? k.a : k.b;
+}
+uint32_t chain_end(const DrawingNetwork& net, const Chain& c) {
+  const DrawingCurve& k = net.curves[c.back().curve];
+  return c.back().forward ? k.b : k.a;
+}
+
+// What the person does, in order.
+struct Step {
+  enum Kind { Register, Stroke, Undo } kind;
+  int pose = 0;
+  std::vector<Vec3> points;  // Stroke: object frame
+};
+
+Status check_drawing(const DrawingOptions& d, const MeshView& object, const DrawingNetwork& net) {
+  const std::pair<const char*, double> named[] = {{"speed", d.speed_m_s}, {"hold", d.hold_s}, {"mark hold", d.mark_hold_s},
+                                                   {"tilt", d.tilt_deg}, {"height", d.height_m}};
+  for (const auto& [name, value] : named)
+    if (!std::isfinite(value)) return Status::failure(std::string("the ") + name + " must be a finite number");
+  if (!(d.speed_m_s > 0.01 && d.speed_m_s <= 5)) return Status::failure("pen speed must be within (0.01, 5] m/s");
+  if (!(d.hold_s >= 0 && d.hold_s <= 10)) return Status::failure("hold must be within [0, 10] s");
+  if (!(d.mark_hold_s >= 0.8 && d.mark_hold_s <= 10))
+    return Status::failure("mark hold must be within [0.8, 10] s (registration averages the pen's last 0.5 s on a mark)");
+  if (!(std::abs(d.tilt_deg) <= 60)) return Status::failure("tilt must be within [-60, 60] degrees");
+  if (d.turns < 1 || d.turns > 36) return Status::failure("turns must be within 1..36");
+  if (d.undo_after < 0 || d.max_strokes < 0) return Status::failure("undo-after and max-strokes must not be negative");
+  if (object.positions.empty() || object.face_offsets.size() < 2) return Status::failure("the object has no faces");
+  if (net.curves.empty()) return Status::failure("the network has no curves");
+  for (size_t k = 0; k < net.curves.size(); ++k) {
+    const DrawingCurve& c = net.curves[k];
+    if (c.a >= net.vertices.size() || c.b >= net.vertices.size() || c.a == c.b || c.points.size() < 2)
+      return Status::failure("network curve " + std::to_string(k) + " is malformed (vertices out of range, a loop or fewer than 2 points)");
+    for (const Vec3& p : c.points)
+      if (!p.allFinite()) return Status::failure("network curve " + std::to_string(k) + " has a non-finite point");
+  }
+  return Status::success();
+}
+
+// The border as strokes, in cycle order starting at `first`: runs between the border's corners (vertices
+// where only two curves meet), each curve a stroke of its own when there are fewer than 3 corners.
+Result<std::vector<Chain>> border_strokes(const DrawingNetwork& net, const std::vector<std::vector<uint32_t>>& at) {
+  using R = Result<std::vector<Chain>>;
+  std::vector<uint32_t> border;
+  for (uint32_t k = 0; k < net.curves.size(); ++k)
+    if (net.curves[k].border) border.push_back(k);
+  if (border.size() < 2) return R::failure("the network has no border to draw first");
+  Chain cycle{{border[0], true}};
+  std::vector<char> used(net.curves.size(), 0);
+  used[border[0]] = 1;
+  for (;;) {
+    const uint32_t v = chain_end(net, cycle);
+    if (v == chain_start(net, cycle)) break;
+    std::optional<Leg> next;
+    for (uint32_t k : at[v])
+      if (net.curves[k].border && !used[k]) next = Leg{k, net.curves[k].a == v};
+    if (!next) return R::failure("the network's border is not one closed loop");
+    used[next->curve] = 1;
+    cycle.push_back(*next);
+  }
+  if (cycle.size() != border.size()) return R::failure("the network's border is more than one loop");
+  auto corner = [&](const Leg& leg) { return at[leg.forward ? net.curves[leg.curve].a : net.curves[leg.curve].b].size() == 2; };
+  const size_t corners = static_cast<size_t>(std::count_if(cycle.begin(), cycle.end(), corner));
+  // Start the cycle at a corner.
+  if (corners >= 3) std::rotate(cycle.begin(), std::find_if(cycle.begin(), cycle.end(), corner), cycle.end());
+  std::vector<Chain> strokes;
+  for (const Leg& leg : cycle) {
+    if (strokes.empty() || corners < 3 || corner(leg)) strokes.emplace_back();
+    strokes.back().push_back(leg);
+  }
+  return strokes;
+}
+
+Chain reversed(const DrawingNetwork&, const Chain& c) {
+  Chain r;
+  for (auto it = c.rbegin(); it != c.rend(); ++it) r.push_back({it->curve, !it->forward});
+  return r;
+}
+
+}  // namespace
+
+Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOptions& d, const MeshView& object,
+                                          const DrawingNetwork& net) {
+  using R = Result<SimulatedDrawing>;
+  Result<SimulatedRig> rig = make_simulated_rig(o);
+  if (!rig) return R::failure(rig.error());
+  if (Status s = check_drawing(d, object, net); !s) return R::failure(s.error);
+
+  // The object's control mesh as triangles, and its poses: standing (+z up is the world's -y), turned by
+  // 360/turns degrees about its up axis, leaning its top toward the cameras, its middle where they converge.
+  Triangles triangles;
+  double top = 0;
+  for (const Vec3& p : object.positions) top = std::max(top, p.z());
+  for (size_t f = 0; f + 1 < object.face_offsets.size(); ++f) {
+    const uint32_t first = object.face_offsets[f], last = object.face_offsets[f + 1];
+    if (last < first + 3 || last > object.face_vertices.size()) return R::failure("face " + std::to_string(f) + " is malformed");
+    for (uint32_t k = first; k < last; ++k)
+      if (object.face_vertices[k] >= object.positions.size()) return R::failure("face " + std::to_string(f) + " uses a vertex out of range");
+    for (uint32_t k = first + 1; k + 1 < last; ++k)
+      triangles.push_back({object.positions[object.face_vertices[first]], object.positions[object.face_vertices[k]],
+                           object.positions[object.face_vertices[k + 1]]});
+  }
+  Eigen::Matrix3d standing;
+  standing << 1, 0, 0, 0, 0, -1, 0, 1, 0;
+  const Eigen::Matrix3d lean = Eigen::AngleAxisd(d.tilt_deg * std::numbers::pi / 180, Vec3::UnitX()).toRotationMatrix();
+  std::vector<Pose> poses;
+  for (int j = 0; j < d.turns; ++j) {
+    const double turn = 2 * std::numbers::pi * j / d.turns;
+    Pose pose;
+    pose.R = lean * standing * Eigen::AngleAxisd(-turn, Vec3::UnitZ()).toRotationMatrix();
+    pose.t = Vec3(0, 0, o.target_distance_m) - pose.R * Vec3(0, 0, 0.5 * top);
+    for (const auto& tri : triangles) pose.triangles.push_back({pose(tri[0]), pose(tri[1]), pose(tri[2])});
+    poses.push_back(std::move(pose));
+  }
+
+  // Six marks among the network's vertices: around the object every 60 degrees, at a fifth and at half its height.
+  constexpr int kMarks = 6;
+  std::vector<uint32_t> mark_vertex;
+  for (int k = 0; k < kMarks; ++k) {
+    const double azimuth = 2 * k * std::numbers::pi / kMarks, height = (k % 2 ? 0.5 : 0.2) * top;
+    double best = std::numeric_limits<double>::infinity();
+    uint32_t pick = 0;
+    for (uint32_t v = 0; v < net.vertices.size(); ++v) {
+      const Vec3& p = net.vertices[v];
+      if (std::find(mark_vertex.begin(), mark_vertex.end(), v) != mark_vertex.end() || std::hypot(p.x(), p.y()) < 1e-6) continue;
+      double off = std::abs(std::remainder(std::atan2(p.x(), -p.y()) - azimuth, 2 * std::numbers::pi));
+      off += 3 * std::abs(p.z() - height) / top;
+      if (off < best) best = off, pick = v;
+    }
+    mark_vertex.push_back(pick);
+  }
+  std::vector<std::vector<uint32_t>> marks_seen(poses.size());
+  for (size_t j = 0; j < poses.size(); ++j)
+    for (uint32_t m = 0; m < mark_vertex.size(); ++m)
+      if (seen_by_both(*rig, poses[j], net.vertices[mark_vertex[m]])) marks_seen[j].push_back(m);
+
+  // Which curves each pose shows whole to both cameras (on a pose with at least 3 marks to register on).
+  std::vector<std::vector<char>> shows(poses.size(), std::vector<char>(net.curves.size(), 0));
+  for (size_t j = 0; j < poses.size(); ++j)
+    if (marks_seen[j].size() >= 3)
+      for (size_t k = 0; k < net.curves.size(); ++k)
+        shows[j][k] = std::all_of(net.curves[k].points.begin(), net.curves[k].points.end(),
+                                  [&](const Vec3& p) { return seen_by_both(*rig, poses[j], p); });
+  auto shown = [&](int pose, const Chain& c) {
+    return std::all_of(c.begin(), c.end(), [&](const Leg& l) { return shows[static_cast<size_t>(pose)][l.curve] != 0; });
+  };
+  // Poses nearest the current one first.
+  auto pose_order = [&](int current) {
+    std::vector<int> order{current};
+    for (int step = 1; step <= d.turns / 2; ++step)
+      for (int j : {(current + step) % d.turns, (current - step + d.turns) % d.turns})
+        if (std::find(order.begin(), order.end(), j) == order.end()) order.push_back(j);
+    return order;
+  };
+
+  std::vector<std::vector<uint32_t>> at(net.vertices.size());
+  for (uint32_t k = 0; k < net.curves.size(); ++k) {
+    at[net.curves[k].a].push_back(k);
+    at[net.curves[k].b].push_back(k);
+  }
+  Result<std::vector<Chain>> border = border_strokes(net, at);
+  if (!border) return R::failure(border.error());
+
+  // The border: the start and direction that need the fewest turns of the object.
+  std::vector<Step> plan;
+  {
+    std::optional<std::pair<size_t, std::vector<int>>> best;  // turns, pose per stroke
+    std::vector<Chain> best_strokes;
+    for (int dir = 0; dir < 2; ++dir)
+      for (size_t s = 0; s < border->size(); ++s) {
+        std::vector<Chain> strokes;
+        for (size_t k = 0; k < border->size(); ++k) {
+          const size_t i = dir == 0 ? (s + k) % border->size() : (s + border->size() - k) % border->size();
+          strokes.push_back(dir == 0 ? (*border)[i] : reversed(net, (*border)[i]));
+        }
+        std::vector<int> pose_of;
+        size_t changes = 0;
+        for (const Chain& c : strokes) {
+          std::optional<int> pick;
+          for (int j : pose_order(pose_of.empty() ? 0 : pose_of.back()))
+            if (shown(j, c)) {
+              pick = j;
+              break;
+            }
+          if (!pick) break;
+          if (!pose_of.empty() && *pick != pose_of.back()) ++changes;
+          pose_of.push_back(*pick);
+        }
+        if (pose_of.size() == strokes.size() && (!best || changes < best->first)) {
+          best.emplace(changes, pose_of);
+          best_strokes = strokes;
+        }
+      }
+    if (!best) return R::failure("part of the network's border is seen whole by both cameras in no pose (try another --tilt or --turns)");
+    for (size_t k = 0; k < best_strokes.size(); ++k) {
+      if (k == 0 || best->second[k] != best->second[k - 1]) plan.push_back({Step::Register, best->second[k], {}});
+      plan.push_back({Step::Stroke, best->second[k], chain_points(net, best_strokes[k])});
+    }
+  }
+
+  // The splits: an ear decomposition. Every vertex on a drawn curve is drawn; stroke ends are the mesh's vertices.
+  std::vector<char> curve_drawn(net.curves.size(), 0), drawn(net.vertices.size(), 0), end_vertex(net.vertices.size(), 0);
+  for (const Chain& c : *border)
+    for (const Leg& l : c) {
+      curve_drawn[l.curve] = 1;
+      drawn[net.curves[l.curve].a] = drawn[net.curves[l.curve].b] = 1;
+    }
+  for (const Chain& c : *border) end_vertex[chain_start(net, c)] = 1;
+  // Whether a and b lie on one edge of the sketch's mesh (a chain of drawn curves between stroke ends): the
+  // faces on both sides of it would hold both ends of a stroke between them, and the sketch picks the wrong one
+  // as often as the right one.
+  auto same_edge = [&](uint32_t a, uint32_t b) {
+    std::vector<uint32_t> stack{a};
+    std::vector<char> seen(net.vertices.size(), 0);
+    seen[a] = 1;
+    while (!stack.empty()) {
+      const uint32_t v = stack.back();
+      stack.pop_back();
+      if (v == b) return true;
+      if (v != a && end_vertex[v]) continue;
+      for (uint32_t k : at[v]) {
+        if (!curve_drawn[k]) continue;
+        const uint32_t w = net.curves[k].a == v ? net.curves[k].b : net.curves[k].a;
+        if (!seen[w]) seen[w] = 1, stack.push_back(w);
+      }
+    }
+    return false;
+  };
+  auto length = [&](const Chain& c) {
+    double sum = 0;
+    for (const Leg& l : c) {
+      const auto& p = net.curves[l.curve].points;
+      for (size_t i = 1; i < p.size(); ++i) sum += (p[i] - p[i - 1]).norm();
+    }
+    return sum;
+  };
+  constexpr size_t kMaxLegs = 4;
+  int pose = plan.back().pose, splits = 0;
+  for (;;) {
+    std::vector<std::pair<double, Chain>> candidates;  // (legs * 1e6 + length: fewest legs, then shortest)
+    for (uint32_t a = 0; a < net.vertices.size(); ++a) {
+      if (!drawn[a]) continue;
+      std::vector<Chain> stack{{}};
+      while (!stack.empty()) {
+        Chain c = std::move(stack.back());
+        stack.pop_back();
+        const uint32_t v = c.empty() ? a : chain_end(net, c);
+        for (uint32_t k : at[v]) {
+          if (curve_drawn[k] || std::any_of(c.begin(), c.end(), [&](const Leg& l) { return l.curve == k; })) continue;
+          Chain next = c;
+          next.push_back({k, net.curves[k].a == v});
+          const uint32_t w = chain_end(net, next);
+          if (drawn[w]) {
+            if (w != a) candidates.emplace_back(double(next.size()) * 1e6 + length(next), std::move(next));
+          } else if (next.size() < kMaxLegs) {
+            stack.push_back(std::move(next));
+          }
+        }
+      }
+    }
+    std::stable_sort(candidates.begin(), candidates.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    std::optional<std::pair<int, Chain>> pick;
+    for (int j : pose_order(pose)) {
+      for (const auto& [key, c] : candidates)
+        if (shown(j, c) && !same_edge(chain_start(net, c), chain_end(net, c))) {
+          pick.emplace(j, c);
+          break;
+        }
+      if (pick) break;
+    }
+    const auto strokes = std::count_if(plan.begin(), plan.end(), [](const Step& s) { return s.kind == Step::Stroke; });
+    if (!pick || (d.max_strokes > 0 && strokes >= d.max_strokes)) break;
+    if (pick->first != pose) plan.push_back({Step::Register, pick->first, {}});
+    pose = pick->first;
+    plan.push_back({Step::Stroke, pose, chain_points(net, pick->second)});
+    for (const Leg& l : pick->second) {
+      curve_drawn[l.curve] = 1;
+      drawn[net.curves[l.curve].a] = drawn[net.curves[l.curve].b] = 1;
+    }
+    end_vertex[chain_start(net, pick->second)] = end_vertex[chain_end(net, pick->second)] = 1;
+    if (++splits == d.undo_after) {
+      Step again = plan.back();
+      plan.push_back({Step::Undo, pose, {}});
+      plan.push_back(std::move(again));
+    }
+  }
+
+  // The timeline: where the pen is, lit or not, and when each command is logged.
+  constexpr double kAccel = 2.0;     // m/s^2, a hand drawing with care
+  constexpr double kTravel_s = 0.6;  // the pen lifted from one stroke or mark to the next: longer than a gap a stroke survives
+  constexpr double kTurn_s = 3.0;    // turning the object, the pen lifted
+  constexpr double kUndoWait_s = 1.0;  // after a stroke, before its undo: its pen up has reached the sketch
+  std::vector<Polyline> strokes;
+  std::vector<Segment> timeline;
+  std::vector<InputEvent> commands;
+  std::vector<std::pair<double, int>> pose_from{{0.0, plan.front().pose}};
+  DrawingStats stats;
+  stats.curves_total = net.curves.size();
+  stats.curves_drawn = static_cast<size_t>(std::count(curve_drawn.begin(), curve_drawn.end(), 1));
+  double t = 0.5;
+  Vec3 pen = poses[static_cast<size_t>(plan.front().pose)].t;
+  auto command = [&](double at, CommandKind kind, uint32_t mark = 0, const Vec3& p = Vec3::Zero()) {
+    InputEvent e;
+    e.t_us = std::llround(at * 1e6);
+    e.kind = EventKind::Command;
+    e.command = kind;
+    e.mark = mark;
+    e.p = p;
+    commands.push_back(std::move(e));
+  };
+  auto travel_to = [&](const Vec3& to, double seconds) {
+    timeline.push_back({Phase::Travel, t, t + seconds, -1, pen, to});
+    t += seconds;
+    pen = to;
+  };
+  auto hold = [&](double seconds) {
+    timeline.push_back({Phase::Hold, t, t + seconds, -1, pen, pen});
+    t += seconds;
+  };
+  bool first = true;
+  for (const Step& step : plan) {
+    const Pose& placed = poses[static_cast<size_t>(step.pose)];
+    switch (step.kind) {
+      case Step::Register:
+        if (!first) {
+          pose_from.emplace_back(t + 0.5 * kTurn_s, step.pose);
+          travel_to(pen, kTurn_s);
+        }
+        first = false;
+        for (uint32_t m : marks_seen[static_cast<size_t>(step.pose)]) {
+          const Vec3& mark = net.vertices[mark_vertex[m]];
+          travel_to(placed(mark), kTravel_s);
+          hold(d.mark_hold_s);
+          command(t - 0.2, CommandKind::Mark, m, mark);
+          ++stats.mark_touches;
+        }
+        travel_to(pen, 0.3);  // the pen lifted off the last mark
+        command(t, CommandKind::Register);
+        ++stats.registrations;
+        break;
+      case Step::Stroke: {
+        std::vector<Vec3> world;
+        for (const Vec3& p : step.points) world.push_back(placed(p));
+        Polyline path = make_polyline(std::move(world));
+        travel_to(path.points.front(), kTravel_s);
+        hold(d.hold_s);
+        const double move = SpeedProfile{path.arc.back(), d.speed_m_s, kAccel}.duration();
+        timeline.push_back({Phase::Move, t, t + move, static_cast<int>(strokes.size()), pen, path.points.back()});
+        t += move;
+        pen = path.points.back();
+        hold(d.hold_s * 2 / 3);
+        strokes.push_back(std::move(path));
+        ++stats.strokes;
+        break;
+      }
+      case Step::Undo:
+        travel_to(pen, kUndoWait_s);
+        command(t, CommandKind::Undo);
+        ++stats.undos;
+        break;
+    }
+  }
+  stats.border_strokes = static_cast<int>(border->size());
+  stats.split_strokes = stats.strokes - stats.border_strokes;
+  const double duration = t + 1.0;
+  if (duration > 3600) return R::failure("the drawing would last more than an hour (" + std::to_string(duration) + " s)");
+  timeline.push_back({Phase::Travel, t, std::numeric_limits<double>::infinity(), -1, pen, pen});
+
+  auto pose_at = [&](double time) -> const Pose& {
+    const auto it = std::upper_bound(pose_from.begin(), pose_from.end(), time,
+                                     [](double v, const std::pair<double, int>& p) { return v < p.first; });
+    return poses[static_cast<size_t>(std::prev(it)->second)];
+  };
+  Scene scene = [&](double time) {
+    const auto it = std::upper_bound(timeline.begin(), timeline.end(), time,
+                                     [](double v, const Segment& s) { return v < s.begin; });
+    const Segment& seg = *(it == timeline.begin() ? it : it - 1);
+    Vec3 p = seg.from;
+    bool lit = false;
+    double speed = 0, still = 0;
+    switch (seg.phase) {
+      case Phase::Travel: {
+        const double len = seg.end - seg.begin;
+        const double u = std::isfinite(len) && len > 0 ? std::clamp((time - seg.begin) / len, 0.0, 1.0) : 0.0;
+        p = seg.from + u * (seg.to - seg.from);
+        break;
+      }
+      case Phase::Hold:
+        lit = true;
+        still = time - seg.begin;
+        break;
+      case Phase::Move: {
+        const Polyline& path = strokes[static_cast<size_t>(seg.stroke)];
+        const auto [s, v] = SpeedProfile{path.arc.back(), d.speed_m_s, kAccel}.at(time - seg.begin);
+        p = path.at(s);
+        lit = true;
+        speed = v;
+        break;
+      }
+    }
+    SceneSample out{{}, "pen", {p.x(), p.y(), p.z(), lit ? 1.0 : 0.0, speed, still}};
+    if (lit) out.lights.push_back(p);
+    return out;
+  };
+  const Occluded occluded = [&](double time, const Vec3& light, const Vec3& centre) { return hidden(pose_at(time), light, centre); };
+  std::vector<InputEvent> header = common_header("drawing", o);
+  add_meta(header, "mesh", d.mesh_name + " height_m=" + format_double(d.height_m));
+  add_meta(header, "drawing", "strokes=" + std::to_string(stats.strokes) + " undos=" + std::to_string(stats.undos) +
+                                  " registrations=" + std::to_string(stats.registrations) + " curves=" +
+                                  std::to_string(stats.curves_drawn) + "/" + std::to_string(stats.curves_total) +
+                                  " speed_m_s=" + format_double(d.speed_m_s));
+  SimulatedDrawing out;
+  out.session = run_session(o, kDrawingScenario, *rig, duration, scene, occluded, std::move(header), commands);
+  out.session.stats.strokes = stats.strokes;
+  for (uint32_t v : mark_vertex) out.marks.push_back(net.vertices[v]);
+  out.drawing = stats;
+  return out;
 }
 
 SessionTruth read_session_truth(std::span<const InputEvent> events) {

@@ -91,6 +91,62 @@ struct SimulatedSession {
   SimulationStats stats;
 };
 
+// A drawing: a person registers the object on marks and draws a curve network on it (simulate_drawing).
+struct DrawingOptions {
+  double height_m = 0.2;      // the object is scaled to this height (its +z axis is up)
+  double speed_m_s = 0.2;     // pen speed along a stroke
+  double hold_s = 0.3;        // the lit pen rests this long where a stroke starts, and 2/3 of it where it ends
+  double mark_hold_s = 1.0;   // the pen rests this long on a mark; `cmd mark` is logged 0.2 s before it lifts
+  double tilt_deg = 10;       // the object leans its top this far toward the cameras
+  int turns = 6;              // poses the object can be turned to, evenly about its up axis
+  int undo_after = 3;         // the split stroke (1-based) undone by `cmd undo` and drawn again; 0: none
+  int max_strokes = 0;        // stop after this many strokes (0: the whole network)
+  std::string mesh_name = "pawn.obj";  // recorded in the log's meta
+};
+
+// The curve network to draw, in the object's frame: curve k joins vertices a and b through `points`
+// (points.front() at a, points.back() at b); border curves have one face.
+struct DrawingCurve {
+  uint32_t a = 0, b = 0;
+  std::vector<Vec3> points;
+  bool border = false;
+};
+struct DrawingNetwork {
+  std::vector<Vec3> vertices;
+  std::vector<DrawingCurve> curves;
+};
+
+struct DrawingStats {
+  int strokes = 0;          // pen strokes drawn on the object (the redrawn one included; touches of marks not)
+  int border_strokes = 0;
+  int split_strokes = 0;
+  int undos = 0;
+  int registrations = 0;    // one per pose the object was drawn in
+  int mark_touches = 0;
+  size_t curves_drawn = 0;  // of the network's curves
+  size_t curves_total = 0;
+};
+
+struct SimulatedDrawing {
+  SimulatedSession session;
+  std::vector<Vec3> marks;  // the object's marks, object frame
+  DrawingStats drawing;
+};
+
+// The object's own frame: `positions` scaled to `height_m` along +z, the centre of its base at the origin.
+Result<std::vector<Vec3>> object_frame(std::span<const Vec3> positions, double height_m);
+
+// `object` (control mesh, object frame, metres) placed before the rig in one of `turns` poses at a time.
+// Six marks are picked among the network's vertices, spread around the object at two heights. The person
+// touches the marks visible in the first pose (a `cmd mark` each, then `cmd register`), draws the border
+// stroke by stroke, then splitting curves, each a chain of the network's curves between two points already
+// drawn whose inner vertices are new (an ear decomposition, shortest chains first), in a face of its own; when
+// no stroke left is seen whole by both cameras in the current pose, the object is turned to the pose that
+// sees one and registered again on the marks visible there. One split stroke is undone and drawn again. The
+// LED sits at the pen's tip, on the limit surface, where the network's points are.
+Result<SimulatedDrawing> simulate_drawing(const RigOptions& rig, const DrawingOptions& drawing, const MeshView& object,
+                                          const DrawingNetwork& network);
+
 // The accuracy rig: the true cameras and the intrinsics calibration is told to start from.
 struct SimulatedRig {
   std::array<Camera, 2> cameras;

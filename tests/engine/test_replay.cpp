@@ -61,7 +61,7 @@ TEST_CASE("the demo log replays to the same pools every time", "[replay]") {
     REQUIRE(w->mesh.validate() == "");
     CHECK(w->mesh.face_count() == 14);
     CHECK(w->rejections.size() == 1);
-    CHECK(s.timings().size() == 7);  // input, triangulate, sketch, split, refine, subdivide, snap
+    CHECK(s.timings().size() == 8);  // input, triangulate, register, sketch, split, refine, subdivide, snap
     CHECK(w->surface.quad_count() > 0);
     CHECK(w->surface_build.problem == "");
     hash = world_hash(*w);
@@ -201,8 +201,8 @@ TEST_CASE("the demo log exercises every split case, an undo, a redo and a delete
     return end.point == 0 || end.point + 1 == count ? std::string("vertex") : std::string("edge");
   };
   std::vector<SystemSpec> systems = session_systems(*w);
-  REQUIRE(systems[2].name == "sketch");
-  systems.insert(systems.begin() + 3, SystemSpec{"probe", {"requests"}, {}, {"mesh"}, [&] {
+  REQUIRE(systems[3].name == "sketch");
+  systems.insert(systems.begin() + 4, SystemSpec{"probe", {"requests"}, {}, {"mesh"}, [&] {
                                                    for (const EditRequest& r : w->requests) {
                                                      if (r.kind == RequestKind::Undo) ++seen["undo"];
                                                      else if (r.kind == RequestKind::Redo) ++seen["redo"];
@@ -272,5 +272,5 @@ TEST_CASE("the session's frame order is accepted and the surface follows the net
   World w;
   auto s = Scheduler::build(session_systems(w), fake_clock);
   REQUIRE(s.ok());
-  CHECK_THAT(s->describe(), Catch::Contains("sketch: reads frame_events, sketch_settings; reads last frame's mesh"));
+  CHECK_THAT(s->describe(), Catch::Contains("sketch: reads object_events, sketch_settings; reads last frame's mesh"));
 }

@@ -103,7 +103,7 @@ std::optional<TrackingRig> rig_of(const std::string& rig_json, const std::vector
 uint64_t clean_hash(const std::vector<InputEvent>& events, const std::string& rig_json = "", World* out = nullptr) {
   auto w = std::make_unique<World>();
   w->log.events = events;
-  w->rig = rig_of(rig_json, events);
+  if (auto rig = rig_of(rig_json, events)) set_rig(*w, *rig);
   Scheduler s = make_scheduler(*w, fake_clock);
   replay_headless(*w, s);
   REQUIRE(w->mesh.validate() == "");
@@ -127,7 +127,7 @@ Status write_session(const InputLog& log, const fs::path& dir, const SessionWrit
                      const std::string& rig_json = "") {
   auto w = std::make_unique<World>();
   w->log = log;
-  w->rig = rig_of(rig_json, log.events);
+  if (auto rig = rig_of(rig_json, log.events)) set_rig(*w, *rig);
   Scheduler s = make_scheduler(*w, fake_clock);
   auto out = SessionWriter::create(dir.string(), settings_json(*w), rig_json);
   if (!out) return Status::failure(out.error());
@@ -195,7 +195,7 @@ SnapshotCoverage reopen_from_each_snapshot(const WrittenSession& s, uint64_t exp
     REQUIRE(contents.ok());
     World w;
     REQUIRE(apply_settings_json(contents->settings, "settings", w).ok());
-    w.rig = rig_of(s.rig, contents->log.log.events);
+    if (auto rig = rig_of(s.rig, contents->log.log.events)) set_rig(w, *rig);
     auto reader = SnapshotReader::open(bytes, "snapshot");
     REQUIRE(reader.ok());
     REQUIRE(load_world_snapshot(*reader, *contents, w).ok());

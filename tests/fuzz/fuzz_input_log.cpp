@@ -28,6 +28,7 @@ bool same_event(const InputEvent& a, const InputEvent& b) {
     case EventKind::Up:
       return true;
     case EventKind::Command:
+      if (a.command == CommandKind::Mark) return b.command == CommandKind::Mark && a.mark == b.mark && same_point(a.p, b.p);
       return a.command == b.command && ((a.command != CommandKind::Delete && a.command != CommandKind::Sharp) || same_point(a.p, b.p));
     case EventKind::Hid:
       return a.device == b.device && a.hid_ok == b.hid_ok && a.bytes == b.bytes;

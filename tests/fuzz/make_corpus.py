@@ -44,7 +44,8 @@ put("input_log", "demo_start.log", "".join(demo[:40]))
 put("input_log", "every_kind.log", "FIRE-LOG 1\n# a comment\n0 meta scenario sketch\n1 meta seed 7 rig_seed=3\n"
     "10 truth pen 0.1 -0.2 0.5\n20 hid 0 33000080809a00801003ffffffffffffffffffffffffff\n"
     "20 hid 1 3300\n21 hid 1 zz\n30 down\n31 pen 0 0.05 0.1\n32 pen 1e-3 2.5 -0\n33 up\n"
-    "40 cmd undo\n41 cmd redo\n42 cmd close\n43 cmd delete 0.1 0.2 0.3\n44 cmd sharp 0.1 0.2 0.3\n")
+    "40 cmd undo\n41 cmd redo\n42 cmd close\n43 cmd delete 0.1 0.2 0.3\n44 cmd sharp 0.1 0.2 0.3\n"
+    "45 cmd mark 3 0.01 -0.02 0.15\n46 cmd register\n")
 put("input_log", "crlf.log", "FIRE-LOG 1\r\n0 down\r\n1 pen 1 2 3\r\n2 up\r\n")
 put("input_log", "bad_version.log", "FIRE-LOG 2\n0 down\n")
 put("input_log", "back_in_time.log", "FIRE-LOG 1\n5 down\n4 up\n")

@@ -104,7 +104,7 @@ int run_replay(const ReplayOptions& o) {
         std::cerr << "fire replay: " << rig.error() << "\n";
         return 1;
       }
-      world->rig = *rig;
+      set_rig(*world, *rig);
       rig_text = std::move(*text);
     } else if (has_device_reports(*log)) {
       std::cerr << "fire replay: " << o.log_path << " holds Wii Remote reports; give the rig they were drawn with: "
@@ -145,6 +145,9 @@ int run_replay(const ReplayOptions& o) {
   if (world->rig)
     for (const std::string& problem : describe_device_problems(world->triangulate))
       std::cerr << lines_of << ": device input: " << problem << "\n";
+  if (world->rig)
+    for (const std::string& line : describe_registration(world->registration))
+      std::cerr << lines_of << ": " << line << "\n";
   std::string problem = world->mesh.validate();
   if (!problem.empty()) {
     std::cerr << "fire replay: internal error, the replayed network is invalid: " << problem << "\n";

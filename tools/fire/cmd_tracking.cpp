@@ -12,6 +12,7 @@
 #include "platform/obj.hpp"
 #include "platform/wiimote/device.hpp"
 #include "platform/wiimote/roles.hpp"
+#include "systems/synth/network_from_mesh.hpp"
 #include "systems/tracking/calibration.hpp"
 #include "systems/tracking/rig_io.hpp"
 #include "systems/tracking/simulate.hpp"
@@ -58,7 +59,9 @@ struct SimulateArgs {
   RigOptions rig;
   WandOptions wand;
   SketchOptions sketch;
-  std::string out_path, session_dir, rig_path;
+  DrawingOptions drawing;
+  uint32_t unrefine = 2;
+  std::string out_path, session_dir, rig_path, marks_path, object_path;
   std::string mesh_path = FIRE_DEFAULT_MESH;
 };
 
@@ -121,23 +124,25 @@ ordered_json simulation_json(const char* scenario, const SimulateArgs& a, const 
   return out;
 }
 
+// The simulated events to -o's log, or to --session's folder with the rig's copy and the marks (when given).
+Status write_log_or_session(const SimulateArgs& a, const std::vector<InputEvent>& events, const std::string& marks_json) {
+  if (a.session_dir.empty()) return write_file_atomic(a.out_path, format_input_log(events));
+  std::string rig_json;
+  if (!a.rig_path.empty()) {
+    Result<std::string> text = read_text_file(a.rig_path);
+    if (!text) return Status::failure(text.error());
+    InputLog log;
+    log.events = events;
+    if (auto rig = tracking_rig_from_json(*text, a.rig_path, log, a.session_dir); !rig) return Status::failure(rig.error());
+    rig_json = std::move(*text);
+  }
+  return write_log_session(a.session_dir, World{}, events, rig_json, marks_json);
+}
+
 int write_simulation(const char* scenario, const SimulateArgs& a, const Result<SimulatedSession>& s) {
   const std::string command = std::string("simulate ") + scenario;
   if (!s) return fail(command, s.error());
-  if (a.session_dir.empty()) {
-    if (Status w = write_file_atomic(a.out_path, format_input_log(s->events)); !w) return fail(command, w.error);
-  } else {
-    std::string rig_json;
-    if (!a.rig_path.empty()) {
-      Result<std::string> text = read_text_file(a.rig_path);
-      if (!text) return fail(command, text.error());
-      InputLog log;
-      log.events = s->events;
-      if (auto rig = tracking_rig_from_json(*text, a.rig_path, log, a.session_dir); !rig) return fail(command, rig.error());
-      rig_json = std::move(*text);
-    }
-    if (Status w = write_log_session(a.session_dir, World{}, s->events, rig_json); !w) return fail(command, w.error);
-  }
+  if (Status w = write_log_or_session(a, s->events, ""); !w) return fail(command, w.error);
   std::cout << simulation_json(scenario, a, *s).dump() << "\n";
   return 0;
 }
@@ -162,6 +167,71 @@ int run_simulate_sketch(const SimulateArgs& a) {
   sketch.mesh_name = a.mesh_path.substr(a.mesh_path.find_last_of('/') + 1);
   const MeshView view{mesh->positions, mesh->face_offsets, mesh->face_vertices};
   return write_simulation("sketch", a, simulate_sketch(a.rig, sketch, view));
+}
+
+// The network to draw: the object's K-unrefined network (systems/synth) on its limit surface.
+DrawingNetwork drawing_network(const Mesh& m) {
+  DrawingNetwork net;
+  for (uint32_t v = 0; v < m.vertex_slots(); ++v) net.vertices.push_back(m.vertices.position[v]);
+  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+    if (!m.edge_alive(e)) continue;
+    const std::span<const Vec3> points = m.polyline(e);
+    net.curves.push_back({m.edges.vertex[e][0], m.edges.vertex[e][1], {points.begin(), points.end()}, m.is_border_edge(e)});
+  }
+  return net;
+}
+
+std::string obj_text(const std::vector<Vec3>& positions, const PolygonMesh& mesh, const std::string& comment) {
+  std::string out = "# " + comment + "\n";
+  for (const Vec3& p : positions) out += "v " + format_double(p.x()) + ' ' + format_double(p.y()) + ' ' + format_double(p.z()) + '\n';
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    out += 'f';
+    for (uint32_t k = mesh.face_offsets[f]; k < mesh.face_offsets[f + 1]; ++k) out += ' ' + std::to_string(mesh.face_vertices[k] + 1);
+    out += '\n';
+  }
+  return out;
+}
+
+int run_simulate_drawing(const SimulateArgs& a) {
+  const std::string command = "simulate drawing";
+  if (!output_chosen("drawing", a)) return 1;
+  if (!std::isfinite(a.drawing.height_m) || !(a.drawing.height_m > 0)) return fail(command, "--height must be a positive number of metres");
+  Result<PolygonMesh> mesh = read_obj(a.mesh_path);
+  if (!mesh) return fail(command, mesh.error() + " (choose the object with --mesh)");
+  Result<std::vector<Vec3>> placed = object_frame(mesh->positions, a.drawing.height_m);
+  if (!placed) return fail(command, a.mesh_path + ": " + placed.error());
+  const PolygonMeshView control{*placed, mesh->face_offsets, mesh->face_vertices, a.mesh_path};
+  Result<Mesh> network = network_from_mesh(control, UnrefineOptions{.unrefine = a.unrefine, .limit = true});
+  if (!network) return fail(command, network.error());
+  DrawingOptions options = a.drawing;
+  options.mesh_name = a.mesh_path.substr(a.mesh_path.find_last_of('/') + 1);
+  const MeshView view{*placed, mesh->face_offsets, mesh->face_vertices};
+  Result<SimulatedDrawing> drawing = simulate_drawing(a.rig, options, view, drawing_network(*network));
+  if (!drawing) return fail(command, a.mesh_path + ": " + drawing.error());
+
+  ordered_json marks = {{"format", "fire-marks"}, {"version", 1}, {"units", "metres"}, {"frame", "object"}, {"marks", ordered_json::array()}};
+  for (size_t k = 0; k < drawing->marks.size(); ++k)
+    marks["marks"].push_back({{"id", k}, {"x", drawing->marks[k].x()}, {"y", drawing->marks[k].y()}, {"z", drawing->marks[k].z()}});
+  const std::string object = obj_text(*placed, *mesh, options.mesh_name + " scaled to " + format_double(options.height_m) +
+                                                         " m along +z, its base's centre at the origin (metres, the object's frame)");
+  // Nothing is written unless everything can be: the log last, so a log never comes without its marks.
+  if (Status w = write_file_atomic(a.marks_path, marks.dump(2) + "\n"); !w) return fail(command, w.error);
+  if (Status w = write_file_atomic(a.object_path, object); !w) return fail(command, w.error);
+  if (Status w = write_log_or_session(a, drawing->session.events, marks.dump(2) + "\n"); !w) return fail(command, w.error);
+  ordered_json out = simulation_json("drawing", a, drawing->session);
+  const DrawingStats& st = drawing->drawing;
+  out["strokes"] = st.strokes;
+  out["border_strokes"] = st.border_strokes;
+  out["split_strokes"] = st.split_strokes;
+  out["undos"] = st.undos;
+  out["registrations"] = st.registrations;
+  out["mark_touches"] = st.mark_touches;
+  out["curves_drawn"] = st.curves_drawn;
+  out["curves_total"] = st.curves_total;
+  out["marks"] = a.marks_path;
+  out["object"] = a.object_path;
+  std::cout << out.dump() << "\n";
+  return 0;
 }
 
 // --- calibrate ---
@@ -391,6 +461,46 @@ void add_tracking_commands(CLI::App& app, Registry& registry) {
   s->add_option("--mesh", sketch->mesh_path, "the object, OBJ")->capture_default_str();
   s->footer("Prints one JSON line: reports written and dropped per camera, LED images, occluded, out of view, merged, stray frames, strokes.");
   s->callback([sketch, &registry] { registry.exit_code = run_simulate_sketch(*sketch); });
+
+  auto drawing = std::make_shared<SimulateArgs>();
+  CLI::App* dr = simulate->add_subcommand(
+      "drawing", "A person registering an object on marks and drawing its curve network (pawn.obj at 20 cm), for fire replay --rig");
+  add_rig_options(dr, *drawing);
+  dr->add_option("--marks-out", drawing->marks_path, "marks file to write: the marks' ids and positions in the object's frame (JSON, metres)")
+      ->required();
+  dr->add_option("--object-out", drawing->object_path,
+                 "the control mesh as drawn on, OBJ in metres in the object's frame (scaled, not posed): fire eval's --reference")
+      ->required();
+  dr->add_option("--mesh", drawing->mesh_path, "the object, OBJ with +z up")->capture_default_str();
+  dr->add_option("--height", drawing->drawing.height_m, "the object is scaled to this height, metres")->capture_default_str();
+  dr->add_option("--unrefine", drawing->unrefine, "K: the network drawn keeps every K-th edge loop of the control mesh (fire network-from-mesh)")
+      ->check(CLI::Range(1u, 64u))
+      ->capture_default_str();
+  dr->add_option("--speed", drawing->drawing.speed_m_s, "pen speed along a stroke, m/s")->capture_default_str();
+  dr->add_option("--hold-s", drawing->drawing.hold_s, "seconds the lit pen rests where a stroke starts (two thirds of it where it ends)")
+      ->capture_default_str();
+  dr->add_option("--mark-hold-s", drawing->drawing.mark_hold_s, "seconds the pen rests on each mark; cmd mark is logged 0.2 s before it lifts")
+      ->capture_default_str();
+  dr->add_option("--tilt", drawing->drawing.tilt_deg, "degrees the object leans its top toward the cameras")->capture_default_str();
+  dr->add_option("--turns", drawing->drawing.turns, "poses the object may be turned to, evenly about its up axis")->capture_default_str();
+  dr->add_option("--undo-after", drawing->drawing.undo_after, "the split stroke (1-based) undone with cmd undo and drawn again (0: none)")
+      ->capture_default_str();
+  dr->add_option("--max-strokes", drawing->drawing.max_strokes, "stop after this many strokes, the border always whole (0: the whole network)")
+      ->capture_default_str();
+  dr->footer(
+      "The object stands before the rig, its middle where the cameras converge (--distance). Six marks are network vertices "
+      "around it at a fifth and half its height. The person touches the marks both cameras see (the pen resting on each, "
+      "cmd mark N X Y Z logged), logs cmd register, draws the border corner to corner, then splitting curves: chains of the "
+      "network's curves between points already drawn, shortest first, each inside one face (an ear decomposition), the "
+      "pen lifted between strokes. When no stroke left is seen whole by both cameras, the object is turned to a pose that "
+      "shows one and registered again on the marks seen there. The pen's LED is at its tip, on the limit surface. "
+      "The stray reflection (--stray) as in every session. Hand occlusions (--occlusion) are off by default: while one "
+      "camera follows the pen the tracker emits no samples, so a hand passing a corner of a stroke that runs along "
+      "several curves makes a chord there, a later curve meant to end at that corner misses it and is rejected, and "
+      "the curves that depend on it after it. "
+      "Prints one JSON line: the session's report counts, strokes (border and split), undos, registrations, mark touches, "
+      "curves drawn of the network's total.");
+  dr->callback([drawing, &registry] { registry.exit_code = run_simulate_drawing(*drawing); });
 
   // calibrate
   auto cal = std::make_shared<CalibrateArgs>();

@@ -18,8 +18,11 @@ std::vector<SystemSpec> session_systems(World& w) {
   systems.push_back({"triangulate", {"frame_events", "rig"}, {"frame_events"}, {}, [&w] {
                        if (w.rig) triangulate_system(w.frame, *w.rig, w.triangulate, w.frame_events);
                      }});
-  systems.push_back({"sketch", {"frame_events", "sketch_settings"}, {"requests", "rejections", "pen_feedback"}, {"mesh", "snap"}, [&w] {
-                       sketch_system(w.frame_events, w.mesh, w.snap, w.sketch_settings, w.sketch, w.requests,
+  systems.push_back({"register", {"frame_events", "rig"}, {"object_events", "rejections"}, {}, [&w] {
+                       register_system(w.frame_events, w.rig.has_value(), w.registration, w.object_events, w.rejections);
+                     }});
+  systems.push_back({"sketch", {"object_events", "sketch_settings"}, {"requests", "rejections", "pen_feedback"}, {"mesh", "snap"}, [&w] {
+                       sketch_system(w.object_events, w.mesh, w.snap, w.sketch_settings, w.sketch, w.requests,
                                      w.rejections, w.pen_feedback);
                      }});
   systems.push_back({"split", {"requests"}, {"mesh", "rejections"}, {}, [&w] {
@@ -55,6 +58,12 @@ void replay_headless(World& w, Scheduler& scheduler, const ReplayHooks& hooks) {
   if (w.log.events.empty()) return;
   begin_frame(w, 0, w.log.events.front().t_us);
   continue_replay(w, scheduler, hooks);
+}
+
+void set_rig(World& w, const TrackingRig& rig) {
+  w.rig = rig;
+  w.sketch_settings.vertex_snap = kTrackedVertexSnap;
+  w.sketch_settings.blend_reach = kTrackedBlendReach;
 }
 
 bool systems_waiting(const World& w) { return !w.sketch.pending.empty() || (w.rig && w.triangulate.busy()); }

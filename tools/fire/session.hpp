@@ -2,7 +2,7 @@
 // A drawing session: the world's data and the per-frame system order of the design card, used by
 // `fire replay` headless (and by the live app).
 //
-//   input -> triangulate -> sketch -> split -> refine -> subdivide -> snap (the sync point: the snapping index)
+//   input -> triangulate -> register -> sketch -> split -> refine -> subdivide -> snap (the sync point: the snapping index)
 //
 // Each system is declared with the world data it reads and writes (names below), so the scheduler can
 // refuse an order in which a system reads what a later one writes in the same frame.
@@ -19,6 +19,7 @@
 #include "engine/surface.hpp"
 #include "systems/input/input.hpp"
 #include "systems/reconstruct/reconstruct.hpp"
+#include "systems/register/register.hpp"
 #include "systems/sketch/sketch.hpp"
 #include "systems/split/edit.hpp"
 #include "systems/triangulate/triangulate.hpp"
@@ -34,6 +35,9 @@ struct World {
   // triangulate: only with a rig (logs of device reports); it appends the pen's events to frame_events
   std::optional<TrackingRig> rig;
   TriangulateState triangulate;
+  // register: the pen's samples from the rig's frame to the object's (cmd mark, cmd register)
+  RegistrationState registration;
+  std::vector<InputEvent> object_events;  // the frame's pen events (object frame) and commands, for sketch
   // sketch
   SketchState sketch;
   SketchSettings sketch_settings;
@@ -66,6 +70,10 @@ struct ReplayHooks {
   std::function<void(World&)> before_frame;
   std::function<void(const World&)> after_frame;
 };
+// Gives the world the rig its device reports are triangulated with, and the sketch settings of a tracked
+// pen (SketchSettings::vertex_snap, blend_reach): every path that runs a tracked drawing (fire replay
+// --rig, a reopened session with a rig.json) runs it the same way.
+void set_rig(World& world, const TrackingRig& rig);
 // Whether a system still holds input that later frames will act on (the sketch system's requests, the
 // triangulation system's reports or open stroke): a replay out of events runs frames until it does not.
 bool systems_waiting(const World& world);

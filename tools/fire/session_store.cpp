@@ -19,6 +19,7 @@ void save_event(SnapshotWriter& out, const InputEvent& e) {
   out.put(e.p);
   out.put(e.snap);
   out.put(uint8_t(e.command));
+  out.put(e.mark);
   out.put(int32_t(e.device));
   out.put(uint8_t(e.hid_ok));
   out.put(e.bytes);
@@ -36,6 +37,7 @@ bool load_event(SnapshotReader& in, InputEvent& e) {
   in.get(e.p);
   in.get(e.snap);
   in.get(command);
+  in.get(e.mark);
   in.get(device);
   in.get(hid_ok);
   in.get(e.bytes);
@@ -43,7 +45,7 @@ bool load_event(SnapshotReader& in, InputEvent& e) {
   in.get(e.values);
   in.get(e.text);
   in.get(e.line);
-  if (kind > uint8_t(EventKind::Meta) || command > uint8_t(CommandKind::Sharp)) in.fail();
+  if (kind > uint8_t(EventKind::Meta) || command > uint8_t(CommandKind::Register)) in.fail();
   e.kind = EventKind(kind);
   e.command = CommandKind(command);
   e.device = device;
@@ -130,7 +132,10 @@ std::string snapshot_world(const World& w, uint64_t log_bytes, uint64_t log_hash
     out.put(r.reason);
   }
   out.put(uint8_t(w.rig.has_value()));
-  if (w.rig) save_triangulate_state(out, w.triangulate);
+  if (w.rig) {
+    save_triangulate_state(out, w.triangulate);
+    w.registration.save(out);
+  }
   return out.finish();
 }
 
@@ -181,6 +186,7 @@ Status load_world_snapshot(SnapshotReader& in, const SessionContents& session, W
                                    : "holds no triangulation state, but the session has a " + std::string(kSessionRig));
   if (in.ok() && tracked && !load_triangulate_state(in, w.triangulate))
     return Status::failure("the triangulation system's state does not load");
+  if (in.ok() && tracked && !w.registration.load(in)) return Status::failure("the registration does not load");
   if (!in.ok() || !in.at_end()) return Status::failure("cut off or followed by bytes it does not hold (damaged)");
   if (std::string problem = w.mesh.validate(); !problem.empty())
     return Status::failure("the pools break an invariant: " + problem);
@@ -253,8 +259,8 @@ Status replay_into_session(World& w, Scheduler& scheduler, SessionWriter& out, c
 }
 
 Status write_log_session(const std::string& dir, const World& w, std::span<const InputEvent> events,
-                         std::string_view rig_json) {
-  auto out = SessionWriter::create(dir, settings_json(w), rig_json);
+                         std::string_view rig_json, std::string_view marks_json) {
+  auto out = SessionWriter::create(dir, settings_json(w), rig_json, marks_json);
   if (!out) return Status::failure(out.error());
   constexpr size_t kCommitEvery = 1000;
   size_t since_commit = 0;
@@ -285,7 +291,7 @@ Result<ReopenedSession> reopen_session(const std::string& dir, Scheduler::Clock 
     Status s = apply_settings_json(c.settings, c.paths.settings(), *w);
     if (s && !c.rig.empty()) {
       Result<TrackingRig> rig = tracking_rig_from_json(c.rig, c.paths.rig(), c.log.log, c.paths.log());
-      if (rig) w->rig = *rig;
+      if (rig) set_rig(*w, *rig);
       else s = Status::failure(rig.error());
     }
     return std::make_pair(std::move(w), s);

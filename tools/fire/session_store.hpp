@@ -71,10 +71,10 @@ class SessionRecorder {
 Status replay_into_session(World& w, Scheduler& scheduler, SessionWriter& out, const SessionWriteOptions& options);
 
 // A log no frame has run yet (a simulator's) written as a new session folder: `w`'s settings, a copy of
-// the rig when given, every event appended, committed at each pen-up and command, every 1,000 events and
-// at the end. No snapshot: reopening replays it from its start.
+// the rig and of the marks when given, every event appended, committed at each pen-up and command, every
+// 1,000 events and at the end. No snapshot: reopening replays it from its start.
 Status write_log_session(const std::string& dir, const World& w, std::span<const InputEvent> events,
-                         std::string_view rig_json);
+                         std::string_view rig_json, std::string_view marks_json = {});
 
 // The input log of a file, or of a session folder (its input.log, a torn last record dropped and said in
 // `notes`), for the commands that read logs without running the frame's systems over them.

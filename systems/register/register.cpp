@@ -1,0 +1,226 @@
+#include "systems/register/register.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <string>
+
+namespace fire {
+namespace {
+
+std::string mm(double metres) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2f mm", metres * 1e3);
+  return buf;
+}
+
+Vec3 mapped(const RegistrationState& s, const Vec3& p) { return s.transform ? Vec3(s.transform->R * p + s.transform->t) : p; }
+
+void touch_mark(const InputEvent& e, RegistrationState& s, std::vector<Rejection>& rejections) {
+  const std::string what = "mark " + std::to_string(e.mark) + ": ";
+  Vec3 mean = Vec3::Zero();
+  size_t n = 0;
+  for (const auto& [t, p] : s.recent)
+    if (t > e.t_us - kRestWindowUs && t <= e.t_us) {
+      mean += p;
+      ++n;
+    }
+  if (n < kRestSamples) {
+    rejections.push_back({e.t_us, e.line, what + "the pen was seen " + std::to_string(n) + " time(s) in the " +
+                                              std::to_string(kRestWindowUs / 1000) + " ms before the command; rest it on the mark (at least " +
+                                              std::to_string(kRestSamples) + " samples)"});
+    return;
+  }
+  mean /= double(n);
+  double spread = 0;
+  for (const auto& [t, p] : s.recent)
+    if (t > e.t_us - kRestWindowUs && t <= e.t_us) spread = std::max(spread, (p - mean).norm());
+  if (spread > kRestSpread) {
+    rejections.push_back({e.t_us, e.line, what + "the pen moved " + mm(spread) + " from its mean while resting on the mark (at most " +
+                                              mm(kRestSpread) + "); hold it still"});
+    return;
+  }
+  // A mark touched again replaces its earlier touch.
+  std::erase_if(s.touched, [&](const MarkTouch& m) { return m.mark == e.mark; });
+  s.touched.push_back({e.mark, mean, e.p});
+}
+
+void register_marks(const InputEvent& e, RegistrationState& s, std::vector<Rejection>& rejections) {
+  auto reject = [&](const std::string& why) {
+    rejections.push_back({e.t_us, e.line, "register: " + why + "; the marks touched are kept"});
+  };
+  if (s.touched.size() < 3) {
+    reject(std::to_string(s.touched.size()) + " mark(s) touched since the last registration, a registration needs at least 3 " +
+           "(rest the pen on each mark and log cmd mark N X Y Z)");
+    return;
+  }
+  std::vector<Vec3> measured, model;
+  for (const MarkTouch& m : s.touched) {
+    measured.push_back(m.measured);
+    model.push_back(m.model);
+  }
+  Result<tracking::RigidTransform> T = tracking::register_rigid(measured, model);
+  if (!T) {
+    reject(T.error());
+    return;
+  }
+  if (!(T->rms_residual <= kMaxResidual)) {
+    reject("the marks do not fit one rigid motion (residual " + mm(T->rms_residual) + ", at most " + mm(kMaxResidual) +
+           "): a mark was touched in the wrong place or logged with the wrong number or coordinates");
+    return;
+  }
+  s.transform = *T;
+  s.done.push_back({e.line, uint32_t(s.touched.size()), T->rms_residual});
+  s.touched.clear();
+}
+
+void release(RegistrationState& s, std::vector<InputEvent>& out) {
+  s.stroke_released = true;
+  for (InputEvent& h : s.held) {
+    if (h.kind == EventKind::Pen) h.p = mapped(s, h.p);
+    out.push_back(std::move(h));
+  }
+  s.held.clear();
+}
+
+}  // namespace
+
+void register_system(const std::vector<InputEvent>& frame_events, bool tracked, RegistrationState& s,
+                     std::vector<InputEvent>& out, std::vector<Rejection>& rejections) {
+  out.clear();
+  for (const InputEvent& e : frame_events) {
+    const bool registering = e.kind == EventKind::Command && (e.command == CommandKind::Mark || e.command == CommandKind::Register);
+    if (registering && !tracked) {
+        rejections.push_back({e.t_us, e.line, std::string(e.command == CommandKind::Mark ? "mark" : "register") +
+                                                ": registration needs a tracked pen (a log of device reports, replayed with --rig)"});
+    } else if (registering) {
+      if (e.command == CommandKind::Mark)
+        touch_mark(e, s, rejections);
+      else
+        register_marks(e, s, rejections);
+    } else if (e.kind == EventKind::Hid || e.kind == EventKind::Truth || e.kind == EventKind::Meta) {
+      // the triangulation system's, or not for replay
+    } else if (!tracked || e.kind == EventKind::Command) {
+      out.push_back(e);
+    } else if (e.kind == EventKind::Pen) {
+      s.recent.emplace_back(e.t_us, e.p);
+      const int64_t oldest = e.t_us - kRestWindowUs;
+      std::erase_if(s.recent, [&](const auto& r) { return r.first <= oldest; });
+      if (!s.stroke_open || s.stroke_released) {
+        out.push_back(e);
+        out.back().p = mapped(s, e.p);
+        continue;
+      }
+      const bool left = s.held.size() >= 2 && (e.p - s.held[1].p).norm() > kTouchRadius;  // held[0] is the Down
+      s.held.push_back(e);
+      if (left) release(s, out);
+    } else if (e.kind == EventKind::Down) {
+      s.stroke_open = true;
+      s.stroke_released = false;
+      s.held.assign(1, e);
+    } else {  // Up
+      if (s.stroke_open && !s.stroke_released)
+        ++s.touches_dropped;  // the pen never left its first sample's neighbourhood: a touch, not a curve
+      else
+        out.push_back(e);
+      s.stroke_open = s.stroke_released = false;
+      s.held.clear();
+    }
+  }
+}
+
+std::vector<std::string> describe_registration(const RegistrationState& s) {
+  std::vector<std::string> out;
+  for (size_t k = 0; k < s.done.size(); ++k)
+    out.push_back("registration " + std::to_string(k + 1) + " (line " + std::to_string(s.done[k].line) + "): " +
+                  std::to_string(s.done[k].marks) + " marks, residual " + mm(s.done[k].residual));
+  if (s.touches_dropped)
+    out.push_back(std::to_string(s.touches_dropped) + " touch(es) of the pen that never moved " + mm(kTouchRadius) +
+                  " from where it started: not drawn");
+  if (!s.touched.empty())
+    out.push_back(std::to_string(s.touched.size()) + " mark(s) touched after the last registration, not registered");
+  return out;
+}
+
+void RegistrationState::save(SnapshotWriter& out) const {
+  out.put(uint8_t(transform.has_value()));
+  if (transform) {
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) out.put(transform->R(r, c));
+    out.put(transform->t);
+    out.put(transform->rms_residual);
+  }
+  out.put(uint64_t(touched.size()));
+  for (const MarkTouch& m : touched) {
+    out.put(m.mark);
+    out.put(m.measured);
+    out.put(m.model);
+  }
+  out.put(recent);
+  out.put(uint8_t(stroke_open));
+  out.put(uint8_t(stroke_released));
+  out.put(uint64_t(held.size()));
+  for (const InputEvent& e : held) {
+    out.put(e.t_us);
+    out.put(uint8_t(e.kind));
+    out.put(e.p);
+    out.put(e.snap);
+    out.put(e.line);
+  }
+  out.put(uint64_t(done.size()));
+  for (const Registration& r : done) {
+    out.put(r.line);
+    out.put(r.marks);
+    out.put(r.residual);
+  }
+  out.put(touches_dropped);
+}
+
+bool RegistrationState::load(SnapshotReader& in) {
+  *this = {};
+  uint8_t has = 0, open = 0, released = 0;
+  in.get(has);
+  if (has) {
+    transform.emplace();
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) in.get(transform->R(r, c));
+    in.get(transform->t);
+    in.get(transform->rms_residual);
+  }
+  uint64_t n = 0;
+  in.get(n);
+  for (uint64_t k = 0; k < n && in.ok(); ++k) {
+    MarkTouch& m = touched.emplace_back();
+    in.get(m.mark);
+    in.get(m.measured);
+    in.get(m.model);
+  }
+  in.get(recent);
+  in.get(open);
+  in.get(released);
+  stroke_open = open;
+  stroke_released = released;
+  in.get(n);
+  for (uint64_t k = 0; k < n && in.ok(); ++k) {
+    InputEvent& e = held.emplace_back();
+    uint8_t kind = 0;
+    in.get(e.t_us);
+    in.get(kind);
+    in.get(e.p);
+    in.get(e.snap);
+    in.get(e.line);
+    if (kind != uint8_t(EventKind::Down) && kind != uint8_t(EventKind::Pen)) in.fail();
+    e.kind = EventKind(kind);
+  }
+  in.get(n);
+  for (uint64_t k = 0; k < n && in.ok(); ++k) {
+    Registration& r = done.emplace_back();
+    in.get(r.line);
+    in.get(r.marks);
+    in.get(r.residual);
+  }
+  in.get(touches_dropped);
+  if (has > 1 || open > 1 || released > 1) in.fail();
+  return in.ok();
+}
+
+}  // namespace fire

@@ -1,0 +1,67 @@
+#pragma once
+// The registration system: from the rig's frame to the object's. Between triangulate and sketch, it reads the
+// frame's pen events and the registration commands (engine/INPUT_LOG.md):
+//   cmd mark N X Y Z  the pen tip rests on mark N of the object, at (X, Y, Z) in the object's frame: the pen's
+//                     position is the mean of its samples over the last kRestWindowUs, which must hold still
+//   cmd register      the rigid transform from the marks touched since the last registration (Umeyama,
+//                     tracking::register_rigid); from then on every pen sample is mapped into the object's frame
+// A registration that cannot be made (fewer than 3 marks, collinear marks, a residual over kMaxResidual) is
+// rejected in words and keeps the marks touched; a later registration (the object turned) replaces the
+// transform, and curves already drawn stay where they are. Before the first registration samples pass unchanged.
+// A touch is not a curve: a stroke is held back until the pen leaves kTouchRadius around its first sample, and
+// one that never does (the pen resting on a mark) is dropped.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "engine/edit_command.hpp"
+#include "engine/input_log.hpp"
+#include "engine/session_dir.hpp"
+#include "systems/tracking/registration.hpp"
+
+namespace fire {
+
+inline constexpr int64_t kRestWindowUs = 500'000;  // the pen rests at least this long on a mark
+inline constexpr double kRestSpread = 0.002;       // metres: a resting pen's samples stay this close to their mean
+inline constexpr size_t kRestSamples = 10;         // fewer in the window: the pen was not seen on the mark
+inline constexpr double kMaxResidual = 0.005;      // metres: more means a mark touched in the wrong place
+inline constexpr double kTouchRadius = 0.003;      // metres: a stroke that stays this close to its start is a touch
+
+struct MarkTouch {
+  uint32_t mark = 0;
+  Vec3 measured = Vec3::Zero();  // the pen at rest, rig frame
+  Vec3 model = Vec3::Zero();     // the mark, object frame
+};
+
+struct Registration {
+  uint32_t line = 0;  // of its cmd register
+  uint32_t marks = 0;
+  double residual = 0;  // metres, RMS over the marks
+};
+
+struct RegistrationState {
+  std::optional<tracking::RigidTransform> transform;  // rig frame -> object frame; none before the first registration
+  std::vector<MarkTouch> touched;                     // since the last registration, one per mark (the latest touch)
+  std::vector<std::pair<int64_t, Vec3>> recent;       // the pen's samples (instant, rig frame) of the last kRestWindowUs
+  // The stroke being drawn: held back (its Down and samples, rig frame) until the pen leaves the touch radius.
+  bool stroke_open = false, stroke_released = false;
+  std::vector<InputEvent> held;
+  std::vector<Registration> done;  // every registration made, in order
+  uint32_t touches_dropped = 0;
+
+  void save(SnapshotWriter& out) const;
+  bool load(SnapshotReader& in);  // false (and `in` failed) on a malformed record
+};
+
+// Writes to `object_events` (cleared first) what the person did in the frame, for the sketch system: the pen's
+// events, in the object's frame, and the commands other than mark and register, which it takes. `tracked`: the
+// pen comes from the rig (device reports); without it the pen is in the model's frame already, the events pass
+// unchanged and mark and register are rejected. A rejected command is appended to `rejections`.
+void register_system(const std::vector<InputEvent>& frame_events, bool tracked, RegistrationState& state,
+                     std::vector<InputEvent>& object_events, std::vector<Rejection>& rejections);
+
+// What the registrations so far amount to, one sentence each (for fire replay).
+std::vector<std::string> describe_registration(const RegistrationState& state);
+
+}  // namespace fire

@@ -1,0 +1,223 @@
+// The registration system: marks touched with a resting pen, a registration from them, pen samples mapped
+// into the object's frame, rejections in words, touches not drawn, and its state through a snapshot.
+#include <catch2/catch.hpp>
+#include <Eigen/Geometry>
+
+#include "systems/register/register.hpp"
+
+using namespace fire;
+
+namespace {
+
+// The object's pose in the rig: object = A rig + b.
+const Eigen::Matrix3d kA = Eigen::AngleAxisd(0.7, Vec3(0.2, 1, 0.3).normalized()).toRotationMatrix();
+const Vec3 kB(0.05, -0.12, 0.4);
+Vec3 to_rig(const Vec3& object) { return kA.transpose() * (object - kB); }
+
+// One frame of the system with a tracked pen: what it passes on to the sketch system.
+std::vector<InputEvent> run(RegistrationState& s, std::vector<Rejection>& rejections, const std::vector<InputEvent>& frame) {
+  std::vector<InputEvent> out;
+  register_system(frame, true, s, out, rejections);
+  return out;
+}
+
+InputEvent pen(int64_t t_us, const Vec3& p) {
+  InputEvent e;
+  e.t_us = t_us;
+  e.kind = EventKind::Pen;
+  e.p = p;
+  return e;
+}
+InputEvent event(int64_t t_us, EventKind kind) {
+  InputEvent e;
+  e.t_us = t_us;
+  e.kind = kind;
+  return e;
+}
+InputEvent mark(int64_t t_us, uint32_t n, const Vec3& object, uint32_t line) {
+  InputEvent e = event(t_us, EventKind::Command);
+  e.command = CommandKind::Mark;
+  e.mark = n;
+  e.p = object;
+  e.line = line;
+  return e;
+}
+InputEvent register_command(int64_t t_us, uint32_t line) {
+  InputEvent e = event(t_us, EventKind::Command);
+  e.command = CommandKind::Register;
+  e.line = line;
+  return e;
+}
+
+// The pen rests 0.8 s on `object` (a touch: down, samples 10 ms apart, up), then `cmd mark n`, one frame per
+// event; returns the frames' output events.
+std::vector<InputEvent> touch(RegistrationState& s, std::vector<Rejection>& rejections, int64_t& t, uint32_t n,
+                              const Vec3& object, uint32_t line, double wobble = 0) {
+  std::vector<InputEvent> out;
+  auto frame = [&](InputEvent e) {
+    const std::vector<InputEvent> passed = run(s, rejections, {std::move(e)});
+    out.insert(out.end(), passed.begin(), passed.end());
+  };
+  frame(event(t, EventKind::Down));
+  for (int k = 0; k < 80; ++k, t += 10'000) frame(pen(t, to_rig(object) + Vec3(k % 2 ? wobble : -wobble, 0, 0)));
+  frame(mark(t, n, object, line));
+  frame(event(t, EventKind::Up));
+  t += 500'000;
+  return out;
+}
+
+const Vec3 kMarks[] = {{0.03, 0, 0.01}, {-0.03, 0.01, 0.05}, {0, -0.03, 0.12}, {0.01, 0.02, 0.18}};
+
+}  // namespace
+
+TEST_CASE("a registration on three or more marks maps later pen samples into the object's frame") {
+  RegistrationState s;
+  std::vector<Rejection> rejections;
+  int64_t t = 0;
+  for (uint32_t n = 0; n < 4; ++n) CHECK(touch(s, rejections, t, n, kMarks[n], 10 + n).empty());  // touches are not drawn
+  CHECK(s.touched.size() == 4);
+  std::vector<InputEvent> frame = run(s, rejections, {register_command(t, 20)});
+  CHECK(frame.empty());
+  CHECK(rejections.empty());
+  REQUIRE(s.transform);
+  REQUIRE(s.done.size() == 1);
+  CHECK(s.done[0].marks == 4);
+  CHECK(s.done[0].residual < 1e-9);
+  CHECK(s.touched.empty());
+  CHECK(s.touches_dropped == 4);
+
+  // A stroke: held back while within the touch radius of its start, then released whole, in the object's frame.
+  frame = run(s, rejections, {event(t, EventKind::Down), pen(t + 1, to_rig(Vec3(0.02, 0, 0.05)))});
+  CHECK(frame.empty());
+  frame = run(s, rejections, {pen(t + 2, to_rig(Vec3(0.02, 0, 0.051)))});
+  CHECK(frame.empty());
+  frame = run(s, rejections, {pen(t + 3, to_rig(Vec3(0.02, 0, 0.06))), event(t + 4, EventKind::Up)});
+  REQUIRE(frame.size() == 5);
+  CHECK(frame[0].kind == EventKind::Down);
+  CHECK(frame[4].kind == EventKind::Up);
+  CHECK((frame[1].p - Vec3(0.02, 0, 0.05)).norm() < 1e-12);
+  CHECK((frame[3].p - Vec3(0.02, 0, 0.06)).norm() < 1e-12);
+  CHECK(rejections.empty());
+}
+
+TEST_CASE("a registration with fewer than 3 marks is rejected in words and keeps the marks touched") {
+  RegistrationState s;
+  std::vector<Rejection> rejections;
+  int64_t t = 0;
+  touch(s, rejections, t, 0, kMarks[0], 10);
+  touch(s, rejections, t, 1, kMarks[1], 11);
+  CHECK(run(s, rejections, {register_command(t, 12)}).empty());
+  REQUIRE(rejections.size() == 1);
+  CHECK(rejections[0].line == 12);
+  CHECK(rejections[0].reason.find("register: 2 mark(s) touched since the last registration, a registration needs at least 3") == 0);
+  CHECK(!s.transform);
+  CHECK(s.touched.size() == 2);
+  // A third mark and the registration goes through.
+  touch(s, rejections, t, 2, kMarks[2], 13);
+  run(s, rejections, {register_command(t, 14)});
+  CHECK(rejections.size() == 1);
+  CHECK(s.transform);
+}
+
+TEST_CASE("marks on a line, a moving pen, a wrong mark and an unseen pen are rejected") {
+  RegistrationState s;
+  std::vector<Rejection> rejections;
+  int64_t t = 0;
+  touch(s, rejections, t, 0, Vec3(0, 0, 0), 1);
+  touch(s, rejections, t, 1, Vec3(0, 0, 0.1), 2);
+  touch(s, rejections, t, 2, Vec3(0, 0, 0.2), 3);
+  run(s, rejections, {register_command(t, 4)});
+  REQUIRE(rejections.size() == 1);
+  CHECK(rejections[0].reason.find("collinear") != std::string::npos);
+
+  touch(s, rejections, t, 3, kMarks[0], 5, 0.004);  // wobbling 4 mm
+  REQUIRE(rejections.size() == 2);
+  CHECK(rejections[1].reason.find("mark 3: the pen moved 4.") == 0);
+  CHECK(rejections[1].reason.find("(at most 2.00 mm); hold it still") != std::string::npos);
+
+  run(s, rejections, {mark(t + 2'000'000, 4, kMarks[1], 6)});  // no pen sample for 2 s
+  REQUIRE(rejections.size() == 3);
+  CHECK(rejections[2].reason.find("mark 4: the pen was seen 0 time(s)") == 0);
+
+  // Mark 2 logged with coordinates 3 cm off: the marks no longer fit a rigid motion.
+  RegistrationState w;
+  std::vector<Rejection> wrong;
+  t = 0;
+  touch(w, wrong, t, 0, kMarks[0], 1);
+  touch(w, wrong, t, 1, kMarks[1], 2);
+  touch(w, wrong, t, 2, kMarks[2], 3);
+  w.touched.back().model += Vec3(0.03, 0, 0);
+  touch(w, wrong, t, 3, kMarks[3], 4);
+  run(w, wrong, {register_command(t, 5)});
+  REQUIRE(wrong.size() == 1);
+  CHECK(wrong[0].reason.find("register: the marks do not fit one rigid motion") == 0);
+  CHECK(!w.transform);
+}
+
+TEST_CASE("a second registration replaces the transform") {
+  RegistrationState s;
+  std::vector<Rejection> rejections;
+  int64_t t = 0;
+  for (uint32_t n = 0; n < 3; ++n) touch(s, rejections, t, n, kMarks[n], n);
+  run(s, rejections, {register_command(t, 9)});
+  // The object turned: the same marks now sit elsewhere in the rig; touched (with the new pose) and registered.
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(2.0, Vec3::UnitY()).toRotationMatrix();
+  for (uint32_t n = 0; n < 4; ++n) {
+    // Touch at the turned position: the rig sees to_rig(object) turned about the rig's y axis.
+    std::vector<InputEvent> frames{event(t, EventKind::Down)};
+    for (int k = 0; k < 80; ++k, t += 10'000) frames.push_back(pen(t, turn * to_rig(kMarks[n])));
+    frames.push_back(mark(t, n, kMarks[n], 20 + n));
+    frames.push_back(event(t, EventKind::Up));
+    CHECK(run(s, rejections, frames).empty());
+    t += 500'000;
+  }
+  run(s, rejections, {register_command(t, 30)});
+  CHECK(rejections.empty());
+  REQUIRE(s.done.size() == 2);
+  const Vec3 p(0.01, 0.01, 0.1);
+  CHECK((s.transform->R * (turn * to_rig(p)) + s.transform->t - p).norm() < 1e-9);
+}
+
+TEST_CASE("the registration state survives a snapshot") {
+  RegistrationState s;
+  std::vector<Rejection> rejections;
+  int64_t t = 0;
+  for (uint32_t n = 0; n < 3; ++n) touch(s, rejections, t, n, kMarks[n], n);
+  run(s, rejections, {register_command(t, 9)});
+  touch(s, rejections, t, 3, kMarks[3], 10);
+  CHECK(run(s, rejections, {event(t, EventKind::Down), pen(t, to_rig(kMarks[0]))}).empty());  // a stroke held back
+
+  SnapshotWriter out;
+  s.save(out);
+  const std::string file = out.finish();
+  Result<SnapshotReader> in = SnapshotReader::open(file, "test");
+  REQUIRE(in.ok());
+  RegistrationState back;
+  REQUIRE(back.load(*in));
+  CHECK(in->at_end());
+  REQUIRE(back.transform);
+  CHECK(back.transform->R == s.transform->R);
+  CHECK(back.transform->t == s.transform->t);
+  CHECK(back.touched.size() == 1);
+  CHECK(back.touched[0].measured == s.touched[0].measured);
+  CHECK(back.recent == s.recent);
+  CHECK(back.held.size() == 2);
+  CHECK(back.stroke_open);
+  CHECK(back.done.size() == 1);
+  CHECK(back.touches_dropped == s.touches_dropped);
+}
+
+TEST_CASE("without a tracked pen the events pass unchanged and mark and register are rejected") {
+  RegistrationState s;
+  std::vector<Rejection> rejections;
+  InputEvent hid = event(0, EventKind::Hid);
+  std::vector<InputEvent> out;
+  register_system({event(0, EventKind::Down), pen(1, Vec3(1, 2, 3)), event(2, EventKind::Up), hid, mark(3, 0, kMarks[0], 7),
+                   register_command(4, 8)},
+                  false, s, out, rejections);
+  REQUIRE(out.size() == 3);  // the device report is the triangulation system's
+  CHECK(out[1].p == Vec3(1, 2, 3));
+  REQUIRE(rejections.size() == 2);
+  CHECK(rejections[0].reason == "mark: registration needs a tracked pen (a log of device reports, replayed with --rig)");
+  CHECK(rejections[1].line == 8);
+}
