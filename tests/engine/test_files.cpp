@@ -68,7 +68,7 @@ TEST_CASE("input log: every kind parses and formats back", "[files]") {
   CHECK(format_input_log(again->events) == format_input_log(log->events));
 }
 
-TEST_CASE("input log: a pen sample's snap radius reads and formats back; without one it is 0", "[files]") {
+TEST_CASE("input log: a pen sample's snap radius reads and formats back, without one it is 0", "[files]") {
   auto log = parse_input_log("FIRE-LOG 1\n10 pen 1 2 3 0.0125\n20 pen 1 2 3\n", "a.log");
   REQUIRE(log.ok());
   CHECK(log->events[0].p == Vec3(1, 2, 3));
@@ -110,7 +110,7 @@ TEST_CASE("input log: a garbled device report is counted, not fatal", "[files]")
   CHECK(log->events.size() == 3);
 }
 
-TEST_CASE("input log: a device report stamped back in time is kept and counted; the order stays the later lines'", "[files]") {
+TEST_CASE("input log: a device report stamped back in time is kept and counted, the order stays the later lines'", "[files]") {
   auto log = parse_input_log("FIRE-LOG 1\n10 hid 0 3300\n20 hid 1 3300\n15 hid 0 3300\n20 down\n", "b.log");
   REQUIRE(log.ok());
   CHECK(log->hid_back_in_time == 1);

@@ -89,7 +89,7 @@ TEST_CASE("strokes become a border, a split, and an undo", "[replay]") {
   CHECK(w->mesh.vertex_count() == 4);
 }
 
-TEST_CASE("a curve marked sharp creases the surface; undo, redo and a replay of the log reproduce it bit for bit",
+TEST_CASE("a curve marked sharp creases the surface, undo, redo and a replay of the log reproduce it bit for bit",
           "[replay][sharp]") {
   int64_t t = 0;
   std::string text = square_log(t);
@@ -255,7 +255,7 @@ TEST_CASE("the scheduler keeps per-system samples for mean, p99 and max", "[sche
   CHECK_THAT(s->describe(), Catch::Contains("count: reads -; writes n"));
 }
 
-TEST_CASE("the scheduler's samples stay bounded over a long session; mean and max cover every frame", "[scheduler]") {
+TEST_CASE("the scheduler's samples stay bounded over a long session, mean and max cover every frame", "[scheduler]") {
   auto s = Scheduler::build({{"a", {}, {"n"}, {}, [] {}}}, fake_clock);
   REQUIRE(s.ok());
   const size_t frames = 2 * kTimingWindow + 1;

@@ -264,7 +264,7 @@ TEST_CASE("deleting a curve keeps a vertex other curves still need", "[split][de
   CHECK(face_sizes(m) == std::vector<uint32_t>{3, 4});
 }
 
-TEST_CASE("marking a curve sharp flips its flag, undoes and redoes bit for bit; the border is refused", "[split][sharp]") {
+TEST_CASE("marking a curve sharp flips its flag, undoes and redoes bit for bit, the border is refused", "[split][sharp]") {
   EditHistory h;
   Mesh m = square(&h);
   const uint32_t middle = split_square(m, h);
@@ -386,7 +386,7 @@ TEST_CASE("border edits undo and redo like every other edit", "[split][undo]") {
   CHECK(h.redo_depth() == 0);
 }
 
-TEST_CASE("a rejected edit leaves the stamps alone; undo stamps exactly what it restores", "[pools][stamps]") {
+TEST_CASE("a rejected edit leaves the stamps alone, undo stamps exactly what it restores", "[pools][stamps]") {
   EditHistory h;
   Mesh m = square(&h);
   m.begin_frame(1);

@@ -46,7 +46,7 @@ TEST_CASE("polylines are read by arc length: nearest sample or linear", "[geomet
   CHECK(sample_polyline(line, t, 0.125, Sampling::nearest) == line[0]);
 }
 
-TEST_CASE("splitting a polyline at its middle sample; a 2-point line at its midpoint", "[geometry]") {
+TEST_CASE("splitting a polyline at its middle sample, a 2-point line at its midpoint", "[geometry]") {
   const std::vector<Vec3> line{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {2, 5, 0}};
   std::vector<Vec3> a, b;
   split_polyline(line, a, b);  // parameters 0, 1/7, 2/7, 1: sample 2 is nearest to 1/2

@@ -175,7 +175,7 @@ TEST_CASE("calibration: unusable input gives a clear error", "[calibration]") {
   }
 }
 
-TEST_CASE("rig.json: doubles round-trip exactly; malformed files give clear errors", "[rig_io]") {
+TEST_CASE("rig.json: doubles round-trip exactly, malformed files give clear errors", "[rig_io]") {
   CalibrationResult rig;
   rig.cam0 = Camera{true_intrinsics(0), Eigen::Matrix3d::Identity(), Vec3::Zero()};
   const Rig truth = distorted_rig();

@@ -233,7 +233,7 @@ TEST_CASE("registration: exact points recover the rigid transform to 1e-9", "[re
   }
 }
 
-TEST_CASE("registration: residual reports the misfit; degenerate input is an error", "[registration]") {
+TEST_CASE("registration: residual reports the misfit, degenerate input is an error", "[registration]") {
   const std::vector<Vec3> model = {{0, 0, 0}, {0.1, 0, 0}, {0, 0.1, 0}, {0, 0, 0.1}};
   std::vector<Vec3> measured = model;
   measured[3].z() += 0.004;  // one point 4 mm off

@@ -52,7 +52,7 @@ TEST_CASE("static blobs are removed, a moving one is kept") {
   }
 }
 
-TEST_CASE("bad device reports are counted and skipped; the good ones are kept") {
+TEST_CASE("bad device reports are counted and skipped, the good ones are kept") {
   auto hid = [](int device, std::vector<uint8_t> bytes, bool ok = true) {
     InputEvent e;
     e.kind = EventKind::Hid;
@@ -91,7 +91,7 @@ TEST_CASE("bad device reports are counted and skipped; the good ones are kept") 
   CHECK(s.cameras[1].blobs[1][0] == Vec2(100, 200));
 }
 
-TEST_CASE("cameras are the remotes the log's device records name; the command pad is no camera") {
+TEST_CASE("cameras are the remotes the log's device records name, the command pad is no camera") {
   auto hid = [](int device, uint16_t x) {
     IrReport r;
     r.slots[0] = IrSlot{true, x, 200, 3};

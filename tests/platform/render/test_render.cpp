@@ -280,7 +280,7 @@ TEST_CASE("uploads copy only what changed and the image equals a fresh upload's"
   CHECK(context->validation_message_count() == 0);
 }
 
-TEST_CASE("samples per pixel: by device, by setting or by FIRE_SAMPLES; 4x draws the scene 1x draws") {
+TEST_CASE("samples per pixel: by device, by setting or by FIRE_SAMPLES, 4x draws the scene 1x draws") {
   auto context = make_context();
   const char* saved = std::getenv("FIRE_SAMPLES");
   const std::string restore = saved ? saved : "";

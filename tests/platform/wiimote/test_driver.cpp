@@ -287,7 +287,7 @@ TEST_CASE("a remote that cannot be opened says why") {
   CHECK_THAT(s.view(Role::Camera0).error, Catch::Contains("permission denied"));
 }
 
-TEST_CASE("a remote that never acknowledges fails in bounded time; the others run") {
+TEST_CASE("a remote that never acknowledges fails in bounded time, the others run") {
   Session s;
   s.cam0->set_never_ack(true);
   s.open();

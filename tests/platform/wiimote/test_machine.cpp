@@ -257,7 +257,7 @@ TEST_CASE("an acknowledgement with an error code counts as a failed try") {
   CHECK(h.machine.resends() == 1);
 }
 
-TEST_CASE("sensitivity levels write their blocks; the pad skips the camera") {
+TEST_CASE("sensitivity levels write their blocks, the pad skips the camera") {
   SECTION("high sensitivity") {
     Harness h(Role::Camera1, StartupOptions{.sensitivity = kHighSensitivity});
     h.light(1, 1);

@@ -248,7 +248,7 @@ TEST_CASE("fire app: strokes drawn with the mouse on a reference mesh replay bit
   fs::remove_all(dir);
 }
 
-TEST_CASE("fire app --session: every stroke on disk as it is drawn; reopened, the app goes on with it",
+TEST_CASE("fire app --session: every stroke on disk as it is drawn, reopened, the app goes on with it",
           "[app][window][session]") {
   REQUIRE(has_xvfb());
   const fs::path dir = scratch("session");
@@ -458,7 +458,7 @@ TEST_CASE("fire app: the face a stroke would split is tinted and its end's snap 
   CHECK(target_outside < 10);
 }
 
-TEST_CASE("fire app: K marks the curve under the cursor sharp, E exports the surface; both replay or reload",
+TEST_CASE("fire app: K marks the curve under the cursor sharp, E exports the surface, both replay or reload",
           "[app][window][sharp][export]") {
   REQUIRE(has_xvfb());
   const fs::path dir = scratch("sharp_export");
@@ -492,7 +492,7 @@ TEST_CASE("fire app: K marks the curve under the cursor sharp, E exports the sur
   fs::remove_all(dir);
 }
 
-TEST_CASE("fire app: an export that cannot be written says why and loses nothing; a bad format is refused",
+TEST_CASE("fire app: an export that cannot be written says why and loses nothing, a bad format is refused",
           "[app][window][export]") {
   REQUIRE(has_xvfb());
   const fs::path dir = scratch("export_fails");
