@@ -44,3 +44,16 @@ grep -q "^two.log:[0-9]*: rejected: register: 2 mark(s) touched since the last r
   fail "no rejection of the 2-mark registration naming its line: $(cat two.err)"
 grep -q "2 mark(s) touched after the last registration, not registered" two.err ||
   fail "the marks touched were not kept: $(cat two.err)"
+
+# As a session folder with the rig's copy, snapshots on the way (each holding the triangulation and the
+# registration state): reopened from its last snapshot and from its log alone, the same hash as the replay.
+"$fire" replay d.log --rig rig.json --session session --snapshot-every 4000 --hash >session.out 2>/dev/null
+[ "$(cat session.out)" = "$hash1" ] || fail "written as a session the drawing hashes to $(cat session.out), not $hash1"
+ls session/snapshot-*.fsnap >/dev/null || fail "the session holds no snapshot"
+reopened=$("$fire" replay session --hash 2>reopen.err)
+[ "$reopened" = "$hash1" ] || fail "the reopened session hashes to $reopened, not $hash1: $(cat reopen.err)"
+grep -q "snapshot after frame" reopen.err || fail "the session reopened without its snapshot: $(cat reopen.err)"
+"$fire" simulate drawing --session simulated --rig rig.json --marks-out marks2.json --object-out pawn20b.obj >/dev/null
+cmp -s marks.json simulated/marks.json || fail "the simulated session's marks.json is not the drawing's marks"
+from_folder=$("$fire" replay simulated --hash 2>/dev/null)
+[ "$from_folder" = "$hash1" ] || fail "the simulated session folder hashes to $from_folder, not $hash1"
