@@ -529,6 +529,45 @@ struct Segment {
   Vec3 from, to;   // Travel: straight line, Hold: `from`
 };
 
+// How the pen moves along a stroke: its cruising speed and its acceleration at both ends.
+struct PenMotion {
+  double speed_m_s, accel_m_s2;
+};
+
+// The pen at `time` of a timeline of strokes: where it is, whether its LED is lit, its truth record.
+SceneSample pen_at(const std::vector<Segment>& timeline, const std::vector<Polyline>& strokes, PenMotion motion,
+                   double time) {
+  const auto it = std::upper_bound(timeline.begin(), timeline.end(), time,
+                                   [](double v, const Segment& s) { return v < s.begin; });
+  const Segment& seg = *(it == timeline.begin() ? it : it - 1);
+  Vec3 p = seg.from;
+  bool lit = false;
+  double speed = 0, still = 0;
+  switch (seg.phase) {
+    case Phase::Travel: {
+      const double len = seg.end - seg.begin;
+      const double u = std::isfinite(len) && len > 0 ? std::clamp((time - seg.begin) / len, 0.0, 1.0) : 0.0;
+      p = seg.from + u * (seg.to - seg.from);
+      break;
+    }
+    case Phase::Hold:
+      lit = true;
+      still = time - seg.begin;
+      break;
+    case Phase::Move: {
+      const Polyline& path = strokes[static_cast<size_t>(seg.stroke)];
+      const auto [s, v] = SpeedProfile{path.arc.back(), motion.speed_m_s, motion.accel_m_s2}.at(time - seg.begin);
+      p = path.at(s);
+      lit = true;
+      speed = v;
+      break;
+    }
+  }
+  SceneSample out{{}, "pen", {p.x(), p.y(), p.z(), lit ? 1.0 : 0.0, speed, still}};
+  if (lit) out.lights.push_back(p);
+  return out;
+}
+
 }  // namespace
 
 Result<SimulatedRig> make_simulated_rig(const RigOptions& o) {
@@ -641,37 +680,7 @@ Result<SimulatedSession> simulate_sketch(const RigOptions& o, const SketchOption
   timeline.push_back({Phase::Travel, t, std::numeric_limits<double>::infinity(), -1, timeline.back().from,
                       timeline.back().from});
 
-  Scene scene = [&](double time) {
-    const auto it = std::upper_bound(timeline.begin(), timeline.end(), time,
-                                     [](double v, const Segment& s) { return v < s.begin; });
-    const Segment& seg = *(it == timeline.begin() ? it : it - 1);
-    Vec3 p = seg.from;
-    bool lit = false;
-    double speed = 0, still = 0;
-    switch (seg.phase) {
-      case Phase::Travel: {
-        const double len = seg.end - seg.begin;
-        const double u = std::isfinite(len) && len > 0 ? std::clamp((time - seg.begin) / len, 0.0, 1.0) : 0.0;
-        p = seg.from + u * (seg.to - seg.from);
-        break;
-      }
-      case Phase::Hold:
-        lit = true;
-        still = time - seg.begin;
-        break;
-      case Phase::Move: {
-        const Polyline& path = strokes[static_cast<size_t>(seg.stroke)];
-        const auto [s, v] = SpeedProfile{path.arc.back(), sk.speed_m_s, kAccel}.at(time - seg.begin);
-        p = path.at(s);
-        lit = true;
-        speed = v;
-        break;
-      }
-    }
-    SceneSample out{{}, "pen", {p.x(), p.y(), p.z(), lit ? 1.0 : 0.0, speed, still}};
-    if (lit) out.lights.push_back(p);
-    return out;
-  };
+  Scene scene = [&](double time) { return pen_at(timeline, strokes, PenMotion{sk.speed_m_s, kAccel}, time); };
   std::vector<InputEvent> header = common_header("sketch", o);
   add_meta(header, "mesh", sk.mesh_name + " height_m=" + format_double(sk.height_m));
   add_meta(header, "sketch", "strokes=" + std::to_string(strokes.size()) + " speed_m_s=" + format_double(sk.speed_m_s) +
@@ -1130,37 +1139,7 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
                                      [](double v, const std::pair<double, int>& p) { return v < p.first; });
     return poses[static_cast<size_t>(std::prev(it)->second)];
   };
-  Scene scene = [&](double time) {
-    const auto it = std::upper_bound(timeline.begin(), timeline.end(), time,
-                                     [](double v, const Segment& s) { return v < s.begin; });
-    const Segment& seg = *(it == timeline.begin() ? it : it - 1);
-    Vec3 p = seg.from;
-    bool lit = false;
-    double speed = 0, still = 0;
-    switch (seg.phase) {
-      case Phase::Travel: {
-        const double len = seg.end - seg.begin;
-        const double u = std::isfinite(len) && len > 0 ? std::clamp((time - seg.begin) / len, 0.0, 1.0) : 0.0;
-        p = seg.from + u * (seg.to - seg.from);
-        break;
-      }
-      case Phase::Hold:
-        lit = true;
-        still = time - seg.begin;
-        break;
-      case Phase::Move: {
-        const Polyline& path = strokes[static_cast<size_t>(seg.stroke)];
-        const auto [s, v] = SpeedProfile{path.arc.back(), d.speed_m_s, kAccel}.at(time - seg.begin);
-        p = path.at(s);
-        lit = true;
-        speed = v;
-        break;
-      }
-    }
-    SceneSample out{{}, "pen", {p.x(), p.y(), p.z(), lit ? 1.0 : 0.0, speed, still}};
-    if (lit) out.lights.push_back(p);
-    return out;
-  };
+  Scene scene = [&](double time) { return pen_at(timeline, strokes, PenMotion{d.speed_m_s, kAccel}, time); };
   const Occluded occluded = [&](double time, const Vec3& light, const Vec3& centre) { return hidden(pose_at(time), light, centre); };
   std::vector<InputEvent> header = common_header("drawing", o);
   add_meta(header, "mesh", d.mesh_name + " height_m=" + format_double(d.height_m));
