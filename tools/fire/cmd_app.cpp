@@ -530,11 +530,11 @@ void add_app_commands(CLI::App& app, Registry& registry) {
   for (const std::string& k : kKeys) keys += "  " + k + "\n";
   cmd->footer(
       "Opens a window (GLFW) drawn with Vulkan (lavapipe without a GPU) and a HUD: frame time, per-system "
-      "timings, counts, the sketch mode, the last rejected edit. NET (.fnet) is a network to continue from; "
-      "any other file is an input log, replayed first. The systems run at the scheduler's fixed step "
+      "timings, counts, the sketch mode, the last rejected edit. INPUT is a session folder to go on with, a "
+      "network (.fnet) to continue from, or an input log, replayed first. The systems run at the scheduler's fixed step "
       "(10 ms of log time) as the wall clock advances; vsync paces the display. Edits made with keys are "
-      "commands appended to the session's input log, so `fire replay` of the --record log reproduces the "
-      "session bit for bit. Needs a display (DISPLAY or WAYLAND_DISPLAY); without one it exits 1 and points "
+      "commands appended to the session's input log, so `fire replay` of the --session folder or of the "
+      "--record log reproduces the session bit for bit. Needs a display (DISPLAY or WAYLAND_DISPLAY); without one it exits 1 and points "
       "to `fire render`. On exit prints one JSON line: display_frames, system_frames, events, edges, faces, "
       "surface_quads, hash (as `fire replay --hash`), device, validation. FIRE_VK_VALIDATION=1 turns the "
       "validation layer on; any message then fails the command. While a stroke is drawn, the face it would split "
@@ -568,7 +568,8 @@ void add_app_commands(CLI::App& app, Registry& registry) {
   cmd->add_option("--export", a->export_path,
                   "where E exports the surface; the extension chooses the format: .obj, .ply, .stl or .glb "
                   "(default: the -o network's path with .obj)");
-  cmd->add_option("--record", a->record_path, "write the session's input log here on exit (not with a .fnet input)");
+  cmd->add_option("--record", a->record_path, "write the session's input log here on exit (not with a .fnet input, nor with a session folder, whose "
+                  "input.log is the record)");
   cmd->add_option("--size", a->size, "window size WIDTHxHEIGHT in pixels")->capture_default_str();
   cmd->add_option("--levels", a->levels, "Catmull-Clark levels of the surface (1 to 6)")->capture_default_str();
   cmd->add_option("--script", a->script_path,
