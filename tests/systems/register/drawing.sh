@@ -3,17 +3,25 @@
 # its K = 2 network through the simulated rig; the replay with the calibrated (not the true) rig gives the
 # whole network and a surface within 0.005 of the diagonal of the pawn's limit surface, the same hash twice;
 # and a registration on 2 marks is rejected in words, the replay going on.
-#   drawing.sh FIRE_BINARY WORK_DIR
+#   drawing.sh FIRE_BINARY WORK_DIR [whole | first-strokes]
+# first-strokes (the sanitizer build): the first 40 strokes only, without the checks that need the whole
+# network (its counts, the second registration, the rms against the pawn).
 set -euo pipefail
 fire="$1"
 dir="$2"
+extent="${3:-whole}"
+case "$extent" in
+  whole) strokes=() ;;
+  first-strokes) strokes=(--max-strokes 40) ;;
+  *) echo "drawing.sh: extent must be whole or first-strokes, not '$extent'" >&2; exit 2 ;;
+esac
 rm -rf "$dir"
 mkdir -p "$dir"
 cd "$dir"
 fail() { echo "FAIL: $*" >&2; exit 1; }
 field() { sed -n "s/.*\"$1\":\([-+0-9.eE]*\)[,}].*/\1/p" <<<"$2"; }
 
-"$fire" simulate drawing -o d.log --marks-out marks.json --object-out pawn20.obj >sim.json
+"$fire" simulate drawing "${strokes[@]}" -o d.log --marks-out marks.json --object-out pawn20.obj >sim.json
 "$fire" simulate wand -o w.log >/dev/null
 "$fire" calibrate w.log -o rig.json >/dev/null
 grep -q '"marks": \[' marks.json || fail "marks.json lists no marks: $(cat marks.json)"
@@ -24,18 +32,22 @@ grep -q '"marks": \[' marks.json || fail "marks.json lists no marks: $(cat marks
 "$fire" replay d.log --rig rig.json -o net.fnet --surface d.obj --hash --timings >first.out 2>replay.err
 "$fire" replay d.log --rig rig.json -o net2.fnet --surface d2.obj --hash --timings >second.out 2>/dev/null
 ! grep -q rejected replay.err || fail "strokes rejected: $(grep rejected replay.err | head -3)"
-grep -q "registration 2 (line [0-9]*): [3-6] marks" replay.err || fail "the object was not registered again: $(cat replay.err)"
-grep -q "^vertices 169 edges 324 faces 156 " first.out || fail "not the pawn's K = 2 network: $(grep vertices first.out)"
+if [ "$extent" = whole ]; then
+  grep -q "registration 2 (line [0-9]*): [3-6] marks" replay.err || fail "the object was not registered again: $(cat replay.err)"
+  grep -q "^vertices 169 edges 324 faces 156 " first.out || fail "not the pawn's K = 2 network: $(grep vertices first.out)"
+fi
 hash1=$(grep -E '^[0-9a-f]{16}$' first.out)
 hash2=$(grep -E '^[0-9a-f]{16}$' second.out)
 [ -n "$hash1" ] && [ "$hash1" = "$hash2" ] || fail "two replays of one log hash to $hash1 and $hash2"
 cmp -s net.fnet net2.fnet || fail "two replays of one log write different networks"
 
-eval_out=$("$fire" eval d.obj --reference pawn20.obj --network net.fnet)
-rms=$(field rms "$eval_out")
-awk -v r="$rms" 'BEGIN {exit !(r > 0 && r <= 0.005)}' || fail "rms $rms of the diagonal, at most 0.005 wanted: $eval_out"
 echo "drawing: $(cat sim.json)"
-echo "eval: $eval_out"
+if [ "$extent" = whole ]; then
+  eval_out=$("$fire" eval d.obj --reference pawn20.obj --network net.fnet)
+  rms=$(field rms "$eval_out")
+  awk -v r="$rms" 'BEGIN {exit !(r > 0 && r <= 0.005)}' || fail "rms $rms of the diagonal, at most 0.005 wanted: $eval_out"
+  echo "eval: $eval_out"
+fi
 
 # The first registration with its third mark left out: 2 marks, rejected in words, the log replays on.
 awk '/ cmd mark / && ++n == 3 {next} {print} / cmd register$/ {exit}' d.log >two.log
@@ -53,7 +65,7 @@ ls session/snapshot-*.fsnap >/dev/null || fail "the session holds no snapshot"
 reopened=$("$fire" replay session --hash 2>reopen.err)
 [ "$reopened" = "$hash1" ] || fail "the reopened session hashes to $reopened, not $hash1: $(cat reopen.err)"
 grep -q "snapshot after frame" reopen.err || fail "the session reopened without its snapshot: $(cat reopen.err)"
-"$fire" simulate drawing --session simulated --rig rig.json --marks-out marks2.json --object-out pawn20b.obj >/dev/null
+"$fire" simulate drawing "${strokes[@]}" --session simulated --rig rig.json --marks-out marks2.json --object-out pawn20b.obj >/dev/null
 cmp -s marks.json simulated/marks.json || fail "the simulated session's marks.json is not the drawing's marks"
 from_folder=$("$fire" replay simulated --hash 2>/dev/null)
 [ "$from_folder" = "$hash1" ] || fail "the simulated session folder hashes to $from_folder, not $hash1"
