@@ -286,14 +286,17 @@ Result<ReopenedSession> reopen_session(const std::string& dir, Scheduler::Clock 
   auto contents = read_session(dir);
   if (!contents) return Result<ReopenedSession>::failure(contents.error());
   const SessionContents& c = *contents;
+  // The rig is read and checked against the log's remotes (a decode of every report) once, not per world.
+  std::optional<TrackingRig> rig;
+  if (!c.rig.empty()) {
+    Result<TrackingRig> read = tracking_rig_from_json(c.rig, c.paths.rig(), c.log.log, c.paths.log());
+    if (!read) return Result<ReopenedSession>::failure(read.error());
+    rig = *read;
+  }
   auto fresh = [&] {
     auto w = std::make_unique<World>();
     Status s = apply_settings_json(c.settings, c.paths.settings(), *w);
-    if (s && !c.rig.empty()) {
-      Result<TrackingRig> rig = tracking_rig_from_json(c.rig, c.paths.rig(), c.log.log, c.paths.log());
-      if (rig) set_rig(*w, *rig);
-      else s = Status::failure(rig.error());
-    }
+    if (rig) set_rig(*w, *rig);
     return std::make_pair(std::move(w), s);
   };
   if (Status s = fresh().second; !s) return Result<ReopenedSession>::failure(s.error);
