@@ -63,7 +63,8 @@ struct ReportCounts {
   size_t unknown_device = 0;      // devices that are no camera: not 0 or 1 in a log without device records,
                                   // or with no camera role in the log's `meta device` records
   size_t pad_reports = 0;         // reports of the command pad (role `pad` in `meta device`): no camera data
-  size_t bad_device_records = 0;  // `meta device` records that do not read as D ADDRESS ROLE PRODUCT
+  size_t bad_device_records = 0;  // `meta device` records that do not read as D ADDRESS ROLE PRODUCT, or whose
+                                  // product is no Wii Remote's (0306, 0330): their device is no camera
   size_t out_of_range_slots = 0;  // blobs with impossible coordinates, dropped from kept reports
   size_t rejected_reports() const { return garbled + bad_length + unknown_id + unknown_device; }
 };

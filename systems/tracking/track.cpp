@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cctype>
 #include <map>
 #include <sstream>
 #include <cmath>
@@ -122,16 +123,27 @@ namespace {
 
 constexpr int kPad = -2, kNoRole = -1;
 
-// A `meta device` record's device number and role (camera index, kPad), or nothing when it does not read.
-std::optional<std::pair<int, int>> device_record(const std::string& text, std::string& address) {
+// A Wii Remote's USB product id (vendor 057E): the original, and the Wii Remote Plus.
+bool wii_remote_product(std::string product) {
+  for (char& c : product) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return product == "0306" || product == "0330";
+}
+
+// A `meta device` record's device number and role (camera index, kPad, or kNoRole for a record that names
+// a device but no role or product of a Wii Remote), or nothing when not even its device number reads.
+std::optional<std::pair<int, int>> device_record(const std::string& text, std::string& address, bool& good) {
   std::istringstream in(text);
   long device = -1;
   std::string role, product;
-  if (!(in >> device >> address >> role >> product) || device < 0 || device > 1'000'000) return std::nullopt;
+  good = false;
+  if (!(in >> device) || device < 0 || device > 1'000'000) return std::nullopt;
+  if (!(in >> address >> role >> product) || !wii_remote_product(product)) return std::pair{int(device), kNoRole};
+  good = true;
   if (role == "camera0") return std::pair{int(device), 0};
   if (role == "camera1") return std::pair{int(device), 1};
   if (role == "pad") return std::pair{int(device), kPad};
-  return std::nullopt;
+  good = false;
+  return std::pair{int(device), kNoRole};
 }
 
 }  // namespace
@@ -179,13 +191,17 @@ std::optional<CameraReport> DeviceDecoder::read(const InputEvent& e) {
   ReportCounts& c = counts;
   if (e.kind == EventKind::Meta && e.name == "device") {
     std::string address;
-    const auto record = device_record(e.text, address);
-    if (!record) {
-      ++c.bad_device_records;
-      return std::nullopt;
-    }
+    bool good = false;
+    const auto record = device_record(e.text, address, good);
+    if (!good) ++c.bad_device_records;
+    if (!record) return std::nullopt;
     has_records_ = true;
     const auto [device, role] = *record;
+    // A device the log does not say is a Wii Remote with a role is no camera, whatever it was before.
+    if (role == kNoRole) {
+      role_of_[device] = kNoRole;
+      return std::nullopt;
+    }
     // A device number now taken by another role, or a role now held by another device, is given up.
     for (auto& [d, r] : role_of_)
       if (d != device && r == role) r = kNoRole;

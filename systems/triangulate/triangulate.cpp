@@ -15,6 +15,7 @@ using tracking::PenSample;
 constexpr double kNominalPeriodUs = 10'000;  // the remotes report at 100 Hz; the gaps say it better once seen
 constexpr size_t kPeriodGaps = 63;           // arrival gaps the period is the median of
 constexpr size_t kMinPeriodGaps = 8;
+constexpr double kRateTolerance = 1.25;        // a report rate outside 80 to 125 Hz is said in words
 constexpr double kPendingTimeout = 1.5;      // periods after which no later report can renumber the waiting ones
 // Camera 1 has not reported an instant this long after it (a lost report, latency and the wait for the
 // next report included): triangulate without it.
@@ -372,10 +373,21 @@ std::vector<std::string> describe_device_problems(const TriangulateState& s) {
   say(c.unknown_id, "device report(s) with an unknown report id: skipped");
   say(c.unknown_device, "report(s) from a device the log names as no camera: skipped");
   say(c.out_of_range_slots, "IR blob(s) outside the camera's 1024 x 768 pixels: dropped");
-  say(c.bad_device_records, "device record(s) that do not read: ignored");
+  say(c.bad_device_records, "device record(s) that do not read as D ADDRESS ROLE PRODUCT or name a product that is no Wii "
+                            "Remote's (0306, 0330): their device's reports skipped");
   say(s.out_of_order, "report(s) stamped earlier than their remote's previous report (time going backwards): dropped");
   say(s.duplicated, "report(s) repeating their remote's previous report at the same instant (sent twice, or held "
                     "and sent with the next): kept");
+  for (int k = 0; k < 2; ++k) {
+    const CameraWindow& w = s.cameras[size_t(k)];
+    // The median of recent arrival gaps: bursts and jitter leave it at a remote's 100 Hz.
+    if (w.gaps_us.size() >= kMinPeriodGaps && (w.period_us < kNominalPeriodUs / kRateTolerance ||
+                                               w.period_us > kNominalPeriodUs * kRateTolerance)) {
+      out.push_back("camera " + std::to_string(k) + " reports at " + std::to_string(std::lround(1e6 / w.period_us)) +
+                    " Hz, far from the 100 Hz of a Wii Remote streaming IR (a weak Bluetooth link, or not a remote): "
+                    "its pen positions are less certain");
+    }
+  }
   for (int k = 0; k < 2; ++k)
     say(s.silences[size_t(k)], std::string("time(s) camera ") + char('0' + k) + " stopped reporting for more than 0.5 s" +
                                    (s.silent[size_t(k)] ? " (silent at the end)" : ""));

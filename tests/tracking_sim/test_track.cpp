@@ -133,6 +133,16 @@ TEST_CASE("cameras are the remotes the log's device records name, the command pa
   CHECK(s.counts.unknown_device == 1);
   CHECK(s.counts.rejected_reports() == 1);
 
+  // A device whose record names a product that is no Wii Remote's does not take the role it claims.
+  const DeviceStreams keyboard = decode_device_streams(std::vector<InputEvent>{
+      device("0 00:1F:32:AA:BB:01 camera0 0306"), device("1 00:1F:32:AA:BB:02 camera1 0330"),
+      device("2 00:1F:32:AA:BB:07 camera0 c31c"), hid(2, 50), hid(0, 10), hid(1, 20)});
+  REQUIRE(keyboard.cameras[0].size() == 1);
+  CHECK(keyboard.cameras[0].blobs[0][0].x() == 10);
+  CHECK(keyboard.camera_address[0] == "00:1F:32:AA:BB:01");
+  CHECK(keyboard.counts.bad_device_records == 1);
+  CHECK(keyboard.counts.unknown_device == 1);
+
   // A log without device records (the simulator's): devices 0 and 1 are cameras 0 and 1.
   const DeviceStreams bare = decode_device_streams(std::vector<InputEvent>{hid(0, 10), hid(1, 20), hid(2, 30)});
   REQUIRE(bare.cameras[0].size() == 1);
