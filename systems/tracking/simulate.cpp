@@ -1163,7 +1163,9 @@ SessionTruth read_session_truth(std::span<const InputEvent> events) {
     return std::all_of(v.begin(), v.end(), [](double d) { return std::isfinite(d); });
   };
   auto device_of = [](double d) { return d == 0.0 ? 0 : d == 1.0 ? 1 : -1; };
+  std::array<uint32_t, 2> report_line{};  // each device's latest report: a pen truth follows its report
   for (const InputEvent& e : events) {
+    if (e.kind == EventKind::Hid && (e.device == 0 || e.device == 1)) report_line[size_t(e.device)] = e.line;
     if (e.kind == EventKind::Truth) {
       const std::vector<double>& v = e.values;
       const int d = v.empty() ? -1 : device_of(v[0]);
@@ -1190,7 +1192,7 @@ SessionTruth read_session_truth(std::span<const InputEvent> events) {
           ++truth.rejected_lines;
           continue;
         }
-        truth.pen.push_back({d, e.t_us, Vec3(v[2], v[3], v[4]), v[5] != 0.0, v[6], v[7]});
+        truth.pen.push_back({d, e.t_us, report_line[size_t(d)], Vec3(v[2], v[3], v[4]), v[5] != 0.0, v[6], v[7]});
       }
     } else if (e.kind == EventKind::Meta) {
       if (e.name == "nominal_intrinsics") {
@@ -1272,8 +1274,15 @@ Result<PenAccuracy> evaluate_pen_accuracy(const PenTrack& track, const SessionTr
   PenAccuracy acc;
   for (const PenSample& s : track.samples) {
     const int64_t key = s.cam0_arrival_us;
-    const auto it = std::lower_bound(by_time.begin(), by_time.end(), key,
-                                     [](const PenTruth* p, int64_t t) { return p->t_us < t; });
+    auto it = std::lower_bound(by_time.begin(), by_time.end(), key,
+                               [](const PenTruth* p, int64_t t) { return p->t_us < t; });
+    // Reports delivered together (a burst) share their arrival: their lines in the log tell them apart.
+    if (s.cam0_line != 0)
+      for (auto same = it; same != by_time.end() && (*same)->t_us == key; ++same)
+        if ((*same)->report_line == s.cam0_line) {
+          it = same;
+          break;
+        }
     if (it == by_time.end() || (*it)->t_us != key) {
       ++acc.unmatched;
       continue;

@@ -161,6 +161,7 @@ Result<SimulatedSession> simulate_sketch(const RigOptions& rig, const SketchOpti
 struct PenTruth {
   int device = 0;
   int64_t t_us = 0;  // the report's logged arrival time (the key to match a report)
+  uint32_t report_line = 0;  // the line of the report it follows in the log (reports of a burst share t_us)
   Vec3 position = Vec3::Zero();
   bool lit = false;
   double speed_m_s = 0;

@@ -303,8 +303,12 @@ FrameNumbering::Line FrameNumbering::line() const {
 
 double FrameNumbering::instant(double number) const { return line().at(number); }
 
-double FrameNumbering::settle(std::span<const double> waiting) {
+double FrameNumbering::settle(std::span<const double> waiting, double previous_arrival) {
   const size_t m = std::min(waiting.size(), kLookahead + 1);
+  // Reports delivered at one instant are consecutive frames (Bluetooth held the earlier ones back and
+  // sent them with the last), and only the last one's arrival says when: the others' arrivals are late
+  // by a period or more, not jitter.
+  auto held = [&](size_t i) { return i + 1 < m && waiting[i] == waiting[i + 1]; };
   double number = 0;
   if (!trailing.empty()) {
     const double previous = trailing.back()[0];
@@ -323,12 +327,13 @@ double FrameNumbering::settle(std::span<const double> waiting) {
     cost[0] = 0;
     for (size_t i = 0; i < m; ++i) {
       std::fill(next.begin(), next.end(), std::numeric_limits<double>::infinity());
+      const bool with_previous = i == 0 ? waiting[0] == previous_arrival : held(i - 1);
       for (int d = 0; d <= max_skip; ++d) {
         if (!std::isfinite(cost[size_t(d)])) continue;
-        for (int step = 0; step <= kMaxLostInARow && d + step <= max_skip; ++step) {
+        for (int step = 0; step <= (with_previous ? 0 : kMaxLostInARow) && d + step <= max_skip; ++step) {
           const double n = previous + static_cast<double>(i + 1) + d + step;
           const double miss = (waiting[i] - (line0 + slope * n)) / sigma;
-          const double c = cost[size_t(d)] + misfit_cost(miss) + kLostPenalty * step;
+          const double c = cost[size_t(d)] + (held(i) ? 0.0 : misfit_cost(miss)) + kLostPenalty * step;
           if (c < next[size_t(d + step)]) {
             next[size_t(d + step)] = c;
             from[i][size_t(d + step)] = d;
@@ -340,17 +345,23 @@ double FrameNumbering::settle(std::span<const double> waiting) {
     int d = static_cast<int>(std::min_element(cost.begin(), cost.end()) - cost.begin());
     for (size_t i = m; i-- > 1;) d = from[i][size_t(d)];
     number = previous + 1 + d;
+    // A held report's arrival would widen the jitter.
+    if (held(0)) return record(number, waiting[0]);
     residuals.push_back(std::abs(waiting[0] - (line0 + slope * number)));
     if (residuals.size() > kJitterWindow) residuals.pop_front();
   }
-  trailing.push_back({number, waiting[0]});
+  return record(number, waiting[0]);
+}
+
+double FrameNumbering::record(double number, double arrival) {
+  trailing.push_back({number, arrival});
   if (trailing.size() > kClockWindow) trailing.pop_front();
   count += 1;
-  const double dn = number - mean_n, dt = waiting[0] - mean_t;
+  const double dn = number - mean_n, dt = arrival - mean_t;
   mean_n += dn / count;
   mean_t += dt / count;
   cnn += dn * (number - mean_n);
-  cnt += dn * (waiting[0] - mean_t);
+  cnt += dn * (arrival - mean_t);
   return number;
 }
 
@@ -365,22 +376,31 @@ void fit_frame_clock(CameraFrames& f) {
   for (size_t k = 0; k < n; ++k) arrivals[k] = arrival(k);
   FrameNumbering numbering;
   for (size_t k = 0; k < n; ++k)
-    number[k] = numbering.settle(std::span<const double>(arrivals).subspan(k, std::min(n - k, FrameNumbering::kLookahead + 1)));
-  // Per report, the least-squares line t = a + b n through its neighbours on both sides.
+    number[k] = numbering.settle(std::span<const double>(arrivals).subspan(k, std::min(n - k, FrameNumbering::kLookahead + 1)),
+                                 k > 0 ? arrivals[k - 1] : std::numeric_limits<double>::quiet_NaN());
+  // Per report, the least-squares line t = a + b n through its neighbours on both sides, leaving out
+  // the arrivals of reports held back and delivered with the next (FrameNumbering::settle).
+  std::vector<uint8_t> held(n, 0);
+  for (size_t k = 0; k + 1 < n; ++k) held[k] = arrivals[k] == arrivals[k + 1];
   constexpr ptrdiff_t kHalfWindow = 200;  // +-2 s: long enough to average the jitter, short for slow drift
   for (ptrdiff_t k = 0; k < static_cast<ptrdiff_t>(n); ++k) {
     const auto lo = static_cast<size_t>(std::max<ptrdiff_t>(0, k - kHalfWindow));
     const auto hi = static_cast<size_t>(std::min<ptrdiff_t>(static_cast<ptrdiff_t>(n) - 1, k + kHalfWindow));
-    double mean_n = 0, mean_t = 0;
+    double mean_n = 0, mean_t = 0, count = 0;
+    for (size_t i = lo; i <= hi; ++i) count += held[i] ? 0 : 1;
+    // A window of reports all stamped alike (no real remote's) keeps them all.
+    const bool skip_held = count >= 2;
+    if (!skip_held) count = static_cast<double>(hi - lo + 1);
     for (size_t i = lo; i <= hi; ++i) {
+      if (skip_held && held[i]) continue;
       mean_n += number[i];
       mean_t += arrivals[i];
     }
-    const double count = static_cast<double>(hi - lo + 1);
     mean_n /= count;
     mean_t /= count;
     double snn = 0, snt = 0;
     for (size_t i = lo; i <= hi; ++i) {
+      if (skip_held && held[i]) continue;
       snn += (number[i] - mean_n) * (number[i] - mean_n);
       snt += (number[i] - mean_n) * (arrivals[i] - mean_t);
     }

@@ -92,9 +92,10 @@ DeviceStreams decode_device_streams(std::span<const InputEvent> events);
 struct FrameNumbering {
   static constexpr size_t kLookahead = 5;  // reports after the oldest that settle its number
 
-  // Settles the number of waiting[0], given the reports after it (up to kLookahead are used), records it
-  // and returns it. The first report is number 0.
-  double settle(std::span<const double> waiting);
+  // Settles the number of waiting[0], given the reports after it (up to kLookahead are used) and the
+  // arrival of the report settled before it (NaN: none), records it and returns it. The first report is
+  // number 0.
+  double settle(std::span<const double> waiting, double previous_arrival);
   // The clock's instant of frame `number`, on the arrivals' axis.
   double instant(double number) const;
 
@@ -108,6 +109,9 @@ struct FrameNumbering {
   std::deque<std::array<double, 2>> trailing;  // (number, arrival) of the last 400 settled reports
   double count = 0, mean_n = 0, mean_t = 0, cnn = 0, cnt = 0;  // running moments of every settled report
   std::deque<double> residuals;               // |arrival - line| of the last 101: the jitter
+
+ private:
+  double record(double number, double arrival);
 };
 
 // Replaces arrival jitter by the remote's regular clock: frame numbers as FrameNumbering settles
@@ -221,6 +225,7 @@ struct PenSample {
   int64_t t_us = 0;         // camera 0's frame instant, rounded
   uint32_t stroke = 0;
   int64_t cam0_arrival_us = 0;  // arrival time of the camera 0 report it came from, as logged
+  uint32_t cam0_line = 0;       // ... and its line in the log (0: not from a file)
   Vec3 raw = Vec3::Zero();       // triangulated, in the rig's frame (camera 0's), metres
   Vec3 filtered = Vec3::Zero();  // after the One Euro filter
   double reprojection_px = 0;

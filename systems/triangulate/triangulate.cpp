@@ -62,7 +62,9 @@ void fix_oldest(CameraWindow& w, int camera, TriangulateState& state, const Trac
   std::array<double, tracking::FrameNumbering::kLookahead + 1> arrivals;
   const size_t m = std::min(w.waiting.size(), arrivals.size());
   for (size_t i = 0; i < m; ++i) arrivals[i] = static_cast<double>(w.waiting[i].t_us - w.origin_us);
-  const double number = w.clock.settle(std::span<const double>(arrivals.data(), m));
+  const double previous = w.frames.size() > 0 ? static_cast<double>(w.frames.t_us.back() - w.origin_us)
+                                              : std::numeric_limits<double>::quiet_NaN();
+  const double number = w.clock.settle(std::span<const double>(arrivals.data(), m), previous);
   w.waiting.pop_front();
   double t_frame = static_cast<double>(w.origin_us) + w.clock.instant(number);
   CameraFrames& f = w.frames;
@@ -256,7 +258,7 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
   }
   out.push_back(pen_event(t_us, f0.line[k], EventKind::Pen, *smooth));
   if (samples)
-    samples->push_back({t_us, s.counts.strokes - 1, f0.t_us[k], tri.X, *smooth,
+    samples->push_back({t_us, s.counts.strokes - 1, f0.t_us[k], f0.line[k], tri.X, *smooth,
                         tri.reprojection_error_px});
   s.both_lost += s.lost_now;
   s.lost_now = false;

@@ -158,22 +158,31 @@ TEST_CASE("a 12 s wand session with a 2 % focal error and a 5 ms clock offset ca
 
 TEST_CASE("a wand session with Bluetooth bursts calibrates as well as one without") {
   // 10 % of the reports held back and delivered with the next one: numbering them as the frames after a
-  // lost report put camera 0's and camera 1's instants a period apart, and this calibration at 0.80 px.
-  RigOptions rig;
-  rig.seed = 3;
-  rig.rig_seed = 3;
-  rig.burst = 0.1;
-  Result<SimulatedSession> wand = simulate_wand(rig, WandOptions{.duration_s = 20, .length_m = 0.3});
-  REQUIRE(wand.ok());
-  const InputLog log = through_text(wand->events);
-  const SessionTruth truth = read_session_truth(log.events);
-  CalibrationOptions options{.nominal0 = truth.nominal[0], .nominal1 = truth.nominal[1],
-                             .wand_length_m = truth.wand_length_m, .max_iterations = 100};
-  Result<WandCalibration> cal = calibrate_wand_streams(decode_device_streams(log.events), options);
-  REQUIRE(cal.ok());
-  CHECK(cal->rig.reprojection_rms_px < 0.35);
-  // The held reports still pull the clock offset: 0.37 ms off here (0.3 ms is the bound without bursts).
-  CHECK(std::abs(cal->time_offset_used_us - rig.clock_offset_ms * 1e3) < 500.0);
+  // lost report put camera 0's and camera 1's instants a period apart (0.80 px at 0.3 ms of jitter);
+  // using a held report's arrival as a measurement of its frame still gave 0.93 px at 4 ms.
+  // Bounds: 0.3 ms gives 0.23 px and 22 us; 4 ms, 0.35 px and 0.44 ms here (a 20 s wand; the 60 s one of
+  // perf/tracking_jitter.sh gives 0.24 px).
+  struct Case {
+    double jitter_ms, max_px, max_offset_error_us;
+  };
+  for (const auto [jitter_ms, max_px, max_offset_error_us] : {Case{0.3, 0.3, 100}, Case{4.0, 0.45, 1000}}) {
+    CAPTURE(jitter_ms);
+    RigOptions rig;
+    rig.seed = 3;
+    rig.rig_seed = 3;
+    rig.burst = 0.1;
+    rig.jitter_ms = jitter_ms;
+    Result<SimulatedSession> wand = simulate_wand(rig, WandOptions{.duration_s = 20, .length_m = 0.3});
+    REQUIRE(wand.ok());
+    const InputLog log = through_text(wand->events);
+    const SessionTruth truth = read_session_truth(log.events);
+    CalibrationOptions options{.nominal0 = truth.nominal[0], .nominal1 = truth.nominal[1],
+                               .wand_length_m = truth.wand_length_m, .max_iterations = 100};
+    Result<WandCalibration> cal = calibrate_wand_streams(decode_device_streams(log.events), options);
+    REQUIRE(cal.ok());
+    CHECK(cal->rig.reprojection_rms_px < max_px);
+    CHECK(std::abs(cal->time_offset_used_us - rig.clock_offset_ms * 1e3) < max_offset_error_us);
+  }
 }
 
 TEST_CASE("a short sketch session tracks within a millimetre or two") {
