@@ -3,8 +3,9 @@
 // frame by frame, recorded as a session folder (engine/SESSION.md) as it goes.
 //
 // The frame loop takes from the log writer the events stamped before `now - kLiveLagUs` and runs every
-// frame that ends by then. Past that instant the writer stamps nothing: a report handed in later is
-// stamped at it (LogWriter::take_before), so each frame's events are final when it runs. What the frames
+// frame that ends by then. From then on the writer stamps nothing before that instant: a report read
+// earlier but handed in later is stamped at it (LogWriter::take_before), so each frame's events are
+// final when it runs. What the frames
 // do depends only on those events, and the session folder's input.log holds them in the same order with
 // the same stamps: replaying the folder (reopen_session, `fire replay DIR`) gives the live world's hash.
 #include <cstdint>
