@@ -31,3 +31,9 @@ if "$fire" calibrate --live --fake-rig 7 --session live -o x.json 2>again.err; t
 grep -q "live" again.err || fail "the used folder is not named: $(cat again.err)"
 if "$fire" calibrate --live --fake-rig 7 --session other --max-seconds nan -o x.json 2>nan.err; then fail "--max-seconds nan accepted"; fi
 grep -q "max-seconds must be" nan.err || fail "no word on --max-seconds: $(cat nan.err)"
+# Without remotes (no --fake-rig; this machine has none, or they are not cameras) no folder is left behind.
+if "$fire" calibrate --live --session none --max-seconds 1 -o x.json 2>none.err </dev/null; then
+  echo "calibrate --live found remotes here: the no-remote case is not checked"
+else
+  [ ! -e none ] || fail "a failed --live start left the folder none: $(cat none.err)"
+fi

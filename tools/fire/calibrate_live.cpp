@@ -124,11 +124,6 @@ bool cameras_running(const wiimote::Driver& driver) {
 
 Result<std::vector<InputEvent>> record_live_wand(const LiveWandOptions& o) {
   using R = Result<std::vector<InputEvent>>;
-  World world;  // no rig yet: the frames carry the reports to the log and nothing draws
-  auto out = SessionWriter::create(o.session_dir, settings_json(world));
-  if (!out) return R::failure(out.error());
-  Scheduler scheduler = make_scheduler(world, [] { return int64_t{0}; });
-
   std::optional<SimulatedWand> wand;
   wiimote::ManualClock manual;
   std::unique_ptr<wiimote::Backend> backend;
@@ -165,6 +160,12 @@ Result<std::vector<InputEvent>> record_live_wand(const LiveWandOptions& o) {
     return R::failure("--live needs two Wii Remotes as cameras and found " + std::to_string(cameras) +
                       " (fire devices lists what this machine sees)");
 
+  // The folder is made once the cameras are there, so a failed start leaves none behind; the log writer
+  // holds what arrived meanwhile.
+  World world;  // no rig yet: the frames carry the reports to the log and nothing draws
+  auto out = SessionWriter::create(o.session_dir, settings_json(world));
+  if (!out) return R::failure(out.error());
+  Scheduler scheduler = make_scheduler(world, [] { return int64_t{0}; });
   LiveSession live(world, scheduler, log, *out);
   std::vector<InputEvent> events;
   WandCoverage coverage;
