@@ -226,7 +226,8 @@ bool Driver::step(Link& link, int read_timeout_ms) {
   std::optional<int> objects;
   // hidapi never returns an empty report (0 bytes is its timeout); the log cannot hold one either.
   if (r.status == ReadStatus::Report && !r.report.empty()) {
-    log_.hid(device, r.report);
+    // Stamped with when the read returned, not when the log's lock was free (a live log keeps its order).
+    log_.hid(device, r.report, now);
     link.machine.on_report(r.report, now, out);
     if (is_camera(link.role) && link.machine.state() == MachineState::Running) objects = ir_object_count(r.report);
   }

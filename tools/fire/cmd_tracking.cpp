@@ -18,6 +18,7 @@
 #include "systems/tracking/simulate.hpp"
 #include "systems/tracking/track.hpp"
 #include "systems/triangulate/triangulate.hpp"
+#include "tools/fire/calibrate_live.hpp"
 #include "tools/fire/commands.hpp"
 #include "tools/fire/session_rig.hpp"
 #include "tools/fire/session_store.hpp"
@@ -255,12 +256,33 @@ struct CalibrateArgs {
   std::string log_path, out_path;
   std::optional<double> wand_length_m;
   int max_iterations = 100;
+  bool live = false;
+  LiveWandOptions live_options;
 };
+
+// The wand's reports: the log or folder given, or (--live) those the remotes send now, recorded.
+Result<InputLog> wand_log(const CalibrateArgs& a, std::vector<std::string>& notes) {
+  if (!a.live) return read_log_or_session(a.log_path, notes);
+  LiveWandOptions live = a.live_options;
+  if (a.wand_length_m) live.wand_length_m = *a.wand_length_m;
+  auto events = record_live_wand(live);
+  if (!events) return Result<InputLog>::failure(events.error());
+  InputLog log;
+  log.events = std::move(*events);
+  return log;
+}
 
 int run_calibrate(const CalibrateArgs& a) {
   const std::string command = "calibrate";
+  if (a.live != a.log_path.empty())
+    return fail(command, "give the LOG (or session folder) of a waved wand, or --live, not both");
+  if (a.live && a.live_options.session_dir.empty())
+    return fail(command, "--live records the remotes' reports into a new session folder: give --session DIR");
+  // Bounded: the fake rig simulates the whole stretch before it starts.
+  if (a.live && !(a.live_options.max_seconds > 0 && a.live_options.max_seconds <= 3600))
+    return fail(command, "--max-seconds must be more than 0 and at most 3600");
   std::vector<std::string> notes;
-  Result<InputLog> log = read_log_or_session(a.log_path, notes);
+  Result<InputLog> log = wand_log(a, notes);
   if (!log) return fail(command, log.error());
   for (const std::string& note : notes) std::cerr << "fire calibrate: " << note << "\n";
   const SessionTruth truth = read_session_truth(log->events);
@@ -275,7 +297,7 @@ int run_calibrate(const CalibrateArgs& a) {
   const ReportCounts counts = streams.counts;
   const ordered_json remotes = logged_remotes(streams);
   Result<WandCalibration> cal = calibrate_wand_streams(std::move(streams), options);
-  if (!cal) return fail(command, a.log_path + ": " + cal.error());
+  if (!cal) return fail(command, (a.live ? a.live_options.session_dir : a.log_path) + ": " + cal.error());
   std::string rig_text = rig_to_json(cal->rig);
   if (!remotes.empty()) {
     // The remotes the wand was seen by, so tracking can refuse a log drawn with other ones.
@@ -504,8 +526,23 @@ void add_tracking_commands(CLI::App& app, Registry& registry) {
 
   // calibrate
   auto cal = std::make_shared<CalibrateArgs>();
-  CLI::App* c = app.add_subcommand("calibrate", "Calibrate the stereo rig from a logged wand session");
-  c->add_option("LOG", cal->log_path, "input log (or session folder) with the remotes' reports of a waved two-LED wand")->required();
+  CLI::App* c = app.add_subcommand("calibrate", "Calibrate the stereo rig from a logged wand session, or live from the remotes (--live)");
+  c->add_option("LOG", cal->log_path, "input log (or session folder) with the remotes' reports of a waved two-LED wand");
+  c->add_flag("--live", cal->live,
+              "record the wand from the two camera remotes now (roles by address order), into --session DIR, with each "
+              "camera's progress on stderr; stops when both have seen enough of it (--coverage, --samples), on Enter, or "
+              "after --max-seconds; then calibrates from the recorded reports as fire calibrate DIR would");
+  c->add_option("--session", cal->live_options.session_dir, "--live: the new session folder to record into");
+  c->add_option("--max-seconds", cal->live_options.max_seconds, "--live: stop after this long")->capture_default_str();
+  c->add_option("--coverage", cal->live_options.coverage,
+                "--live: share of each camera's image (an 8 x 6 grid) the wand's LEDs must have crossed")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  c->add_option("--samples", cal->live_options.samples, "--live: reports showing both LEDs each camera must have")
+      ->capture_default_str();
+  c->add_option("--fake-rig", cal->live_options.fake_rig_seed,
+                "--live test and simulation hook, not for calibrating anything real: no hardware; two fake remotes stream "
+                "the simulated wand of fire simulate wand with this seed (rig and motion), faster than real time");
   c->add_option("-o,--output", cal->out_path, "rig file to write (systems/tracking/README.md)")->required();
   c->add_option("--wand-length", cal->wand_length_m,
                 "distance between the wand's LEDs, metres (default: the log's meta wand_length_m, else 0.3)");

@@ -70,18 +70,38 @@ bool systems_waiting(const World& w) { return !w.sketch.pending.empty() || (w.ri
 
 bool replay_done(const World& w) { return w.cursor.next >= w.log.events.size() && !systems_waiting(w); }
 
+namespace {
+
+// Skips the stretch with nothing to do before `t_us`, the next event's time: the frames still count, so
+// frame numbers match a session that ran them all.
+void skip_idle_frames(World& w, int64_t t_us) {
+  if (systems_waiting(w) || t_us < w.frame.end_us) return;
+  const int64_t steps = (t_us - w.frame.begin_us) / kFrameStepUs;
+  begin_frame(w, w.frame.index + uint64_t(steps), w.frame.begin_us + steps * kFrameStepUs);
+}
+
+void run_one_frame(World& w, Scheduler& scheduler, const ReplayHooks& hooks) {
+  if (hooks.before_frame) hooks.before_frame(w);
+  scheduler.run_frame();
+  if (hooks.after_frame) hooks.after_frame(w);
+  begin_frame(w, w.frame.index + 1, w.frame.end_us);
+}
+
+}  // namespace
+
 void continue_replay(World& w, Scheduler& scheduler, const ReplayHooks& hooks) {
-  auto waiting = [&] { return systems_waiting(w); };
   while (!replay_done(w)) {
-    // Skip stretches with nothing to do: the frames still count, so frame numbers match a live session.
-    if (!waiting() && w.log.events[w.cursor.next].t_us >= w.frame.end_us) {
-      const int64_t steps = (w.log.events[w.cursor.next].t_us - w.frame.begin_us) / kFrameStepUs;
-      begin_frame(w, w.frame.index + uint64_t(steps), w.frame.begin_us + steps * kFrameStepUs);
-    }
-    if (hooks.before_frame) hooks.before_frame(w);
-    scheduler.run_frame();
-    if (hooks.after_frame) hooks.after_frame(w);
-    begin_frame(w, w.frame.index + 1, w.frame.end_us);
+    if (w.cursor.next < w.log.events.size()) skip_idle_frames(w, w.log.events[w.cursor.next].t_us);
+    run_one_frame(w, scheduler, hooks);
+  }
+}
+
+void run_frames_until(World& w, Scheduler& scheduler, int64_t until_us, const ReplayHooks& hooks) {
+  for (;;) {
+    // No event yet: the next one will come at until_us or later.
+    skip_idle_frames(w, w.cursor.next < w.log.events.size() ? w.log.events[w.cursor.next].t_us : until_us);
+    if (w.frame.end_us > until_us) return;
+    run_one_frame(w, scheduler, hooks);
   }
 }
 

@@ -83,6 +83,9 @@ bool replay_done(const World& world);
 void replay_headless(World& world, Scheduler& scheduler, const ReplayHooks& hooks = {});
 // The same from where `world` stands: a frame begun, as replay_headless and a loaded snapshot leave it.
 void continue_replay(World& world, Scheduler& scheduler, const ReplayHooks& hooks = {});
+// The same for a live session, whose log holds every event stamped before `until_us` and none after: runs
+// the frames that end by then, as continue_replay would run them on the finished log.
+void run_frames_until(World& world, Scheduler& scheduler, int64_t until_us, const ReplayHooks& hooks = {});
 // Drops the delivered events from the front of the world's log (all but the newest delivered one), so a
 // live session's memory does not grow with its log; only for a log that is on disk elsewhere (a session
 // folder's). Amortized: does nothing until `keep_below` events are waiting to be dropped.

@@ -14,6 +14,7 @@
 #include "systems/tracking/simulate.hpp"
 #include "systems/tracking/track.hpp"
 #include "tests/platform/wiimote/helpers.hpp"
+#include "tests/platform/wiimote/simulated_blobs.hpp"
 
 using namespace fire;
 using namespace fire::wiimote;
@@ -321,17 +322,6 @@ TEST_CASE("status reports mid-drawing and garbage from a remote lose no drawing"
 
 namespace {
 
-// The blobs each camera of the simulated rig saw, in time order, for a fake remote to replay.
-struct SimulatedBlobs {
-  std::array<std::vector<std::pair<int64_t, IrObjects>>, 2> frames;
-  IrObjects at(int camera, int64_t t_ns) const {
-    const auto& f = frames[camera];
-    auto it = std::upper_bound(f.begin(), f.end(), t_ns,
-                               [](int64_t t, const std::pair<int64_t, IrObjects>& p) { return t < p.first; });
-    return it == f.begin() ? IrObjects{} : std::prev(it)->second;
-  }
-};
-
 SimulatedBlobs simulated_blobs() {
   Result<PolygonMesh> mesh = read_obj(std::string(FIRE_SHARED_DIR) + "/data/meshes/pawn.obj");
   REQUIRE(mesh.ok());
@@ -342,19 +332,7 @@ SimulatedBlobs simulated_blobs() {
   Result<tracking::SimulatedSession> sim = tracking::simulate_sketch(
       tracking::RigOptions{}, sketch, tracking::MeshView{mesh->positions, mesh->face_offsets, mesh->face_vertices});
   REQUIRE(sim.ok());
-  SimulatedBlobs out;
-  for (const InputEvent& e : sim->events) {
-    if (e.kind != EventKind::Hid || e.device > 1) continue;
-    const tracking::DecodedReport d = tracking::decode_ir_report(e.bytes);
-    if (d.status != tracking::ReportStatus::Ok) continue;
-    IrObjects o{};
-    for (int k = 0; k < 4; ++k) {
-      const tracking::IrSlot& s = d.report.slots[k];
-      o[k] = {.seen = s.seen, .x = s.x, .y = s.y, .size = s.size};
-    }
-    out.frames[e.device].push_back({e.t_us * 1000, o});
-  }
-  return out;
+  return simulated_blobs_of(sim->events);
 }
 
 }  // namespace

@@ -1,0 +1,213 @@
+#include "tools/fire/calibrate_live.hpp"
+
+#include <poll.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <thread>
+
+#include "platform/wiimote/driver.hpp"
+#include "platform/wiimote/fake_remote.hpp"
+#include "platform/wiimote/hidapi_backend.hpp"
+#include "systems/tracking/camera.hpp"
+#include "systems/tracking/hid.hpp"
+#include "systems/tracking/simulate.hpp"
+#include "tools/fire/live_session.hpp"
+
+namespace fire::cli {
+
+namespace {
+
+using wiimote::IrObjects;
+
+// What the wand has shown each camera: reports with both LEDs (samples for the bundle adjustment) and the
+// cells of an 8 x 6 grid over the 1024 x 768 image its blobs fell in.
+class WandCoverage {
+ public:
+  static constexpr int kColumns = 8, kRows = 6;
+
+  void add(const InputEvent& e) {
+    if (e.kind != EventKind::Hid || e.device < 0 || e.device > 1) return;
+    const tracking::DecodedReport d = tracking::decode_ir_report(e.bytes);
+    if (d.status != tracking::ReportStatus::Ok) return;
+    Camera& c = cameras_[size_t(e.device)];
+    int seen = 0;
+    for (const tracking::IrSlot& s : d.report.slots) {
+      if (!s.seen) continue;
+      ++seen;
+      const int col = std::min(kColumns - 1, s.x * kColumns / tracking::kWiimoteWidth);
+      const int row = std::min(kRows - 1, s.y * kRows / tracking::kWiimoteHeight);
+      c.cells[size_t(row * kColumns + col)] = true;
+    }
+    c.samples += seen == 2;
+  }
+  size_t samples(int camera) const { return cameras_[size_t(camera)].samples; }
+  double covered(int camera) const {
+    const auto& cells = cameras_[size_t(camera)].cells;
+    return double(std::count(cells.begin(), cells.end(), true)) / double(cells.size());
+  }
+  bool enough(const LiveWandOptions& o) const {
+    for (int c = 0; c < 2; ++c)
+      if (samples(c) < o.samples || covered(c) < o.coverage) return false;
+    return true;
+  }
+  std::string line() const {
+    char text[160];
+    std::snprintf(text, sizeof text, "camera 0: %zu wand samples, %.0f%% of the image covered; camera 1: %zu, %.0f%%",
+                  samples(0), 100 * covered(0), samples(1), 100 * covered(1));
+    return text;
+  }
+
+ private:
+  struct Camera {
+    size_t samples = 0;
+    std::array<bool, kColumns * kRows> cells{};
+  };
+  std::array<Camera, 2> cameras_;
+};
+
+// The simulated wand as each camera saw it, held from one report's arrival to the next, for a fake remote.
+struct SimulatedWand {
+  std::array<std::vector<std::pair<int64_t, IrObjects>>, 2> frames;  // (arrival ns, blobs)
+  IrObjects at(int camera, int64_t t_ns) const {
+    const auto& f = frames[size_t(camera)];
+    auto it = std::upper_bound(f.begin(), f.end(), t_ns, [](int64_t t, const auto& p) { return t < p.first; });
+    return it == f.begin() ? IrObjects{} : std::prev(it)->second;
+  }
+};
+
+Result<SimulatedWand> simulated_wand(uint64_t seed, const LiveWandOptions& o) {
+  tracking::RigOptions rig;
+  rig.seed = seed;
+  rig.rig_seed = seed;
+  tracking::WandOptions wand;
+  wand.duration_s = o.max_seconds;
+  wand.length_m = o.wand_length_m;
+  auto session = tracking::simulate_wand(rig, wand);
+  if (!session) return Result<SimulatedWand>::failure("--fake-rig: " + session.error());
+  SimulatedWand out;
+  for (const InputEvent& e : session->events) {
+    if (e.kind != EventKind::Hid || e.device < 0 || e.device > 1) continue;
+    const tracking::DecodedReport d = tracking::decode_ir_report(e.bytes);
+    if (d.status != tracking::ReportStatus::Ok) continue;
+    IrObjects o{};
+    for (size_t k = 0; k < 4; ++k)
+      o[k] = {.seen = d.report.slots[k].seen, .x = d.report.slots[k].x, .y = d.report.slots[k].y, .size = d.report.slots[k].size};
+    out.frames[size_t(e.device)].push_back({e.t_us * 1000, o});
+  }
+  return out;
+}
+
+// Enter on a terminal stops the recording; anything else on stdin (a pipe, /dev/null) is not a key.
+bool key_pressed() {
+  if (!::isatty(STDIN_FILENO)) return false;
+  pollfd p{.fd = STDIN_FILENO, .events = POLLIN, .revents = 0};
+  if (::poll(&p, 1, 0) <= 0) return false;
+  std::string line;
+  std::getline(std::cin, line);
+  return true;
+}
+
+bool cameras_running(const wiimote::Driver& driver) {
+  int running = 0;
+  for (const wiimote::RemoteView& v : driver.remotes())
+    running += wiimote::is_camera(v.role) && v.state == wiimote::LinkState::Running;
+  return running == 2;
+}
+
+}  // namespace
+
+Result<std::vector<InputEvent>> record_live_wand(const LiveWandOptions& o) {
+  using R = Result<std::vector<InputEvent>>;
+  std::optional<SimulatedWand> wand;
+  wiimote::ManualClock manual;
+  std::unique_ptr<wiimote::Backend> backend;
+  wiimote::Clock clock = wiimote::system_clock();
+  std::vector<std::shared_ptr<wiimote::FakeRemote>> fakes;
+  int64_t origin_ns = -1;  // fake rig: the wand is waved once both cameras run
+  if (o.fake_rig_seed) {
+    auto simulated = simulated_wand(*o.fake_rig_seed, o);
+    if (!simulated) return R::failure(simulated.error());
+    wand = std::move(*simulated);
+    clock = manual.clock();
+    auto bus = std::make_unique<wiimote::FakeBus>(clock);
+    for (int c = 0; c < 2; ++c) {
+      fakes.push_back(bus->add_remote({.address = c ? "00:1F:32:FA:CE:01" : "00:1F:32:FA:CE:00",
+                                       .phase_ns = (3 + 4 * c) * 1'000'000}));
+      fakes.back()->set_blob_source([&wand, &origin_ns, c](int64_t t) {
+        return origin_ns < 0 ? IrObjects{} : wand->at(c, t - origin_ns);
+      });
+    }
+    backend = std::move(bus);
+  } else {
+    backend = std::make_unique<wiimote::HidapiBackend>();
+  }
+
+  wiimote::LogWriter log(clock);
+  log.meta("wand_length_m", format_double(o.wand_length_m));
+  wiimote::Driver driver(*backend, log, {}, {}, clock);
+  auto scan = driver.open_all();
+  if (!scan) return R::failure(scan.error());
+  for (const std::string& e : scan->open_errors) std::cerr << "fire calibrate: " << e << "\n";
+  int cameras = 0;
+  for (const wiimote::RemoteView& v : driver.remotes()) cameras += wiimote::is_camera(v.role);
+  if (cameras < 2)
+    return R::failure("--live needs two Wii Remotes as cameras and found " + std::to_string(cameras) +
+                      " (fire devices lists what this machine sees)");
+
+  // The folder is made once the cameras are there, so a failed start leaves none behind; the log writer
+  // holds what arrived meanwhile.
+  World world;  // no rig yet: the frames carry the reports to the log and nothing draws
+  auto out = SessionWriter::create(o.session_dir, settings_json(world));
+  if (!out) return R::failure(out.error());
+  Scheduler scheduler = make_scheduler(world, [] { return int64_t{0}; });
+  LiveSession live(world, scheduler, log, *out);
+  std::vector<InputEvent> events;
+  WandCoverage coverage;
+  live.on_taken([&](std::span<const InputEvent> taken) {
+    for (const InputEvent& e : taken) {
+      coverage.add(e);
+      events.push_back(e);
+    }
+  });
+  std::cerr << "fire calibrate: wave the wand through the working volume; Enter stops\n";
+  const int64_t start_ns = clock();
+  int64_t next_progress_ns = start_ns;
+  std::string stop;
+  if (!o.fake_rig_seed) driver.start();
+  while (stop.empty()) {
+    if (o.fake_rig_seed) {
+      // One millisecond of the fake clock; a read per remote drains a report each.
+      manual.advance(1'000'000);
+      for (int k = 0; k < 2; ++k) driver.poll(0);
+      if (origin_ns < 0 && cameras_running(driver)) origin_ns = manual.now();
+    } else {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    live.step();
+    for (const wiimote::Notice& n : driver.take_notices())
+      std::cerr << "fire calibrate: remote " << n.device << " " << n.address << ": " << n.text << "\n";
+    const int64_t now = clock();
+    if (now >= next_progress_ns) {
+      std::cerr << "fire calibrate: " << coverage.line() << "\n";
+      next_progress_ns += 1'000'000'000;
+    }
+    if (coverage.enough(o)) stop = "both cameras have seen enough of the wand";
+    else if (double(now - start_ns) * 1e-9 >= o.max_seconds) stop = "time is up (--max-seconds)";
+    else if (key_pressed()) stop = "stopped by a key";
+    if (!live.status()) return R::failure(live.status().error);
+  }
+  driver.stop();
+  for (int k = 0; o.fake_rig_seed && k < 4; ++k) driver.poll(0);  // what the fake remotes still hold
+  if (Status s = live.finish(); !s) return R::failure(s.error);
+  std::cerr << "fire calibrate: " << coverage.line() << "\nfire calibrate: " << stop << "; " << events.size()
+            << " events recorded in " << o.session_dir << "\n";
+  return events;
+}
+
+}  // namespace fire::cli
