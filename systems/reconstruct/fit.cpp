@@ -313,7 +313,16 @@ LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points
     for (const Span& span : whole) {
       const Eigen::Index count = Eigen::Index(span.rows.size()) - 2;
       for (Eigen::Index k = 0; k < count; ++k, ++i) {
-        const double lo = k == 0 ? 0.0 : current[i - 1], hi = k + 1 == count ? 1.0 : current[i + 1];
+        // At least min_target_spacing of the equal step from the neighbours' targets, so that feet do not
+        // gather where the curve bends faster than the surface can follow (fit.hpp).
+        const double gap = m.settings.min_target_spacing / double(count + 1);
+        double lo = k == 0 ? 0.0 : current[i - 1], hi = k + 1 == count ? 1.0 : current[i + 1];
+        if (lo + gap <= hi - gap) {
+          lo += gap;
+          hi -= gap;
+        } else {
+          lo = hi = 0.5 * (lo + hi);
+        }
         out[i] = foot_fraction(span, fitted.row(span.rows[size_t(k + 1)]).transpose(), lo, hi);
         largest_move = std::max(largest_move, std::abs(out[i] - current[i]) * span.length);
       }

@@ -20,7 +20,10 @@
 //   2. each target becomes the foot point of its fitted limit point on the edge's polyline. Phase 1's
 //      fixed point lets the fairness choose the parameterization along each curve; the feet's fixed
 //      point minimizes the squared distances of the fitted points to the polylines plus the fairness.
-//      Alternating with the solve creeps along the curves, so the last steps are Anderson-mixed;
+//      Alternating with the solve creeps along the curves, so the last steps are Anderson-mixed. Each
+//      foot keeps `min_target_spacing` of the equal step from its neighbours: where a curve bends faster
+//      than the surface can follow, the feet would otherwise gather at the bend, and the surface, pinched
+//      across the curve there, folds (the rook's K = 2 foot ring: tests/reconstruct/cli_folds.sh);
 //   3. the split points settle on the polyline samples nearest to where phase 2 put them, and each
 //      piece slides alone as in phase 1. Where the curves are representable this converges fast (about
 //      a factor 6 per solve on smooth data) to a surface through every sample, which phase 2's creep
@@ -44,6 +47,9 @@ struct FitWeights {
   double ridge = 1e-9;  // same scale, towards the initial base points
   uint32_t slide_iterations = 10;  // solves of phase 1
   uint32_t feet_iterations = 60;   // solves of phase 2
+  // Phase 2: each target keeps at least this fraction of the equal arc-length step from its neighbours'
+  // targets along its edge.
+  double min_target_spacing = 0.3;
   size_t anderson_depth = 10;      // steps mixed in phase 2
   uint32_t max_iterations = 110;   // solves in all
   double tolerance = 1e-11;
