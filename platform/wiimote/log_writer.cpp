@@ -54,6 +54,12 @@ int64_t LogWriter::meta(const std::string& key, const std::string& text) {
   return add_locked(std::move(e), std::nullopt);
 }
 
+int64_t LogWriter::command(InputEvent command) {
+  command.kind = EventKind::Command;
+  std::lock_guard lock(mutex_);
+  return add_locked(std::move(command), std::nullopt);
+}
+
 void LogWriter::take_before(int64_t until_us, std::vector<InputEvent>& out) {
   std::lock_guard lock(mutex_);
   // Closed up to now at most: an event that has not arrived yet keeps its own stamp.

@@ -33,6 +33,9 @@ class LogWriter {
   int64_t hid(int device, std::span<const uint8_t> report, std::optional<int64_t> arrival_ns = std::nullopt);
   // `meta <key> <text>`, stamped with the clock now; returns its stamp.
   int64_t meta(const std::string& key, const std::string& text);
+  // A command the person gave (a key, the command pad's button: `cmd ...`), stamped with the clock now;
+  // returns its stamp.
+  int64_t command(InputEvent command);
   // Microseconds since the log began, on its clock.
   int64_t now_us() const;
 

@@ -1362,4 +1362,15 @@ Result<RigErrors> compare_rig(const CalibrationResult& rig, const SessionTruth& 
   return e;
 }
 
+DrawingNetwork drawing_network(const Mesh& m) {
+  DrawingNetwork net;
+  for (uint32_t v = 0; v < m.vertex_slots(); ++v) net.vertices.push_back(m.vertices.position[v]);
+  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+    if (!m.edge_alive(e)) continue;
+    const std::span<const Vec3> points = m.polyline(e);
+    net.curves.push_back({m.edges.vertex[e][0], m.edges.vertex[e][1], {points.begin(), points.end()}, m.is_border_edge(e)});
+  }
+  return net;
+}
+
 }  // namespace fire::tracking

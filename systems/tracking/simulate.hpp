@@ -27,6 +27,7 @@
 
 #include "engine/common.hpp"
 #include "engine/input_log.hpp"
+#include "engine/mesh.hpp"
 #include "systems/tracking/calibration.hpp"
 #include "systems/tracking/camera.hpp"
 #include "systems/tracking/track.hpp"
@@ -146,6 +147,8 @@ Result<std::vector<Vec3>> object_frame(std::span<const Vec3> positions, double h
 // LED sits at the pen's tip, on the limit surface, where the network's points are.
 Result<SimulatedDrawing> simulate_drawing(const RigOptions& rig, const DrawingOptions& drawing, const MeshView& object,
                                           const DrawingNetwork& network);
+// The network to draw from a curve network (the object's K-unrefined one on its limit surface, systems/synth).
+DrawingNetwork drawing_network(const Mesh& network);
 
 // The accuracy rig: the true cameras and the intrinsics calibration is told to start from.
 struct SimulatedRig {

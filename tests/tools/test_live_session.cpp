@@ -1,6 +1,7 @@
 // Issue 12: a drawing made live, through the Wii Remote driver and its Backend/Device interface with
 // fake remotes showing a simulated pen, with reports arriving late and out of order, recorded as a
-// session folder, replays from that folder to the hash the live world had.
+// session folder, replays from that folder to the hash the live world had; and a registration made live
+// (the person touching marks, the commands given as they touch) registers as the offline replay does.
 #include <catch2/catch.hpp>
 
 #include <atomic>
@@ -13,6 +14,7 @@
 #include "platform/session_files.hpp"
 #include "platform/wiimote/driver.hpp"
 #include "platform/wiimote/fake_remote.hpp"
+#include "systems/synth/network_from_mesh.hpp"
 #include "systems/tracking/rig_io.hpp"
 #include "systems/tracking/simulate.hpp"
 #include "tests/platform/wiimote/helpers.hpp"
@@ -49,15 +51,29 @@ bool is_camera_report(const InputEvent& e) {
   return e.kind == EventKind::Hid && (e.device == 0 || e.device == 1) && !e.bytes.empty() && e.bytes[0] == 0x33;
 }
 
-// The person's strokes on the pawn, as the simulated rig's true cameras saw them, and that rig.
-struct Sketch {
+// What the person did before the simulated rig, and that rig (its true cameras): the pen as each camera
+// saw it, and the commands they gave (the marks they touched, registering the object), which in a live
+// session come from a key or the command pad at that moment.
+struct Scenario {
   SimulatedBlobs blobs;
   double duration_s = 0;
   std::string rig_json;
+  std::vector<InputEvent> commands;  // stamped from the simulation's start
 };
 
-const Sketch& sketch() {
-  static const Sketch s = [] {
+std::string true_rig_json(const tracking::RigOptions& rig_options) {
+  auto cameras = tracking::make_simulated_rig(rig_options);
+  REQUIRE(cameras.ok());
+  tracking::CalibrationResult calibrated;
+  calibrated.cam0 = cameras->cameras[0];
+  calibrated.cam1 = cameras->cameras[1];
+  calibrated.time_offset_us = rig_options.clock_offset_ms * 1e3;
+  return tracking::rig_to_json(calibrated);
+}
+
+// Strokes on the pawn.
+const Scenario& sketch() {
+  static const Scenario s = [] {
     auto pawn = read_obj(FIRE_SHARED_DIR "/data/meshes/pawn.obj");
     REQUIRE(pawn.ok());
     tracking::RigOptions rig_options;
@@ -68,13 +84,32 @@ const Sketch& sketch() {
     auto simulated =
         tracking::simulate_sketch(rig_options, options, {pawn->positions, pawn->face_offsets, pawn->face_vertices});
     REQUIRE(simulated.ok());
-    auto cameras = tracking::make_simulated_rig(rig_options);
-    REQUIRE(cameras.ok());
-    tracking::CalibrationResult calibrated;
-    calibrated.cam0 = cameras->cameras[0];
-    calibrated.cam1 = cameras->cameras[1];
-    calibrated.time_offset_us = rig_options.clock_offset_ms * 1e3;
-    return Sketch{simulated_blobs_of(simulated->events), simulated->stats.duration_s, tracking::rig_to_json(calibrated)};
+    return Scenario{simulated_blobs_of(simulated->events), simulated->stats.duration_s, true_rig_json(rig_options), {}};
+  }();
+  return s;
+}
+
+// The start of `fire simulate drawing`: the pawn at 20 cm registered on three marks, then its border drawn.
+const Scenario& drawing() {
+  static const Scenario s = [] {
+    auto pawn = read_obj(FIRE_SHARED_DIR "/data/meshes/pawn.obj");
+    REQUIRE(pawn.ok());
+    tracking::DrawingOptions options;
+    options.max_strokes = 2;
+    auto placed = tracking::object_frame(pawn->positions, options.height_m);
+    REQUIRE(placed.ok());
+    auto network = network_from_mesh({*placed, pawn->face_offsets, pawn->face_vertices, "pawn.obj"},
+                                     UnrefineOptions{.unrefine = 2, .limit = true});
+    REQUIRE(network.ok());
+    tracking::RigOptions rig_options;
+    auto simulated = tracking::simulate_drawing(rig_options, options, {*placed, pawn->face_offsets, pawn->face_vertices},
+                                                tracking::drawing_network(*network));
+    REQUIRE(simulated.ok());
+    constexpr double kSeconds = 12;  // the first registration (at 5.6 s) and the border's first strokes
+    Scenario out{simulated_blobs_of(simulated->session.events), kSeconds, true_rig_json(rig_options), {}};
+    for (const InputEvent& e : simulated->session.events)
+      if (e.kind == EventKind::Command && e.t_us < kSeconds * 1e6) out.commands.push_back(e);
+    return out;
   }();
   return s;
 }
@@ -98,19 +133,22 @@ struct LiveRig {
   std::optional<LiveSession> live;
   bool threads = false;
 
-  explicit LiveRig(bool reader_threads) : threads(reader_threads) {
+  const Scenario& scenario;
+  size_t next_command = 0;
+
+  LiveRig(bool reader_threads, const Scenario& what) : threads(reader_threads), scenario(what) {
     // The rig is read from the text the folder keeps, as a replay reads it.
-    auto read = tracking_rig_from_json(sketch().rig_json, "rig.json", InputLog{}, dir);
+    auto read = tracking_rig_from_json(scenario.rig_json, "rig.json", InputLog{}, dir);
     REQUIRE(read.ok());
     rig = *read;
     set_rig(world, rig);
-    auto created = SessionWriter::create(dir, settings_json(world), sketch().rig_json);
+    auto created = SessionWriter::create(dir, settings_json(world), scenario.rig_json);
     REQUIRE(created.ok());
     out.emplace(std::move(*created));
     for (int c = 0; c < 2; ++c)
       (c ? cam1 : cam0)->set_blob_source([this, c](int64_t t) {
         const int64_t o = origin.load();
-        return o < 0 ? IrObjects{} : sketch().blobs.at(c, t - o);
+        return o < 0 ? IrObjects{} : scenario.blobs.at(c, t - o);
       });
     REQUIRE(driver.open_all().ok());
     SessionWriteOptions options;
@@ -126,6 +164,12 @@ struct LiveRig {
       if (threads) std::this_thread::sleep_for(std::chrono::microseconds(200));  // the readers keep up
       else
         for (int k = 0; k < 4; ++k) driver.poll(0);  // a burst of held reports drains within the millisecond
+      // The person presses the key as the simulation did (the commands are the frame loop's thread's).
+      const int64_t o = origin.load();
+      for (; o >= 0 && next_command < scenario.commands.size() &&
+             clock.now() - o >= scenario.commands[next_command].t_us * 1000;
+           ++next_command)
+        log.command(scenario.commands[next_command]);
       live->step();
     }
   }
@@ -140,7 +184,7 @@ struct LiveRig {
     for (int i = 0; i < 100 && !running(); ++i) run_ms(10);
     REQUIRE(running());
     origin = clock.now();
-    const int64_t drawing_ns = static_cast<int64_t>(sketch().duration_s * 1e9);
+    const int64_t drawing_ns = static_cast<int64_t>(scenario.duration_s * 1e9);
     for (int k = 0; clock.now() - origin < drawing_ns; ++k) {
       run_ms(110);
       const auto& stalled = k % 2 ? cam0 : cam1;
@@ -194,6 +238,7 @@ struct LiveRig {
     Scheduler clean_scheduler = make_scheduler(clean, fake_clock);
     replay_headless(clean, clean_scheduler);
     CHECK(clean.triangulate.counts.strokes == world.triangulate.counts.strokes);
+    CHECK(describe_registration(clean.registration) == describe_registration(world.registration));
     CHECK(world_hash(clean) == live_hash);
   }
 };
@@ -202,7 +247,7 @@ struct LiveRig {
 
 TEST_CASE("a live drawing through the driver, late and out of order, replays from its session folder to the live hash",
           "[live]") {
-  LiveRig s(false);
+  LiveRig s(false, sketch());
   const uint64_t live_hash = s.draw();
   INFO("strokes " << s.world.triangulate.counts.strokes << ", edges " << s.world.mesh.edge_count() << ", frames "
                   << s.live->frames_run());
@@ -218,11 +263,27 @@ TEST_CASE("a live drawing on the driver's reader threads replays to the live has
   // The readers run when the OS schedules them, so the interleaving of the two remotes' reports in the
   // log is not the test's to choose (a report handed in after the frame loop took its time would be
   // restamped, test_log_writer.cpp); whatever it is, the replay sees the stamps the log has and agrees.
-  LiveRig s(true);
+  LiveRig s(true, sketch());
   const uint64_t live_hash = s.draw();
   INFO("strokes " << s.world.triangulate.counts.strokes << ", restamped " << s.log.restamped());
   CHECK(s.world.triangulate.counts.strokes >= 3);
   CHECK(s.world.mesh.edge_count() > 0);
   s.check_log();
+  s.check_replays(live_hash);
+}
+
+TEST_CASE("a live registration: marks touched and the object registered through the driver, as the offline replay registers it",
+          "[live]") {
+  LiveRig s(false, drawing());
+  const uint64_t live_hash = s.draw();
+  REQUIRE(s.next_command == drawing().commands.size());
+  const std::vector<Registration>& done = s.world.registration.done;
+  REQUIRE(done.size() == 1);
+  INFO(describe_registration(s.world.registration)[0]);
+  CHECK(done[0].marks == 3);
+  CHECK(done[0].residual < 0.5e-3);  // metres: the pen rests on the marks within half a millimetre
+  CHECK(s.world.rejections.empty());
+  CHECK(s.world.triangulate.counts.strokes >= 4);  // three touches, then the border
+  CHECK(s.world.mesh.edge_count() > 0);             // drawn in the object's frame
   s.check_replays(live_hash);
 }

@@ -170,18 +170,6 @@ int run_simulate_sketch(const SimulateArgs& a) {
   return write_simulation("sketch", a, simulate_sketch(a.rig, sketch, view));
 }
 
-// The network to draw: the object's K-unrefined network (systems/synth) on its limit surface.
-DrawingNetwork drawing_network(const Mesh& m) {
-  DrawingNetwork net;
-  for (uint32_t v = 0; v < m.vertex_slots(); ++v) net.vertices.push_back(m.vertices.position[v]);
-  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
-    if (!m.edge_alive(e)) continue;
-    const std::span<const Vec3> points = m.polyline(e);
-    net.curves.push_back({m.edges.vertex[e][0], m.edges.vertex[e][1], {points.begin(), points.end()}, m.is_border_edge(e)});
-  }
-  return net;
-}
-
 std::string obj_text(const std::vector<Vec3>& positions, const PolygonMesh& mesh, const std::string& comment) {
   std::string out = "# " + comment + "\n";
   for (const Vec3& p : positions) out += "v " + format_double(p.x()) + ' ' + format_double(p.y()) + ' ' + format_double(p.z()) + '\n';
