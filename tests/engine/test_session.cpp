@@ -22,6 +22,7 @@
 #include "platform/obj.hpp"
 #include "systems/tracking/rig_io.hpp"
 #include "systems/tracking/simulate.hpp"
+#include "tests/temp_dir.hpp"
 #include "tools/fire/session_rig.hpp"
 #include "tools/fire/session_store.hpp"
 
@@ -66,15 +67,7 @@ void write_file(const fs::path& p, std::string_view bytes) {
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "fire-session-XXXXXX").string();
-    REQUIRE(::mkdtemp(pattern.data()) != nullptr);
-    path = pattern;
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
+using test::TempDir;
 
 bool is_durable(const InputEvent& e) { return e.kind == EventKind::Meta && e.name == kDurableKey; }
 

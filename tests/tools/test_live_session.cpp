@@ -19,6 +19,7 @@
 #include "systems/tracking/simulate.hpp"
 #include "tests/platform/wiimote/helpers.hpp"
 #include "tests/platform/wiimote/simulated_blobs.hpp"
+#include "tests/temp_dir.hpp"
 #include "tools/fire/live_session.hpp"
 #include "tools/fire/session_rig.hpp"
 
@@ -34,15 +35,7 @@ int64_t fake_clock() {
   return t += 1000;
 }
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "fire-live-XXXXXX").string();
-    REQUIRE(::mkdtemp(pattern.data()) != nullptr);
-    path = pattern;
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
+using fire::test::TempDir;
 
 const std::string kCam0 = "00:1F:32:00:00:0A";
 const std::string kCam1 = "00:1F:32:00:00:0B";
