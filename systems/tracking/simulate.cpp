@@ -12,6 +12,7 @@
 
 #include "systems/tracking/hid.hpp"
 #include "systems/tracking/registration.hpp"
+#include "systems/tracking/rig_io.hpp"
 
 namespace fire::tracking {
 namespace {
@@ -591,6 +592,16 @@ Result<SimulatedRig> make_simulated_rig(const RigOptions& o) {
                                 .cx = 512, .cy = 384, .k1 = 0, .k2 = 0};
   }
   return rig;
+}
+
+Result<std::string> true_rig_json(const RigOptions& o) {
+  Result<SimulatedRig> rig = make_simulated_rig(o);
+  if (!rig) return Result<std::string>::failure(rig.error());
+  CalibrationResult calibrated;
+  calibrated.cam0 = rig->cameras[0];
+  calibrated.cam1 = rig->cameras[1];
+  calibrated.time_offset_us = o.clock_offset_ms * 1e3;
+  return rig_to_json(calibrated);
 }
 
 Result<SimulatedSession> simulate_wand(const RigOptions& o, const WandOptions& w) {

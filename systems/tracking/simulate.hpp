@@ -156,6 +156,9 @@ struct SimulatedRig {
   std::array<Intrinsics, 2> nominal;
 };
 Result<SimulatedRig> make_simulated_rig(const RigOptions& rig);
+// The rig file (rig_io.hpp) of the true cameras and clock offset: what a perfect calibration would give,
+// for tracking a simulated session without calibrating first.
+Result<std::string> true_rig_json(const RigOptions& rig);
 
 Result<SimulatedSession> simulate_wand(const RigOptions& rig, const WandOptions& wand);
 Result<SimulatedSession> simulate_sketch(const RigOptions& rig, const SketchOptions& sketch, const MeshView& mesh);

@@ -20,7 +20,6 @@
 #include <unistd.h>
 
 #include "platform/obj.hpp"
-#include "systems/tracking/rig_io.hpp"
 #include "systems/tracking/simulate.hpp"
 #include "tests/temp_dir.hpp"
 #include "tools/fire/session_rig.hpp"
@@ -423,13 +422,9 @@ TEST_CASE("a tracked drawing's snapshots hold the triangulation system's state",
   auto simulated = tracking::simulate_sketch(rig_options, sketch,
                                              {pawn->positions, pawn->face_offsets, pawn->face_vertices});
   REQUIRE(simulated.ok());
-  auto cameras = tracking::make_simulated_rig(rig_options);
-  REQUIRE(cameras.ok());
-  tracking::CalibrationResult calibrated;
-  calibrated.cam0 = cameras->cameras[0];
-  calibrated.cam1 = cameras->cameras[1];
-  calibrated.time_offset_us = rig_options.clock_offset_ms * 1e3;
-  const std::string rig_json = tracking::rig_to_json(calibrated);
+  auto true_rig = tracking::true_rig_json(rig_options);
+  REQUIRE(true_rig.ok());
+  const std::string rig_json = *true_rig;
   auto log = parse_input_log(format_input_log(simulated->events), "sketch.log");
   REQUIRE(log.ok());
 

@@ -15,7 +15,6 @@
 #include "platform/wiimote/driver.hpp"
 #include "platform/wiimote/fake_remote.hpp"
 #include "systems/synth/network_from_mesh.hpp"
-#include "systems/tracking/rig_io.hpp"
 #include "systems/tracking/simulate.hpp"
 #include "tests/platform/wiimote/helpers.hpp"
 #include "tests/platform/wiimote/simulated_blobs.hpp"
@@ -54,14 +53,10 @@ struct Scenario {
   std::vector<InputEvent> commands;  // stamped from the simulation's start
 };
 
-std::string true_rig_json(const tracking::RigOptions& rig_options) {
-  auto cameras = tracking::make_simulated_rig(rig_options);
-  REQUIRE(cameras.ok());
-  tracking::CalibrationResult calibrated;
-  calibrated.cam0 = cameras->cameras[0];
-  calibrated.cam1 = cameras->cameras[1];
-  calibrated.time_offset_us = rig_options.clock_offset_ms * 1e3;
-  return tracking::rig_to_json(calibrated);
+std::string rig_json_of(const tracking::RigOptions& rig_options) {
+  auto rig = tracking::true_rig_json(rig_options);
+  REQUIRE(rig.ok());
+  return *rig;
 }
 
 // Strokes on the pawn.
@@ -77,7 +72,7 @@ const Scenario& sketch() {
     auto simulated =
         tracking::simulate_sketch(rig_options, options, {pawn->positions, pawn->face_offsets, pawn->face_vertices});
     REQUIRE(simulated.ok());
-    return Scenario{simulated_blobs_of(simulated->events), simulated->stats.duration_s, true_rig_json(rig_options), {}};
+    return Scenario{simulated_blobs_of(simulated->events), simulated->stats.duration_s, rig_json_of(rig_options), {}};
   }();
   return s;
 }
@@ -99,7 +94,7 @@ const Scenario& drawing() {
                                                 tracking::drawing_network(*network));
     REQUIRE(simulated.ok());
     constexpr double kSeconds = 12;  // the first registration (at 5.6 s) and the border's first strokes
-    Scenario out{simulated_blobs_of(simulated->session.events), kSeconds, true_rig_json(rig_options), {}};
+    Scenario out{simulated_blobs_of(simulated->session.events), kSeconds, rig_json_of(rig_options), {}};
     for (const InputEvent& e : simulated->session.events)
       if (e.kind == EventKind::Command && e.t_us < kSeconds * 1e6) out.commands.push_back(e);
     return out;

@@ -198,15 +198,13 @@ int run_simulate_drawing(const SimulateArgs& a) {
   Result<SimulatedDrawing> drawing = simulate_drawing(a.rig, options, view, drawing_network(*network));
   if (!drawing) return fail(command, a.mesh_path + ": " + drawing.error());
 
-  ordered_json marks = {{"format", "fire-marks"}, {"version", 1}, {"units", "metres"}, {"frame", "object"}, {"marks", ordered_json::array()}};
-  for (size_t k = 0; k < drawing->marks.size(); ++k)
-    marks["marks"].push_back({{"id", k}, {"x", drawing->marks[k].x()}, {"y", drawing->marks[k].y()}, {"z", drawing->marks[k].z()}});
+  const std::string marks = marks_to_json(drawing->marks);
   const std::string object = obj_text(*placed, *mesh, options.mesh_name + " scaled to " + format_double(options.height_m) +
                                                          " m along +z, its base's centre at the origin (metres, the object's frame)");
   // Nothing is written unless everything can be: the log last, so a log never comes without its marks.
-  if (Status w = write_file_atomic(a.marks_path, marks.dump(2) + "\n"); !w) return fail(command, w.error);
+  if (Status w = write_file_atomic(a.marks_path, marks); !w) return fail(command, w.error);
   if (Status w = write_file_atomic(a.object_path, object); !w) return fail(command, w.error);
-  if (Status w = write_log_or_session(a, drawing->session.events, marks.dump(2) + "\n"); !w) return fail(command, w.error);
+  if (Status w = write_log_or_session(a, drawing->session.events, marks); !w) return fail(command, w.error);
   ordered_json out = simulation_json("drawing", a, drawing->session);
   const DrawingStats& st = drawing->drawing;
   out["strokes"] = st.strokes;

@@ -1,6 +1,8 @@
 #include "tools/fire/session_rig.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
 
 #include "platform/files.hpp"
 #include "platform/wiimote/roles.hpp"
@@ -57,6 +59,39 @@ Result<TrackingRig> tracking_rig_from_json(const std::string& rig_text, const st
 
 bool has_device_reports(const InputLog& log) {
   return std::any_of(log.events.begin(), log.events.end(), [](const InputEvent& e) { return e.kind == EventKind::Hid; });
+}
+
+std::string marks_to_json(const std::vector<Vec3>& marks) {
+  nlohmann::ordered_json out = {{"format", "fire-marks"}, {"version", 1}, {"units", "metres"}, {"frame", "object"},
+                                {"marks", nlohmann::ordered_json::array()}};
+  for (size_t k = 0; k < marks.size(); ++k)
+    out["marks"].push_back({{"id", k}, {"x", marks[k].x()}, {"y", marks[k].y()}, {"z", marks[k].z()}});
+  return out.dump(2) + "\n";
+}
+
+Result<std::vector<Vec3>> marks_from_json(std::string_view text, const std::string& source) {
+  using R = Result<std::vector<Vec3>>;
+  const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+  if (j.is_discarded()) return R::failure(source + ": not JSON");
+  if (!j.is_object() || j.value("format", "") != "fire-marks")
+    return R::failure(source + ": not a marks file (\"format\": \"fire-marks\")");
+  if (!j.contains("marks") || !j["marks"].is_array() || j["marks"].empty())
+    return R::failure(source + ": no \"marks\" array, or an empty one");
+  std::vector<Vec3> marks;
+  for (const nlohmann::json& m : j["marks"]) {
+    const std::string which = source + ": mark " + std::to_string(marks.size());
+    if (!m.is_object() || !m.contains("id") || !m["id"].is_number_unsigned() || m["id"].get<size_t>() != marks.size())
+      return R::failure(which + ": its \"id\" must be " + std::to_string(marks.size()) + " (ids run 0, 1, ... in order)");
+    Vec3 p;
+    for (int k = 0; k < 3; ++k) {
+      const char* axis = k == 0 ? "x" : k == 1 ? "y" : "z";
+      if (!m.contains(axis) || !m[axis].is_number() || !std::isfinite(m[axis].get<double>()))
+        return R::failure(which + ": \"" + axis + "\" must be a finite number of metres");
+      p[k] = m[axis].get<double>();
+    }
+    marks.push_back(p);
+  }
+  return marks;
 }
 
 }  // namespace fire
