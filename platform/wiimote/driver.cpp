@@ -91,6 +91,16 @@ void Driver::notice(const Link& link, int64_t now, std::string text) {
   notices_.push_back({.t_ns = now, .device = log_device(link.role), .address = link.address, .text = std::move(text)});
 }
 
+void Driver::pen_notice(int64_t now, std::string text) {
+  std::lock_guard lock(notices_mutex_);
+  notices_.push_back({.t_ns = now, .device = kPenNotice, .address = {}, .text = std::move(text)});
+}
+
+std::string describe(const Notice& n) {
+  if (n.device == kPenNotice) return "pen: " + n.text;
+  return "remote " + std::to_string(n.device) + " " + n.address + ": " + n.text;
+}
+
 void Driver::reopen(Link& link, int64_t now) {
   link.next_reopen = now + options_.reopen_every_ns;
   Result<std::unique_ptr<Device>> opened = Result<std::unique_ptr<Device>>::failure("not found");
@@ -154,7 +164,7 @@ void Driver::lose(Link& link, const std::string& why, int64_t now) {
       events = feedback_.take_events();
     }
     if (was_down) notice(link, now, "the stroke ended: camera " + std::to_string(device) + " is gone");
-    for (std::string& e : events) notice(link, now, std::move(e));
+    for (std::string& e : events) pen_notice(now, std::move(e));
   }
   publish(link, now);
 }
@@ -246,8 +256,8 @@ bool Driver::step(Link& link, int read_timeout_ms) {
     rumble = link.role == Role::CommandPad && feedback_.rumble(now);
     events = feedback_.take_events();
   }
-  if (stroke_ended) notice(link, now, "the stroke ended");
-  for (std::string& e : events) notice(link, now, std::move(e));
+  if (stroke_ended) pen_notice(now, "the stroke ended");
+  for (std::string& e : events) pen_notice(now, std::move(e));
   link.machine.set_leds(leds);
   // The start-up sets the LEDs itself; after it, they follow the feedback.
   if (link.machine.state() != MachineState::Starting && (leds != link.sent_leds || rumble != link.sent_rumble))

@@ -43,10 +43,14 @@ struct RemoteView {
 
 struct Notice {
   int64_t t_ns = 0;
-  int device = 0;
+  int device = 0;  // kPenNotice: about the pen as the cameras see it, not one remote
   std::string address;
   std::string text;
 };
+
+inline constexpr int kPenNotice = -1;
+// "remote 0 00:1F:32:..: running", or "pen: the stroke ended".
+std::string describe(const Notice& notice);
 
 // What open_all found besides the remotes it opened.
 struct Scan {
@@ -83,6 +87,7 @@ class Driver {
   void write_all(Link& link, std::vector<Bytes>& out, bool rumble, int64_t now);
   void publish(Link& link, int64_t now);
   void notice(const Link& link, int64_t now, std::string text);
+  void pen_notice(int64_t now, std::string text);
 
   Backend& backend_;
   LogWriter& log_;

@@ -42,6 +42,7 @@ void FakeRemote::power_on_locked() {
   registers_.clear();
   configured_ = false;
   bad_active_ = BadState::None;
+  buttons_ = 0;
   fresh_ = true;
   queue_.clear();
   held_.clear();
@@ -50,6 +51,13 @@ void FakeRemote::power_on_locked() {
 void FakeRemote::set_blob_source(BlobSource source) {
   std::lock_guard lock(mutex_);
   blobs_ = std::move(source);
+}
+
+void FakeRemote::set_buttons(uint16_t buttons) {
+  std::lock_guard lock(mutex_);
+  const bool changed = buttons != buttons_;
+  buttons_ = buttons;
+  if (changed && plugged_ && !continuous_) queue_locked(data_report_locked(clock_()));
 }
 
 void FakeRemote::drop_acks(uint8_t id, int count) {
@@ -175,12 +183,12 @@ void FakeRemote::ack_locked(uint8_t id, uint8_t error) {
     --it->second;
     return;
   }
-  queue_locked({kInAck, 0x00, 0x00, id, error});
+  queue_locked({kInAck, uint8_t(buttons_ >> 8), uint8_t(buttons_), id, error});
 }
 
 void FakeRemote::status_locked() {
   const uint8_t flags = static_cast<uint8_t>(leds_ | (pixel_clock_ ? 0x08 : 0) | (options_.battery < 0x20 ? 0x01 : 0));
-  queue_locked({kInStatus, 0x00, 0x00, flags, 0x00, 0x00, options_.battery});
+  queue_locked({kInStatus, uint8_t(buttons_ >> 8), uint8_t(buttons_), flags, 0x00, 0x00, options_.battery});
   continuous_ = false;  // the trap the notes describe: reporting stops until 0x12 is sent again
 }
 
@@ -248,6 +256,8 @@ Bytes FakeRemote::data_report_locked(int64_t t_ns) {
     const size_t size = input_report_size(mode);
     Bytes out(size ? size : 3, 0);
     out[0] = size ? mode : kInButtons;
+    out[1] = uint8_t(buttons_ >> 8);
+    out[2] = uint8_t(buttons_);
     return out;
   }
   IrObjects objects{};
@@ -255,6 +265,8 @@ Bytes FakeRemote::data_report_locked(int64_t t_ns) {
   const bool any = std::any_of(objects.begin(), objects.end(), [](const IrObject& o) { return o.seen; });
   Bytes out = ir_extended_report(objects, fresh_ && !any);
   if (any) fresh_ = false;
+  out[1] = uint8_t(buttons_ >> 8);
+  out[2] = uint8_t(buttons_);
   out[3] = static_cast<uint8_t>(streamed_ >> 16);
   out[4] = static_cast<uint8_t>(streamed_ >> 8);
   out[5] = static_cast<uint8_t>(streamed_);

@@ -69,6 +69,9 @@ class FakeRemote {
   void send_status();
   // An arbitrary input report (garbage, truncated, another id) is queued for the host.
   void inject(Bytes report);
+  // The buttons held now (kButton* bits): every report that carries buttons shows them, and a change is
+  // reported at once unless the remote streams continuously, as the hardware does.
+  void set_buttons(uint16_t buttons);
   // While held, reports pile up; on release they reach the host together, late.
   void hold_reports(bool hold);
   // Switched off: open handles fail and the bus no longer lists it. Plugging it back in is a
@@ -127,6 +130,7 @@ class FakeRemote {
   std::map<uint32_t, uint8_t> registers_;
   bool configured_ = false;   // set-up complete when 0x12 arrived
   BadState bad_active_ = BadState::None;  // how the current initialisation went wrong
+  uint16_t buttons_ = 0;
   bool fresh_ = true;         // has not seen light yet: empty slots read as zeros
   int initialisations_ = 0;
   int64_t next_report_ns_ = 0;

@@ -72,6 +72,14 @@ std::optional<StatusReport> parse_status(std::span<const uint8_t> report) {
   return StatusReport{.flags = report[3], .battery = report[6]};
 }
 
+std::optional<uint16_t> core_buttons(std::span<const uint8_t> report) {
+  if (report.empty()) return std::nullopt;
+  const uint8_t id = report[0];
+  const bool carries = (id >= 0x20 && id <= 0x22) || (id >= 0x30 && id <= 0x37) || id == 0x3E || id == 0x3F;
+  if (!carries || report.size() != input_report_size(id)) return std::nullopt;
+  return static_cast<uint16_t>((report[1] << 8 | report[2]) & kAllButtons);
+}
+
 std::optional<int> ir_object_count(std::span<const uint8_t> report) {
   if (report.size() != input_report_size(kInIrExtended) || report[0] != kInIrExtended) return std::nullopt;
   int n = 0;

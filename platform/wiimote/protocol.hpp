@@ -89,6 +89,15 @@ std::optional<StatusReport> parse_status(std::span<const uint8_t> report);
 // is not a complete 0x33.
 std::optional<int> ir_object_count(std::span<const uint8_t> report);
 
+// The core buttons, as the first two payload bytes of the reports that carry them (0x20-0x22, and the
+// data reports 0x30-0x37, 0x3E, 0x3F) hold them, first byte high (wiibrew.org, "Core Buttons").
+inline constexpr uint16_t kButtonLeft = 0x0100, kButtonRight = 0x0200, kButtonDown = 0x0400, kButtonUp = 0x0800,
+                          kButtonPlus = 0x1000, kButtonTwo = 0x0001, kButtonOne = 0x0002, kButtonB = 0x0004,
+                          kButtonA = 0x0008, kButtonMinus = 0x0010, kButtonHome = 0x0080;
+inline constexpr uint16_t kAllButtons = 0x1F9F;
+// The buttons held when `report` was sent; nullopt for a report that does not carry them or is too short.
+std::optional<uint16_t> core_buttons(std::span<const uint8_t> report);
+
 // One IR object as a 0x33 report carries it.
 struct IrObject {
   bool seen = false;

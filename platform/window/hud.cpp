@@ -82,6 +82,28 @@ Status Hud::status() const {
 
 bool Hud::wants_mouse() const { return ImGui::GetIO().WantCaptureMouse; }
 
+namespace {
+
+// The camera's 1024 x 768 image at an eighth of its size, its blobs as discs that grow with their size;
+// framed green while it sees the pen, red while it does not.
+void draw_camera(int camera, const CameraView& view) {
+  constexpr float kScale = 1.0f / 8.0f, kWidth = 1024 * kScale, kHeight = 768 * kScale;
+  ImGui::BeginGroup();
+  ImGui::Text("camera %d: %s", camera, view.pen_seen ? "pen seen" : "no light");
+  const ImVec2 corner = ImGui::GetCursorScreenPos();
+  ImDrawList* draw = ImGui::GetWindowDrawList();
+  const ImU32 frame = view.pen_seen ? IM_COL32(90, 220, 110, 255) : IM_COL32(230, 90, 80, 255);
+  draw->AddRectFilled(corner, ImVec2(corner.x + kWidth, corner.y + kHeight), IM_COL32(15, 15, 20, 230));
+  draw->AddRect(corner, ImVec2(corner.x + kWidth, corner.y + kHeight), frame);
+  for (const IrBlob& b : view.blobs)
+    draw->AddCircleFilled(ImVec2(corner.x + b.x * kScale, corner.y + b.y * kScale), 2.0f + float(b.size) * 0.5f,
+                          IM_COL32(255, 255, 255, 255));
+  ImGui::Dummy(ImVec2(kWidth, kHeight));
+  ImGui::EndGroup();
+}
+
+}  // namespace
+
 void Hud::build(const HudData& d) {
   ImGui_ImplVulkan_NewFrame();
   ImGui_ImplGlfw_NewFrame();
@@ -127,6 +149,13 @@ void Hud::build(const HudData& d) {
     ImGui::PopStyleColor();
   }
   if (!d.status.empty()) ImGui::TextUnformatted(d.status.c_str());
+  if (!d.live.empty()) {
+    ImGui::Separator();
+    for (const std::string& line : d.live) ImGui::TextUnformatted(line.c_str());
+  }
+  if (d.cameras[0].present) draw_camera(0, d.cameras[0]);
+  if (d.cameras[0].present && d.cameras[1].present) ImGui::SameLine();
+  if (d.cameras[1].present) draw_camera(1, d.cameras[1]);
   ImGui::TextDisabled("H: help");
   ImGui::End();
 

@@ -1,7 +1,9 @@
 #pragma once
 // The HUD, drawn with Dear ImGui over the presented frame: frame time, per-system timings, the counts,
-// the sketch mode, the last rejected edit, the view toggles, and the help overlay listing the keys.
+// the sketch mode, the last rejected edit, the view toggles, the help overlay listing the keys, and in a live
+// session the remotes' states and each IR camera's view.
 // It shows what the app hands it in HudData (engine data read by the app); it calls nothing of the engine.
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -11,6 +13,17 @@
 #include "platform/window/window.hpp"
 
 namespace fire::window {
+
+// One IR camera's view: its blobs on the 1024 x 768 sensor image, and whether the pen is among them.
+struct IrBlob {
+  float x = 0, y = 0;  // sensor pixels
+  int size = 0;        // the report's blob size, 0 to 15
+};
+struct CameraView {
+  bool present = false;   // the camera has reported
+  bool pen_seen = false;  // its last report shows a light
+  std::vector<IrBlob> blobs;
+};
 
 struct HudData {
   double frame_ms = 0;       // wall time of the last displayed frame
@@ -24,6 +37,9 @@ struct HudData {
   render::DrawOptions view;
   bool wireframe_supported = true;
   bool help = false;
+  // A live session's news: the remotes' states and batteries, the mark to touch next; and each camera's view.
+  std::vector<std::string> live;
+  std::array<CameraView, 2> cameras;
   // The keys, one line each ("Ctrl+Z  undo"), for the help overlay.
   std::vector<std::string> keys;
 };

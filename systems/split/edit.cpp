@@ -284,6 +284,12 @@ EditOutcome EditHistory::apply(Mesh& mesh, const EditCommand& command) {
   return outcome;
 }
 
+const EditCommand* EditHistory::last_drawn() const {
+  for (auto it = undo_.rbegin(); it != undo_.rend(); ++it)
+    if (!it->command.points.empty()) return &it->command;
+  return nullptr;
+}
+
 EditOutcome EditHistory::undo(Mesh& mesh) {
   if (undo_.empty()) return EditOutcome::reject("nothing to undo");
   mesh.rollback(undo_.back().mark);

@@ -32,6 +32,9 @@ class EditHistory {
   EditOutcome redo(Mesh& mesh);
   size_t undo_depth() const { return undo_.size(); }
   size_t redo_depth() const { return redo_.size(); }
+  // The newest command on the undo stack that drew a curve (a border or split kind); nullptr when none:
+  // what "the curve drawn last" means to a command that has no cursor to pick with (the command pad).
+  const EditCommand* last_drawn() const;
   // Forgets everything (needed after Mesh::compact, which cannot be undone).
   void clear(Mesh& mesh);
   // A snapshot of the history (engine/SESSION.md): each undoable command with its marks into the

@@ -17,14 +17,16 @@
 #include "systems/synth/network_from_mesh.hpp"
 #include "systems/tracking/simulate.hpp"
 #include "tests/platform/wiimote/helpers.hpp"
-#include "tests/platform/wiimote/simulated_blobs.hpp"
 #include "tests/temp_dir.hpp"
+#include "tools/fire/fake_rig.hpp"
 #include "tools/fire/live_session.hpp"
 #include "tools/fire/session_rig.hpp"
 
 using namespace fire;
 using namespace fire::wiimote;
 using namespace fire::wiimote::test;
+using fire::cli::SimulatedBlobs;
+using fire::cli::simulated_blobs_of;
 namespace fs = std::filesystem;
 
 namespace {

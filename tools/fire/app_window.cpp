@@ -95,7 +95,9 @@ bool AppWindow::display(const render::Orbit& orbit, render::Image* capture) {
   auto mark = WallClock::now();
   stages_ = {};
   const int64_t now_us = session_us();
-  while (w.frame.end_us <= now_us) run_frame();
+  if (drive_frames_) drive_frames_();
+  else
+    while (w.frame.end_us <= now_us) run_frame();
   if (w.rejections.size() > rejections_seen_) {
     hud_data.last_rejection = w.rejections.back().reason;
     rejections_seen_ = w.rejections.size();

@@ -5,6 +5,7 @@
 // One displayed frame (display()): the session's systems for every fixed step the wall clock has passed,
 // the renderer's uploads (changed ranges only), the stroke in progress and the pen's feedback, the HUD, the present (vsync).
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <span>
 
@@ -50,6 +51,9 @@ class AppWindow {
   // and drops the delivered events from memory (they are on disk).
   void run_frame(bool last = false);
   void record_into(SessionRecorder* recorder) { recorder_ = recorder; }
+  // A live session runs the frames itself as the remotes' reports complete them (app_live.hpp): display()
+  // then calls `step` instead of running the fixed steps the wall clock has passed.
+  void drive_frames_with(std::function<void()> step) { drive_frames_ = std::move(step); }
   // One displayed frame, the camera from `orbit`. With `capture`, a presented frame is read back into it.
   // False: nothing was shown (minimised, the swapchain was remade for a new size, or status() failed).
   bool display(const render::Orbit& orbit, render::Image* capture = nullptr);
@@ -77,6 +81,7 @@ class AppWindow {
   World& world_;
   Scheduler& scheduler_;
   SessionRecorder* recorder_ = nullptr;
+  std::function<void()> drive_frames_;
   std::unique_ptr<window::Window> window_;
   std::unique_ptr<render::Context> context_;
   std::unique_ptr<render::Presenter> presenter_;

@@ -17,6 +17,7 @@
 #include "systems/tracking/camera.hpp"
 #include "systems/tracking/hid.hpp"
 #include "systems/tracking/simulate.hpp"
+#include "tools/fire/fake_rig.hpp"
 #include "tools/fire/live_session.hpp"
 
 namespace fire::cli {
@@ -71,17 +72,7 @@ class WandCoverage {
   std::array<Camera, 2> cameras_;
 };
 
-// The simulated wand as each camera saw it, held from one report's arrival to the next, for a fake remote.
-struct SimulatedWand {
-  std::array<std::vector<std::pair<int64_t, IrObjects>>, 2> frames;  // (arrival ns, blobs)
-  IrObjects at(int camera, int64_t t_ns) const {
-    const auto& f = frames[size_t(camera)];
-    auto it = std::upper_bound(f.begin(), f.end(), t_ns, [](int64_t t, const auto& p) { return t < p.first; });
-    return it == f.begin() ? IrObjects{} : std::prev(it)->second;
-  }
-};
-
-Result<SimulatedWand> simulated_wand(uint64_t seed, const LiveWandOptions& o) {
+Result<SimulatedBlobs> simulated_wand(uint64_t seed, const LiveWandOptions& o) {
   tracking::RigOptions rig;
   rig.seed = seed;
   rig.rig_seed = seed;
@@ -89,18 +80,8 @@ Result<SimulatedWand> simulated_wand(uint64_t seed, const LiveWandOptions& o) {
   wand.duration_s = o.max_seconds;
   wand.length_m = o.wand_length_m;
   auto session = tracking::simulate_wand(rig, wand);
-  if (!session) return Result<SimulatedWand>::failure("--fake-rig: " + session.error());
-  SimulatedWand out;
-  for (const InputEvent& e : session->events) {
-    if (e.kind != EventKind::Hid || e.device < 0 || e.device > 1) continue;
-    const tracking::DecodedReport d = tracking::decode_ir_report(e.bytes);
-    if (d.status != tracking::ReportStatus::Ok) continue;
-    IrObjects o{};
-    for (size_t k = 0; k < 4; ++k)
-      o[k] = {.seen = d.report.slots[k].seen, .x = d.report.slots[k].x, .y = d.report.slots[k].y, .size = d.report.slots[k].size};
-    out.frames[size_t(e.device)].push_back({e.t_us * 1000, o});
-  }
-  return out;
+  if (!session) return Result<SimulatedBlobs>::failure("--fake-rig: " + session.error());
+  return simulated_blobs_of(session->events);
 }
 
 // Enter on a terminal stops the recording; anything else on stdin (a pipe, /dev/null) is not a key.
@@ -124,7 +105,7 @@ bool cameras_running(const wiimote::Driver& driver) {
 
 Result<std::vector<InputEvent>> record_live_wand(const LiveWandOptions& o) {
   using R = Result<std::vector<InputEvent>>;
-  std::optional<SimulatedWand> wand;
+  std::optional<SimulatedBlobs> wand;
   wiimote::ManualClock manual;
   std::unique_ptr<wiimote::Backend> backend;
   wiimote::Clock clock = wiimote::system_clock();
@@ -191,7 +172,7 @@ Result<std::vector<InputEvent>> record_live_wand(const LiveWandOptions& o) {
     }
     live.step();
     for (const wiimote::Notice& n : driver.take_notices())
-      std::cerr << "fire calibrate: remote " << n.device << " " << n.address << ": " << n.text << "\n";
+      std::cerr << "fire calibrate: " << wiimote::describe(n) << "\n";
     const int64_t now = clock();
     if (now >= next_progress_ns) {
       std::cerr << "fire calibrate: " << coverage.line() << "\n";

@@ -6,6 +6,7 @@
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -23,6 +24,7 @@
 #include "platform/obj.hpp"
 #include "platform/surface_io.hpp"
 #include "systems/evaluate/evaluate.hpp"
+#include "tools/fire/app_live.hpp"
 #include "tools/fire/app_window.hpp"
 #include "tools/fire/commands.hpp"
 #include "tools/fire/session.hpp"
@@ -38,6 +40,8 @@ struct AppArgs {
   uint32_t levels = 3;
   int reference_levels = 3;
   double snap_pixels = 12;
+  bool live = false;
+  AppLiveOptions live_options;
 };
 
 int fail(const std::string& message) {
@@ -66,6 +70,20 @@ const std::vector<std::string> kKeys = {
     "H or F1         this help",
     "Esc             quit",
 };
+// With --live, besides the pad's buttons.
+const std::vector<std::string> kLiveKeys = {
+    "M               the pen rests on the mark shown: touched (logged)",
+    "R               register the object on the marks touched (logged)",
+    "N / P           show the next / previous mark",
+};
+
+// A new session folder's default name: the time it began, so a second session never meets the first's.
+std::string default_live_session() {
+  const std::time_t now = std::time(nullptr);
+  char name[64];
+  std::strftime(name, sizeof name, "fire-live-%Y%m%d-%H%M%S", std::localtime(&now));
+  return name;
+}
 
 // A scripted event of --script: at display frame `frame`, `event` goes through the window's callbacks, or,
 // with a resize size, the window asks the window system for that size (as a person dragging its border).
@@ -192,6 +210,24 @@ int run_app(const AppArgs& a) {
     return fail("--levels must be 1 to " + std::to_string(reconstruct::kMaxSurfaceLevels));
   if (!a.screenshot_path.empty() && !ends_with(a.screenshot_path, ".png"))
     return fail(a.screenshot_path + ": --screenshot must be a .png file");
+  if (a.live) {
+    if (!a.input_path.empty())
+      return fail("--live starts a new session from the remotes; " + a.input_path +
+                  " cannot be continued live (open it without --live to go on drawing with the mouse)");
+    if (!a.record_path.empty()) return fail("--record: with --live the session folder's input.log is the record");
+    if (!a.live_options.fake_rig_seed && a.live_options.rig_path.empty())
+      return fail("--live needs the rig file from fire calibrate: give --rig RIG.json (or --fake-rig SEED to try it "
+                  "without remotes)");
+    if (a.live_options.fake_rig_seed && !a.live_options.rig_path.empty())
+      return fail("--fake-rig brings its own rig and marks; --rig is for real remotes");
+    if (!(a.live_options.fake_speed > 0 && a.live_options.fake_speed <= 100))
+      return fail("--fake-speed must be above 0 and at most 100");
+    if (a.live_options.fake_strokes < 0) return fail("--fake-strokes must be 0 (all) or more");
+    if (a.live_options.ir_sensitivity < 1 || a.live_options.ir_sensitivity > 6)
+      return fail("--ir-sensitivity must be 1 to 5, or 6 for the high-sensitivity block");
+  } else if (a.live_options.fake_rig_seed || !a.live_options.rig_path.empty() || !a.live_options.marks_path.empty()) {
+    return fail("--rig, --marks and --fake-rig are for --live");
+  }
   const bool from_network = ends_with(a.input_path, ".fnet");
   const bool session_in = !a.input_path.empty() && is_directory(a.input_path);
   const bool recording = session_in || !a.session_dir.empty();
@@ -239,7 +275,18 @@ int run_app(const AppArgs& a) {
   std::optional<SessionWriter> writer;
   SessionWriteOptions write_options;
   write_options.snapshot_every = a.snapshot_every;
-  if (session_in) {
+  std::unique_ptr<AppLive> live;
+  const std::string live_dir = a.session_dir.empty() ? default_live_session() : a.session_dir;
+  if (a.live) {
+    AppLiveOptions options = a.live_options;
+    options.session_dir = live_dir;
+    options.levels = a.levels;
+    options.write = write_options;
+    auto opened = AppLive::open(options);
+    if (!opened) return fail(opened.error());
+    live = std::move(*opened);
+    std::cerr << "fire app: live session in " << live_dir << "\n";
+  } else if (session_in) {
     auto reopened = reopen_session(a.input_path, monotonic_ns);
     if (!reopened) return fail(reopened.error());
     for (const std::string& note : reopened->notes) std::cerr << "fire app: " << note << "\n";
@@ -266,8 +313,8 @@ int run_app(const AppArgs& a) {
       world->log = std::move(*log);
     }
   }
-  World& w = *world;
-  if (w.log.events.empty()) {
+  World& w = live ? live->world() : *world;
+  if (!live && w.log.events.empty()) {
     // Frame 0 starts at the first event, in a replay as here: a first event at 0 fixes the clock's origin.
     InputEvent start;
     start.kind = EventKind::Meta;
@@ -275,13 +322,13 @@ int run_app(const AppArgs& a) {
     start.text = "fire app";
     w.log.events.push_back(start);
   }
-  if (!a.session_dir.empty()) {
+  if (!live && !a.session_dir.empty()) {
     auto created = SessionWriter::create(a.session_dir, settings_json(w));
     if (!created) return fail(created.error());
     writer.emplace(std::move(*created));
   }
-  if (!scheduler_owner) scheduler_owner = std::make_unique<Scheduler>(make_scheduler(w, monotonic_ns));
-  Scheduler& scheduler = *scheduler_owner;
+  if (!live && !scheduler_owner) scheduler_owner = std::make_unique<Scheduler>(make_scheduler(w, monotonic_ns));
+  Scheduler& scheduler = live ? live->scheduler() : *scheduler_owner;
   std::optional<SessionRecorder> recorder;
   if (writer) {
     recorder.emplace(w, *writer, write_options);
@@ -292,7 +339,7 @@ int run_app(const AppArgs& a) {
       replay_headless(w, scheduler, hooks);
     }
     if (Status s = recorder->finish(); !s) return fail(s.error);
-  } else {
+  } else if (!live) {
     replay_headless(w, scheduler);
   }
 
@@ -305,13 +352,30 @@ int run_app(const AppArgs& a) {
   render::Orbit orbit = frame_orbit(scene_box(w.mesh, w.surface, reference_positions), app.width(), app.height());
   window::HudData& hud_data = app.hud_data;
   hud_data.keys = kKeys;
+  if (live) {
+    hud_data.keys.insert(hud_data.keys.end(), kLiveKeys.begin(), kLiveKeys.end());
+    for (const std::string& line : pad_help_lines()) hud_data.keys.push_back(line);
+  }
   const std::string out_path = a.out_path.empty() ? default_output(a.input_path) : a.out_path;
   const std::string export_path = a.export_path.empty() ? default_export(out_path) : a.export_path;
   auto report = [&](std::string message) {
     hud_data.status = std::move(message);
     std::cerr << "fire app: " << hud_data.status << "\n";
   };
+  // The view frames the drawing as it grows, until the person moves it.
+  bool view_moved = false;
+  size_t framed_edges = w.mesh.edge_count();
+  if (live)
+    app.drive_frames_with([&] {
+      for (std::string& message : live->step()) report(std::move(message));
+      live->fill_hud(hud_data);
+      if (!view_moved && w.mesh.edge_count() != framed_edges) {
+        framed_edges = w.mesh.edge_count();
+        orbit = frame_orbit(scene_box(w.mesh, w.surface, reference_positions), app.width(), app.height());
+      }
+    });
   auto log_command = [&](CommandKind command, const Vec3& p) {
+    if (live) return live->command(command, p);
     InputEvent e;
     e.kind = EventKind::Command;
     e.command = command;
@@ -398,6 +462,7 @@ int run_app(const AppArgs& a) {
         const glm::vec2 now(float(e.x), float(e.y)), d = now - cursor;
         if (dragging) orbit.rotate(d.x, d.y);
         if (panning) orbit.pan(d.x, d.y, std::max(app.height(), 1u));
+        view_moved = view_moved || dragging || panning;
         if (drawing) {  // samples every 2 pixels along the move, so a fast drag still makes a dense stroke
           const int steps = std::max(1, int(std::ceil(glm::length(d) / 2.0f)));
           for (int k = 1; k <= steps; ++k) pen_sample(cursor + d * (float(k) / float(steps)));
@@ -409,7 +474,9 @@ int run_app(const AppArgs& a) {
         cursor = glm::vec2(float(e.x), float(e.y));
         if (app.hud().wants_mouse() || dragging || panning || drawing) break;
         if (shift || e.button == window::Button::Middle) panning = true;
-        else if (e.button == window::Button::Left) {
+        else if (e.button == window::Button::Left && live) {
+          hud_data.status = "--live: the IR pen draws; right drag orbits, Shift + drag pans";
+        } else if (e.button == window::Button::Left) {
           // The pen goes down with its first sample, on what the stroke will draw on.
           if (!begin_stroke_target(cursor)) {
             hud_data.status = "press on the reference mesh to draw";
@@ -425,7 +492,10 @@ int run_app(const AppArgs& a) {
         dragging = panning = drawing = false;
         break;
       case EventKind::Scroll:
-        if (!app.hud().wants_mouse()) orbit.zoom(float(e.y));
+        if (!app.hud().wants_mouse()) {
+          orbit.zoom(float(e.y));
+          view_moved = true;
+        }
         break;
       case EventKind::KeyPress:
         if (ctrl && e.key == GLFW_KEY_Z) log_command(shift ? CommandKind::Redo : CommandKind::Undo, Vec3::Zero());
@@ -455,7 +525,11 @@ int run_app(const AppArgs& a) {
           else
             report("exported " + std::to_string(w.surface.quad_count()) + " surface quads to " + export_path +
                    (w.surface.settled ? "" : " (provisional: the fit was still converging)"));
-        } else if (e.key == GLFW_KEY_1) hud_data.view.surface = !hud_data.view.surface;
+        } else if (live && e.key == GLFW_KEY_M) report(live->act(PadAction::TouchMark));
+        else if (live && e.key == GLFW_KEY_R) report(live->act(PadAction::Register));
+        else if (live && e.key == GLFW_KEY_N) report(live->act(PadAction::NextMark));
+        else if (live && e.key == GLFW_KEY_P) report(live->act(PadAction::PreviousMark));
+        else if (e.key == GLFW_KEY_1) hud_data.view.surface = !hud_data.view.surface;
         else if (e.key == GLFW_KEY_2) hud_data.view.curves = !hud_data.view.curves;
         else if (e.key == GLFW_KEY_3) hud_data.view.wireframe = !hud_data.view.wireframe;
         else if (e.key == GLFW_KEY_F) orbit = frame_orbit(scene_box(w.mesh, w.surface, reference_positions), app.width(), app.height());
@@ -483,7 +557,11 @@ int run_app(const AppArgs& a) {
 
   // Every logged event handled, as `fire replay` ends, and the session's last snapshot; then the last
   // picture, which --screenshot keeps.
-  while (!replay_done(w)) app.run_frame();
+  if (live) {
+    if (Status s = live->finish(); !s) return fail(s.error);
+    app.drive_frames_with([] {});
+  }
+  while (!live && !replay_done(w)) app.run_frame();
   if (recorder) {
     app.run_frame(true);
     if (Status s = recorder->finish(); !s) return fail(s.error);
@@ -515,6 +593,11 @@ int run_app(const AppArgs& a) {
   out["faces"] = w.mesh.face_count();
   out["surface_quads"] = w.surface.quad_count();
   out["hash"] = hex;
+  if (live) {
+    out["session"] = live_dir;
+    out["strokes"] = w.triangulate.counts.strokes;
+    out["registrations"] = w.registration.done.size();
+  }
   out["device"] = device;
   out["validation"] = validation;
   std::cout << out.dump() << "\n";
@@ -528,6 +611,9 @@ void add_app_commands(CLI::App& app, Registry& registry) {
   CLI::App* cmd = app.add_subcommand("app", "The interactive window: the sketch, its surface and a HUD");
   std::string keys;
   for (const std::string& k : kKeys) keys += "  " + k + "\n";
+  std::string live_keys;
+  for (const std::string& k : kLiveKeys) live_keys += "  " + k + "\n";
+  for (const std::string& k : pad_help_lines()) live_keys += "  " + k + "\n";
   cmd->footer(
       "Opens a window (GLFW) drawn with Vulkan (lavapipe without a GPU) and a HUD: frame time, per-system "
       "timings, counts, the sketch mode, the last rejected edit. INPUT is a session folder to go on with, a "
@@ -539,8 +625,10 @@ void add_app_commands(CLI::App& app, Registry& registry) {
       "surface_quads, hash (as `fire replay --hash`), device, validation. FIRE_VK_VALIDATION=1 turns the "
       "validation layer on; any message then fails the command. While a stroke is drawn, the face it would split "
       "is tinted magenta and the point its end would snap to is marked cyan; on an open border, its first vertex "
-      "is marked green when the stroke would close it there. Ctrl+S and E report in the HUD and on stderr."
-      "\n\nKeys:\n" + keys);
+      "is marked green when the stroke would close it there. Ctrl+S and E report in the HUD and on stderr. With "
+      "--live the Wii Remotes draw: the HUD adds the remotes' states and batteries, each IR camera's view and "
+      "the mark to touch next, and the JSON line adds session, strokes and registrations."
+      "\n\nKeys:\n" + keys + "\nWith --live:\n" + live_keys);
   cmd->add_option("INPUT", a->input_path,
                   "a session folder to go on with (engine/SESSION.md: its last good snapshot, then its log's tail; "
                   "new strokes are written to it; its settings.json fixes --levels), a curve network (.fnet) to "
@@ -578,6 +666,28 @@ void add_app_commands(CLI::App& app, Registry& registry) {
                   "'FRAME key [ctrl+][shift+]KEY', 'FRAME resize W H' (asks the window system), 'FRAME close'; FRAME is "
                   "the display frame");
   cmd->add_option("--screenshot", a->screenshot_path, "on exit, write the last presented frame (HUD included) as PNG");
+  cmd->add_flag("--live", a->live,
+                "draw with the IR pen: the rig's Wii Remotes (platform/wiimote, docs/wiimote.md) feed a new session "
+                "folder (--session, default fire-live-DATE-TIME) frame by frame, 20 ms behind the clock; keys and the "
+                "command pad's buttons are logged commands; `fire replay DIR` gives the same pools and surface");
+  cmd->add_option("--rig", a->live_options.rig_path,
+                  "--live: the rig file from fire calibrate (the cameras, and the remotes' roles by address)");
+  cmd->add_option("--marks", a->live_options.marks_path,
+                  "--live: the object's marks (fire-marks JSON, object frame, metres), to register it: the HUD shows "
+                  "the mark to touch next");
+  cmd->add_option("--ir-sensitivity", a->live_options.ir_sensitivity,
+                  "--live: the cameras' IR sensitivity, 1 to 5 (the Wii's levels), 6 the high-sensitivity block")
+      ->capture_default_str();
+  cmd->add_option("--fake-rig", a->live_options.fake_rig_seed,
+                  "--live without hardware: three fake remotes (two cameras and the pad) show `fire simulate drawing` "
+                  "with this seed, the person pressing the pad for each command; its rig and marks are the simulation's");
+  cmd->add_option("--fake-strokes", a->live_options.fake_strokes,
+                  "--fake-rig: the simulated person stops after this many strokes (0: the whole network)")
+      ->capture_default_str();
+  cmd->add_option("--fake-speed", a->live_options.fake_speed,
+                  "--fake-rig: seconds of the drawing per 60 displayed frames, whatever they cost (the fake clock is "
+                  "the frames', not the wall's)")
+      ->capture_default_str();
   cmd->callback([a, &registry] { registry.exit_code = run_app(*a); });
 }
 

@@ -212,3 +212,57 @@ TEST_CASE("fake remote holds reports back and releases them late") {
   remote->hold_reports(false);
   CHECK(drain(*d).size() == 5);  // at 0, 10, ..., 40 ms
 }
+
+TEST_CASE("fake remote reports its buttons: at once when it does not stream, in every report when it does") {
+  ManualClock clock;
+  FakeBus bus(clock.clock());
+  auto remote = bus.add_remote({});
+  auto d = open_only(bus);
+  // A pad: buttons only, reported when they change.
+  write(*d, reporting_mode_report(kInButtons, false, false));
+  CHECK(drain(*d).empty());
+  remote->set_buttons(kButtonA | kButtonLeft);
+  std::vector<Bytes> got = drain(*d);
+  REQUIRE(got.size() == 1);
+  CHECK(got[0] == Bytes{kInButtons, 0x01, 0x08});
+  CHECK(core_buttons(got[0]) == uint16_t(kButtonA | kButtonLeft));
+  remote->set_buttons(kButtonA | kButtonLeft);  // no change, no report
+  CHECK(drain(*d).empty());
+  remote->set_buttons(0);
+  got = drain(*d);
+  REQUIRE(got.size() == 1);
+  CHECK(core_buttons(got[0]) == uint16_t{0});
+  // Acknowledgements and status reports carry them too.
+  remote->set_buttons(kButtonHome);
+  drain(*d);
+  write(*d, leds_report(player_led(3), true));
+  write(*d, status_request_report());
+  got = drain(*d);
+  REQUIRE(got.size() == 2);
+  CHECK(got[0][0] == kInAck);
+  CHECK(core_buttons(got[0]) == kButtonHome);
+  CHECK(got[1][0] == kInStatus);
+  CHECK(core_buttons(got[1]) == kButtonHome);
+  // Streaming: a change waits for the next report, which shows it.
+  write(*d, reporting_mode_report(kInIrExtended, true, false));
+  clock.advance(10 * kMs);
+  drain(*d);
+  remote->set_buttons(kButtonTwo);
+  CHECK(drain(*d).empty());
+  clock.advance(10 * kMs);
+  got = drain(*d);
+  REQUIRE(got.size() == 1);
+  CHECK(core_buttons(got[0]) == kButtonTwo);
+}
+
+TEST_CASE("core buttons are read only from reports that carry them, whole") {
+  CHECK(core_buttons(Bytes{kInButtons, 0xFF, 0xFF}) == kAllButtons);  // the unused bits are not buttons
+  CHECK(core_buttons(Bytes{0x3D, 0x01, 0x08}) == std::nullopt);       // 0x3D is all extension bytes
+  CHECK(core_buttons(Bytes{kInButtons, 0x01}) == std::nullopt);
+  CHECK(core_buttons(Bytes{kInIrExtended, 0x00, 0x04}) == std::nullopt);  // a 0x33 is 18 bytes
+  Bytes ir(18, 0);
+  ir[0] = kInIrExtended;
+  ir[2] = 0x04;
+  CHECK(core_buttons(ir) == kButtonB);
+  CHECK(core_buttons(Bytes{}) == std::nullopt);
+}

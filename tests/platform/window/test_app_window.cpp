@@ -556,3 +556,121 @@ TEST_CASE("fire app: a script that does not parse is refused before a window ope
   CHECK(app.err.find("bad.script:2: frames must not decrease") != std::string::npos);
   fs::remove_all(dir);
 }
+
+// Issue 12: `fire app --live` on three fake remotes (two cameras showing `fire simulate drawing`, the command
+// pad pressed for each of the simulated person's commands) through the real driver: the pen draws, the pad's
+// presses are the logged commands, the HUD shows the remotes and each camera's view, and the session folder
+// replays to the live world's hash.
+TEST_CASE("fire app --live: fake remotes draw through the driver, the pad gives the commands, the session replays",
+          "[app][window][live]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("live");
+  const std::string session = (dir / "live").string(), shot = (dir / "shot.png").string();
+  const Run app = run_app(230,
+                          "--live --fake-rig 7 --fake-strokes 8 --fake-speed 6 --snapshot-every 500 --size 800x600 "
+                          "--session " + quote(session) + " --script " + quote(FIRE_WINDOW_TEST_DIR "/live.script") +
+                              " --screenshot " + quote(shot),
+                          dir);
+  INFO("xvfb-run exit: " << app.runner_exit << "\nstdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  const auto json = nlohmann::json::parse(app.out);
+  CHECK(json["validation"] == true);
+  CHECK(json["display_frames"] == 201);
+  CHECK(json["session"] == session);
+  CHECK(json["registrations"].get<int>() == 2);  // the object registered, turned and registered again
+  CHECK(json["strokes"].get<int>() >= 8);         // the marks' touches and the border's first curves
+  CHECK(json["edges"].get<int>() >= 3);
+  CHECK(app.err.find("pad: mark ") != std::string::npos);
+  CHECK(app.err.find("pad: registering on 3 mark(s)") != std::string::npos);
+
+  {  // the folder's log: the three remotes, the pad's reports, the commands its presses gave
+    const auto log = fire::read_text_file(session + "/input.log");
+    REQUIRE(log);
+    CHECK(log->find(" meta device 2 00:1F:32:FA:CE:02 pad 0306\n") != std::string::npos);
+    CHECK(log->find(" hid 2 30") != std::string::npos);
+    size_t marks = 0, registers = 0;
+    for (size_t at = log->find(" cmd mark "); at != std::string::npos; at = log->find(" cmd mark ", at + 1)) ++marks;
+    for (size_t at = log->find(" cmd register\n"); at != std::string::npos; at = log->find(" cmd register\n", at + 1))
+      ++registers;
+    CHECK(marks == 6);
+    CHECK(registers == 2);
+    CHECK(fs::exists(session + "/marks.json"));
+    CHECK(fs::exists(session + "/rig.json"));
+    const Run replay = run(quote(FIRE_BINARY) + " replay " + quote(session) + " --hash", dir);
+    REQUIRE(replay.exit_code == 0);
+    CHECK(replay.out == json["hash"].get<std::string>() + "\n");
+  }
+
+  {  // the HUD shows each camera's IR view: camera 0 framed red (no light), camera 1 green with the pen's blob
+    auto image = fire::render::read_png(shot);
+    REQUIRE(image);
+    const Image& im = *image;
+    // The HUD's frame colours (230, 90, 80) and (90, 220, 110) as the sRGB swapchain shows them.
+    const uint8_t red[3] = {244, 160, 152}, green[3] = {160, 239, 175}, white[3] = {255, 255, 255};
+    size_t red_pixels = 0, green_pixels = 0, green_x0 = im.width, green_x1 = 0, green_y0 = im.height, green_y1 = 0;
+    for (uint32_t y = 0; y < im.height; ++y)
+      for (uint32_t x = 0; x < im.width; ++x) {
+        red_pixels += near(im.pixel(x, y), red, 12);
+        if (near(im.pixel(x, y), green, 12)) {
+          ++green_pixels;
+          green_x0 = std::min<size_t>(green_x0, x), green_x1 = std::max<size_t>(green_x1, x);
+          green_y0 = std::min<size_t>(green_y0, y), green_y1 = std::max<size_t>(green_y1, y);
+        }
+      }
+    INFO("red " << red_pixels << ", green " << green_pixels << " in x " << green_x0 << ".." << green_x1 << ", y "
+                << green_y0 << ".." << green_y1);
+    CHECK(red_pixels > 300);  // the outline of a 128 x 96 view
+    REQUIRE(green_pixels > 300);
+    CHECK(green_x1 - green_x0 == 127);
+    CHECK(green_y1 - green_y0 == 95);
+    size_t blob = 0;
+    for (size_t y = green_y0 + 1; y < green_y1; ++y)
+      for (size_t x = green_x0 + 1; x < green_x1; ++x) blob += near(im.pixel(uint32_t(x), uint32_t(y)), white, 10);
+    CHECK(blob > 4);
+    CHECK(curve_pixels(im) > 200);  // the curves drawn so far
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("fire app --live misused, or without remotes: a clear message, exit 1, no folder left", "[app][live]") {
+  const fs::path dir = scratch("live_misuse");
+  auto app = [&](const std::string& args) {
+    return run("env -u DISPLAY -u WAYLAND_DISPLAY " + quote(FIRE_BINARY) + " app " + args, dir);
+  };
+  const Run no_rig = app("--live");
+  CHECK(no_rig.exit_code == 1);
+  CHECK(no_rig.err.find("give --rig RIG.json") != std::string::npos);
+  const Run input = app("--live --fake-rig 1 " + quote(FIRE_DEMO_LOG));
+  CHECK(input.exit_code == 1);
+  CHECK(input.err.find("cannot be continued live") != std::string::npos);
+  const Run rig_alone = app("--rig x.json");
+  CHECK(rig_alone.exit_code == 1);
+  CHECK(rig_alone.err.find("are for --live") != std::string::npos);
+  const Run speed = app("--live --fake-rig 1 --fake-speed nan");
+  CHECK(speed.exit_code == 1);
+  CHECK(speed.err.find("--fake-speed must be") != std::string::npos);
+  // A rig file, and no remote on this machine (CI has none): the remotes are looked for before the window
+  // opens, and the session folder is made only once they are there.
+  const std::string rig = (dir / "rig.json").string(), session = (dir / "none").string();
+  REQUIRE(fire::write_file_atomic(rig, R"({"format": "fire-rig", "version": 1})"));
+  const Run missing_rig = app("--live --rig " + quote((dir / "missing.json").string()));
+  CHECK(missing_rig.exit_code == 1);
+  CHECK(missing_rig.err.find("--rig: ") != std::string::npos);
+  CHECK(missing_rig.err.find("missing.json") != std::string::npos);
+  const Run bad_marks = app("--live --rig " + quote(rig) + " --marks " + quote(rig));
+  CHECK(bad_marks.exit_code == 1);
+  INFO("stderr: " << bad_marks.err);
+  CHECK(bad_marks.err.find("not a marks file") != std::string::npos);
+  const std::string good_rig = FIRE_WINDOW_TEST_DIR "/../../fuzz/corpus/rig/rig.json";
+  const Run no_remotes = app("--live --rig " + quote(good_rig) + " --session " + quote(session));
+  INFO("stderr: " << no_remotes.err);
+  CHECK(no_remotes.exit_code == 1);
+  if (no_remotes.err.find("no display") != std::string::npos) {
+    WARN("this machine has the rig's Wii Remotes: the no-remote case is not checked");
+  } else {
+    CHECK(no_remotes.err.find("two camera remotes and found 0") != std::string::npos);
+    CHECK(no_remotes.err.find("fire devices --rig") != std::string::npos);
+    CHECK_FALSE(fs::exists(session));
+  }
+  fs::remove_all(dir);
+}

@@ -1,0 +1,209 @@
+#include "tools/fire/app_live.hpp"
+
+#include <cstdio>
+
+#include "platform/files.hpp"
+#include "platform/wiimote/hidapi_backend.hpp"
+#include "platform/wiimote/roles.hpp"
+#include "systems/tracking/hid.hpp"
+#include "tools/fire/session_rig.hpp"
+
+namespace fire::cli {
+
+namespace {
+
+std::string millimetres(const Vec3& p) {
+  char text[64];
+  std::snprintf(text, sizeof text, "(%.0f, %.0f, %.0f) mm", p.x() * 1e3, p.y() * 1e3, p.z() * 1e3);
+  return text;
+}
+
+}  // namespace
+
+Result<std::unique_ptr<AppLive>> AppLive::open(const AppLiveOptions& o) {
+  using R = Result<std::unique_ptr<AppLive>>;
+  std::unique_ptr<AppLive> app(new AppLive(o));
+  std::string rig_json, marks_json;
+  wiimote::Backend* backend = nullptr;
+  wiimote::Clock clock;
+  std::string rig_source = o.rig_path;
+  if (o.fake_rig_seed) {
+    auto fake = FakeDrawingRig::create(*o.fake_rig_seed, o.fake_strokes);
+    if (!fake) return R::failure(fake.error());
+    app->fake_ = std::move(*fake);
+    rig_json = app->fake_->rig_json();
+    marks_json = app->fake_->marks_json();
+    rig_source = "the fake rig's rig.json";
+    backend = &app->fake_->backend();
+    clock = app->fake_->clock();
+  } else {
+    auto text = read_text_file(o.rig_path);
+    if (!text) return R::failure("--rig: " + text.error());
+    rig_json = std::move(*text);
+    if (!o.marks_path.empty()) {
+      auto marks = read_text_file(o.marks_path);
+      if (!marks) return R::failure("--marks: " + marks.error());
+      marks_json = std::move(*marks);
+    }
+    app->hardware_ = std::make_unique<wiimote::HidapiBackend>();
+    backend = app->hardware_.get();
+    clock = wiimote::system_clock();
+  }
+  auto assigned = wiimote::remotes_from_rig_json(rig_json, rig_source);
+  if (!assigned) return R::failure(assigned.error());
+  if (!marks_json.empty()) {
+    auto marks = marks_from_json(marks_json, o.fake_rig_seed ? "the fake rig's marks" : o.marks_path);
+    if (!marks) return R::failure(marks.error());
+    app->marks_ = std::move(*marks);
+  }
+  World& w = app->world_;
+  w.surface_options.levels = o.levels;
+  auto rig = tracking_rig_from_json(rig_json, rig_source, InputLog{}, o.session_dir);
+  if (!rig) return R::failure(rig.error());
+  set_rig(w, *rig);
+
+  app->log_ = std::make_unique<wiimote::LogWriter>(clock);
+  wiimote::DriverOptions driver_options;
+  driver_options.startup.sensitivity = o.ir_sensitivity;
+  app->driver_ = std::make_unique<wiimote::Driver>(*backend, *app->log_, *assigned, driver_options, clock);
+  auto scan = app->driver_->open_all();
+  if (!scan) return R::failure(scan.error());
+  int cameras = 0;
+  for (const wiimote::RemoteView& v : app->driver_->remotes())
+    cameras += wiimote::is_camera(v.role) && v.state != wiimote::LinkState::Missing;
+  if (cameras < 2) {
+    std::string why = "--live needs the rig's two camera remotes and found " + std::to_string(cameras);
+    for (const std::string& e : scan->open_errors) why += "\n  " + e;
+    return R::failure(why + "\n  (fire devices --rig " + (o.rig_path.empty() ? std::string("RIG") : o.rig_path) +
+                      " lists what this machine sees)");
+  }
+  // The folder is made once the cameras are there, so a failed start leaves none behind.
+  auto out = SessionWriter::create(o.session_dir, settings_json(w), rig_json, marks_json);
+  if (!out) return R::failure(out.error());
+  app->out_.emplace(std::move(*out));
+  app->live_.emplace(w, app->scheduler_, *app->log_, *app->out_, o.write);
+  app->live_->on_taken([self = app.get()](std::span<const InputEvent> taken) { self->observe(taken); });
+  if (!app->fake_) app->driver_->start();  // the fake rig's remotes are read on the frame loop's thread
+  return app;
+}
+
+AppLive::~AppLive() {
+  if (driver_) driver_->stop();
+}
+
+void AppLive::observe(std::span<const InputEvent> taken) {
+  const int pad = wiimote::log_device(wiimote::Role::CommandPad);
+  for (const InputEvent& e : taken) {
+    if (e.kind == EventKind::Meta && e.name == "device_lost" && e.text.rfind(std::to_string(pad) + " ", 0) == 0)
+      pad_.forget();
+    if (e.kind != EventKind::Hid) continue;
+    if (e.device == pad) {
+      for (PadAction a : pad_.on_report(e.bytes)) pad_actions_.push_back(a);
+      continue;
+    }
+    if (e.device < 0 || e.device > 1) continue;
+    const tracking::DecodedReport d = tracking::decode_ir_report(e.bytes);
+    if (d.status != tracking::ReportStatus::Ok) continue;
+    window::CameraView& view = cameras_[size_t(e.device)];
+    view.present = true;
+    view.blobs.clear();
+    for (const tracking::IrSlot& s : d.report.slots)
+      if (s.seen) view.blobs.push_back({float(s.x), float(s.y), int(s.size)});
+    view.pen_seen = !view.blobs.empty();
+  }
+}
+
+std::vector<std::string> AppLive::step() {
+  if (fake_) {
+    // A displayed frame is a 60th of a second of the drawing, times the speed.
+    const auto ns = int64_t(1e9 / 60 * options_.fake_speed);
+    fake_->advance(ns, *driver_, [this] { live_->step(); });
+  } else {
+    live_->step();
+  }
+  std::vector<std::string> messages;
+  std::vector<PadAction> actions;
+  actions.swap(pad_actions_);
+  for (PadAction a : actions) messages.push_back("pad: " + act(a));
+  for (const wiimote::Notice& n : driver_->take_notices())
+    messages.push_back(wiimote::describe(n));
+  return messages;
+}
+
+void AppLive::command(CommandKind kind, const Vec3& p) {
+  InputEvent e;
+  e.kind = EventKind::Command;
+  e.command = kind;
+  e.p = p;
+  log_->command(std::move(e));
+}
+
+std::string AppLive::act(PadAction action) {
+  switch (action) {
+    case PadAction::CloseBorder: command(CommandKind::Close); return "closing the border";
+    case PadAction::Undo: command(CommandKind::Undo); return "undo";
+    case PadAction::Redo: command(CommandKind::Redo); return "redo";
+    case PadAction::DeleteLastCurve:
+    case PadAction::SharpLastCurve: {
+      const bool remove = action == PadAction::DeleteLastCurve;
+      const std::optional<Vec3> p = last_curve_point(world_.history);
+      if (!p) return std::string("no curve drawn to ") + (remove ? "delete" : "mark sharp");
+      command(remove ? CommandKind::Delete : CommandKind::Sharp, *p);
+      return remove ? "deleting the curve drawn last" : "the curve drawn last: sharp / smooth";
+    }
+    case PadAction::TouchMark: {
+      if (marks_.empty()) return "no marks to touch: give --marks FILE";
+      InputEvent e;
+      e.kind = EventKind::Command;
+      e.command = CommandKind::Mark;
+      e.mark = uint32_t(shown_mark_);
+      e.p = marks_[shown_mark_];
+      log_->command(std::move(e));
+      const std::string done = "mark " + std::to_string(shown_mark_) + " touched (" + std::to_string(++marks_touched_) +
+                               " since the last registration)";
+      shown_mark_ = (shown_mark_ + 1) % marks_.size();
+      return done;
+    }
+    case PadAction::Register: {
+      command(CommandKind::Register);
+      const size_t touched = marks_touched_;
+      if (touched >= 3) marks_touched_ = 0;
+      return "registering on " + std::to_string(touched) + " mark(s)";
+    }
+    case PadAction::PreviousMark:
+    case PadAction::NextMark:
+      if (marks_.empty()) return "no marks: give --marks FILE";
+      shown_mark_ = (shown_mark_ + (action == PadAction::NextMark ? 1 : marks_.size() - 1)) % marks_.size();
+      return "touch mark " + std::to_string(shown_mark_) + " next";
+  }
+  return {};
+}
+
+void AppLive::fill_hud(window::HudData& hud) const {
+  hud.live.clear();
+  for (const wiimote::RemoteView& v : driver_->remotes()) {
+    std::string line = std::string(wiimote::role_name(v.role)) + " " + v.address + ": " +
+                       std::string(wiimote::link_state_name(v.state));
+    if (v.status) {
+      line += ", battery " + std::to_string(int(v.status->battery) * 100 / wiimote::kBatteryFull) + "%";
+      if (v.status->battery_low()) line += " LOW";
+    }
+    if (!v.error.empty()) line += " (" + v.error + ")";
+    else if (!v.warning.empty()) line += " (" + v.warning + ")";
+    hud.live.push_back(line);
+  }
+  if (!marks_.empty())
+    hud.live.push_back("touch mark " + std::to_string(shown_mark_) + " of " + std::to_string(marks_.size()) + " " +
+                       millimetres(marks_[shown_mark_]) + ", then press 2 (or M); Home (or R) registers");
+  hud.cameras = cameras_;
+}
+
+Status AppLive::finish() {
+  if (stopped_) return Status::success();
+  stopped_ = true;
+  driver_->stop();
+  if (fake_) fake_->advance(8'000'000, *driver_, [] {});  // what the fake remotes still hold
+  return live_->finish();
+}
+
+}  // namespace fire::cli

@@ -1,0 +1,166 @@
+#include "tools/fire/fake_rig.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <nlohmann/json.hpp>
+
+#include "platform/obj.hpp"
+#include "systems/synth/network_from_mesh.hpp"
+#include "systems/tracking/hid.hpp"
+#include "systems/tracking/simulate.hpp"
+#include "tools/fire/pad.hpp"
+#include "tools/fire/session_rig.hpp"
+
+namespace fire::cli {
+
+using wiimote::IrObjects;
+
+IrObjects SimulatedBlobs::at(int camera, int64_t t_ns) const {
+  // Frames further apart than this are a gap (the pen unseen, a lost report): nothing to interpolate across.
+  constexpr int64_t kMaxGapNs = 25'000'000;
+  const auto& f = frames[size_t(camera)];
+  auto next = std::upper_bound(f.begin(), f.end(), t_ns,
+                               [](int64_t t, const std::pair<int64_t, IrObjects>& p) { return t < p.first; });
+  if (next == f.begin()) return {};
+  const auto& [t0, before] = *std::prev(next);
+  if (next == f.end() || next->first - t0 > kMaxGapNs) return before;
+  // The fake remote's frames are not the simulator's: a blob held from the simulator's last frame would be up
+  // to a frame old, differently for each camera, and triangulated as if it were now.
+  const double s = double(t_ns - t0) / double(next->first - t0);
+  IrObjects out = before;
+  for (size_t k = 0; k < out.size(); ++k) {
+    const wiimote::IrObject &a = before[k], &b = next->second[k];
+    if (!a.seen || !b.seen) continue;
+    out[k].x = uint16_t(std::lround(a.x + s * (double(b.x) - a.x)));
+    out[k].y = uint16_t(std::lround(a.y + s * (double(b.y) - a.y)));
+  }
+  return out;
+}
+
+SimulatedBlobs simulated_blobs_of(const std::vector<InputEvent>& events) {
+  SimulatedBlobs out;
+  for (const InputEvent& e : events) {
+    if (e.kind != EventKind::Hid || e.device < 0 || e.device > 1) continue;
+    const tracking::DecodedReport d = tracking::decode_ir_report(e.bytes);
+    if (d.status != tracking::ReportStatus::Ok) continue;
+    IrObjects o{};
+    for (size_t k = 0; k < o.size(); ++k) {
+      const tracking::IrSlot& s = d.report.slots[k];
+      o[k] = {.seen = s.seen, .x = s.x, .y = s.y, .size = s.size};
+    }
+    out.frames[size_t(e.device)].push_back({e.t_us * 1000, o});
+  }
+  return out;
+}
+
+std::vector<PadPress> pad_presses_for(const std::vector<InputEvent>& commands, size_t mark_count) {
+  constexpr int64_t kBetweenPressesNs = 100'000'000;
+  auto button_of = [](PadAction action) {
+    for (const PadBinding& b : pad_bindings())
+      if (b.action == action) return b.button;
+    return uint16_t{0};
+  };
+  std::vector<PadPress> presses;
+  size_t shown = 0;
+  for (const InputEvent& c : commands) {
+    if (c.kind != EventKind::Command) continue;
+    const int64_t t = c.t_us * 1000;
+    PadAction action = PadAction::Undo;
+    switch (c.command) {
+      case CommandKind::Undo: action = PadAction::Undo; break;
+      case CommandKind::Redo: action = PadAction::Redo; break;
+      case CommandKind::Close: action = PadAction::CloseBorder; break;
+      case CommandKind::Delete: action = PadAction::DeleteLastCurve; break;
+      case CommandKind::Sharp: action = PadAction::SharpLastCurve; break;
+      case CommandKind::Register: action = PadAction::Register; break;
+      case CommandKind::Mark: {
+        if (mark_count == 0 || c.mark >= mark_count) continue;
+        // The shorter way round to the mark, the presses ending just before the touch.
+        const size_t forward = (c.mark + mark_count - shown) % mark_count, backward = mark_count - forward;
+        const bool right = forward <= backward;
+        const size_t steps = forward == 0 ? 0 : right ? forward : backward;
+        for (size_t k = 0; k < steps; ++k)
+          presses.push_back({t - int64_t(steps - k) * kBetweenPressesNs,
+                             button_of(right ? PadAction::NextMark : PadAction::PreviousMark)});
+        shown = (c.mark + 1) % mark_count;
+        action = PadAction::TouchMark;
+        break;
+      }
+    }
+    presses.push_back({t, button_of(action)});
+  }
+  return presses;
+}
+
+Result<std::unique_ptr<FakeDrawingRig>> FakeDrawingRig::create(uint64_t seed, int max_strokes) {
+  using R = Result<std::unique_ptr<FakeDrawingRig>>;
+  auto pawn = read_obj(FIRE_DEFAULT_MESH);
+  if (!pawn) return R::failure("--fake-rig: " + pawn.error());
+  tracking::DrawingOptions options;
+  options.max_strokes = max_strokes;
+  auto placed = tracking::object_frame(pawn->positions, options.height_m);
+  if (!placed) return R::failure("--fake-rig: " + placed.error());
+  auto network = network_from_mesh({*placed, pawn->face_offsets, pawn->face_vertices, FIRE_DEFAULT_MESH},
+                                   UnrefineOptions{.unrefine = 2, .limit = true});
+  if (!network) return R::failure("--fake-rig: " + network.error());
+  tracking::RigOptions rig;
+  rig.seed = rig.rig_seed = seed;
+  auto drawing = tracking::simulate_drawing(rig, options, {*placed, pawn->face_offsets, pawn->face_vertices},
+                                            tracking::drawing_network(*network));
+  if (!drawing) return R::failure("--fake-rig: " + drawing.error());
+  auto rig_json = tracking::true_rig_json(rig);
+  if (!rig_json) return R::failure("--fake-rig: " + rig_json.error());
+
+  std::unique_ptr<FakeDrawingRig> out(new FakeDrawingRig());
+  nlohmann::ordered_json with_remotes = nlohmann::ordered_json::parse(*rig_json);
+  with_remotes["remotes"] = {{{"address", kAddresses[0]}, {"role", "camera0"}},
+                             {{"address", kAddresses[1]}, {"role", "camera1"}},
+                             {{"address", kAddresses[2]}, {"role", "pad"}}};
+  out->rig_json_ = with_remotes.dump(2) + "\n";
+  out->marks_json_ = marks_to_json(drawing->marks);
+  out->duration_s_ = drawing->session.stats.duration_s;
+  out->blobs_ = simulated_blobs_of(drawing->session.events);
+  out->presses_ = pad_presses_for(drawing->session.events, drawing->marks.size());
+  FakeDrawingRig* self = out.get();
+  for (size_t r = 0; r < kAddresses.size(); ++r) {
+    // The cameras report from phases apart, as two remotes switched on at different instants do.
+    self->remotes_[r] = self->bus_.add_remote({.address = kAddresses[r], .phase_ns = int64_t(3 + 4 * r) * 1'000'000});
+    if (r < 2)
+      self->remotes_[r]->set_blob_source([self, r](int64_t t) {
+        return self->origin_ns_ < 0 ? IrObjects{} : self->blobs_.at(int(r), t - self->origin_ns_);
+      });
+  }
+  return out;
+}
+
+void FakeDrawingRig::advance(int64_t ns, wiimote::Driver& driver, const std::function<void()>& each_ms) {
+  for (int64_t done = 0; done < ns; done += 1'000'000) {
+    clock_.advance(1'000'000);
+    const int64_t now = clock_.now();
+    if (origin_ns_ >= 0) {
+      if (release_at_ >= 0 && now >= release_at_) {
+        remotes_[2]->set_buttons(0);
+        release_at_ = -1;
+      }
+      if (release_at_ < 0 && next_press_ < presses_.size() && now - origin_ns_ >= presses_[next_press_].t_ns) {
+        remotes_[2]->set_buttons(presses_[next_press_++].button);
+        release_at_ = now + kPadHoldNs;
+      }
+    }
+    for (int k = 0; k < 4; ++k) driver.poll(0);  // a burst of held reports drains within the millisecond
+    if (origin_ns_ < 0) {
+      int running = 0;
+      for (const wiimote::RemoteView& v : driver.remotes())
+        running += wiimote::is_camera(v.role) && v.state == wiimote::LinkState::Running;
+      if (running == 2) origin_ns_ = now;
+    }
+    each_ms();
+  }
+}
+
+bool FakeDrawingRig::finished() const {
+  return origin_ns_ >= 0 && double(clock_.now() - origin_ns_) * 1e-9 > duration_s_ + 0.5;
+}
+
+}  // namespace fire::cli
