@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <numeric>
 #include <limits>
 #include <optional>
@@ -204,18 +205,30 @@ std::array<Vec3, 2> wand_points(const Wand& w, double half_length) {
   return {w.centre + half_length * w.direction, w.centre - half_length * w.direction};
 }
 
-double total_cost(const Model& m, const std::vector<Frame>& frames, double half_length) {
-  double sum = 0;
+// Calls visit(frame index, camera, pixel residual) for every blob, always in the same order, so
+// that sums over the residuals are reproducible to the bit.
+template <typename Visit>
+void for_each_residual(const Model& m, const std::vector<Frame>& frames, double half_length, Visit&& visit) {
   const Camera c0{m.K[0], Eigen::Matrix3d::Identity(), Vec3::Zero()};
   const Camera c1{m.K[1], m.R1, m.t1};
   for (size_t i = 0; i < frames.size(); ++i) {
     const auto X = wand_points(m.wands[i], half_length);
     for (int k = 0; k < 2; ++k) {
-      sum += (c0.project(X[k]) - frames[i].cam0[k]).squaredNorm();
-      sum += (c1.project(X[k]) - frames[i].cam1[k]).squaredNorm();
+      visit(i, 0, Vec2(c0.project(X[k]) - frames[i].cam0[k]));
+      visit(i, 1, Vec2(c1.project(X[k]) - frames[i].cam1[k]));
     }
   }
+}
+
+double total_cost(const Model& m, const std::vector<Frame>& frames, double half_length) {
+  double sum = 0;
+  for_each_residual(m, frames, half_length, [&](size_t, int, const Vec2& r) { sum += r.squaredNorm(); });
   return sum;
+}
+
+// Per coordinate (x and y counted separately) over `frames` frames of 2 blobs in 2 cameras.
+double rms_per_coordinate(double cost, size_t frames) {
+  return std::sqrt(cost / (8.0 * static_cast<double>(frames)));
 }
 
 struct NormalEquations {
@@ -326,12 +339,16 @@ struct Adjustment {
   int iterations;
 };
 
+// Called with the starting point (iteration 0) and after each accepted step.
+using StepObserver = std::function<void(const Model&, double cost, int iteration)>;
+
 // Levenberg-Marquardt with Marquardt's diagonal damping.
 Adjustment bundle_adjust(Model m, const std::vector<Frame>& frames, double half_length,
-                         int max_iterations) {
+                         int max_iterations, const StepObserver& on_step) {
   double cost = total_cost(m, frames, half_length);
   double lambda = 1e-4;
   int it = 0;
+  on_step(m, cost, it);
   NormalEquations ne = build_normal_equations(m, frames, half_length);
   while (it < max_iterations) {
     ++it;
@@ -353,6 +370,7 @@ Adjustment bundle_adjust(Model m, const std::vector<Frame>& frames, double half_
       const double decrease = (cost - candidate_cost) / cost;
       m = candidate;
       cost = candidate_cost;
+      on_step(m, cost, it);
       lambda = std::max(lambda / 5, 1e-12);
       if (decrease < 1e-12) break;
       ne = build_normal_equations(m, frames, half_length);
@@ -366,19 +384,28 @@ Adjustment bundle_adjust(Model m, const std::vector<Frame>& frames, double half_
 
 // Largest coordinate residual of each frame.
 std::vector<double> frame_residuals(const Model& m, const std::vector<Frame>& frames, double half_length) {
-  const Camera c0{m.K[0], Eigen::Matrix3d::Identity(), Vec3::Zero()};
-  const Camera c1{m.K[1], m.R1, m.t1};
-  std::vector<double> worst(frames.size());
-  for (size_t i = 0; i < frames.size(); ++i) {
-    const auto X = wand_points(m.wands[i], half_length);
-    double w = 0;
-    for (int k = 0; k < 2; ++k) {
-      w = std::max(w, (c0.project(X[k]) - frames[i].cam0[k]).cwiseAbs().maxCoeff());
-      w = std::max(w, (c1.project(X[k]) - frames[i].cam1[k]).cwiseAbs().maxCoeff());
-    }
-    worst[i] = w;
-  }
+  std::vector<double> worst(frames.size(), 0.0);
+  for_each_residual(m, frames, half_length, [&](size_t i, int, const Vec2& r) {
+    worst[i] = std::max(worst[i], r.cwiseAbs().maxCoeff());
+  });
   return worst;
+}
+
+// Reports the adjustment's state to CalibrationOptions::on_iteration. The per-camera sums are
+// computed here only, so an unobserved calibration does no extra work.
+CalibrationProgress progress(const Model& m, const std::vector<Frame>& frames, double half_length, double cost,
+                             int iteration, bool finished) {
+  std::array<double, 2> camera_cost{0.0, 0.0};
+  for_each_residual(m, frames, half_length,
+                    [&](size_t, int cam, const Vec2& r) { camera_cost[cam] += r.squaredNorm(); });
+  CalibrationProgress p;
+  p.iteration = iteration;
+  p.frames = static_cast<int>(frames.size());
+  p.reprojection_rms_px = rms_per_coordinate(cost, frames.size());
+  // A camera has 4 of a frame's 8 coordinates.
+  for (int c = 0; c < 2; ++c) p.camera_rms_px[c] = rms_per_coordinate(2.0 * camera_cost[c], frames.size());
+  p.finished = finished;
+  return p;
 }
 
 double median(std::vector<double> v) {
@@ -505,8 +532,13 @@ Result<CalibrationResult> calibrate_wand(std::span<const WandObservation> obs,
                       " frames give a consistent wand length");
 
   const double half_length = 0.5 * o.wand_length_m;
-  Adjustment adj = bundle_adjust(std::move(model), frames, half_length, o.max_iterations);
-  int iterations = adj.iterations;
+  // Iteration numbers run on through the adjustment resumed without the outlying frames.
+  int iterations = 0;
+  const StepObserver on_step = [&](const Model& m, double cost, int iteration) {
+    if (o.on_iteration) o.on_iteration(progress(m, frames, half_length, cost, iterations + iteration, false));
+  };
+  Adjustment adj = bundle_adjust(std::move(model), frames, half_length, o.max_iterations, on_step);
+  iterations = adj.iterations;
 
   // One pass of outlier removal: a frame whose worst residual is far beyond the robust spread
   // (mismatched LEDs, a reflection, a bad time alignment) is dropped and the adjustment resumed.
@@ -528,10 +560,11 @@ Result<CalibrationResult> calibrate_wand(std::span<const WandObservation> obs,
                           " observations fit the adjusted model");
       frames = std::move(inlier_frames);
       adj = bundle_adjust(std::move(inlier_model), frames, half_length,
-                          std::max(1, o.max_iterations - iterations));
+                          std::max(1, o.max_iterations - iterations), on_step);
       iterations += adj.iterations;
     }
   }
+  if (o.on_iteration) o.on_iteration(progress(adj.model, frames, half_length, adj.cost, iterations, true));
 
   // A wand that only translates, or stays in one plane, leaves the cameras (nearly) undetermined
   // even when the residuals are small. The reduced camera system's inverse is their covariance:
@@ -546,8 +579,7 @@ Result<CalibrationResult> calibrate_wand(std::span<const WandObservation> obs,
     const Eigen::LDLT<CameraBlock> ldlt(scale_s.asDiagonal() * S * scale_s.asDiagonal());
     const CameraBlock covariance_unit =
         scale_s.asDiagonal() * ldlt.solve(CameraBlock::Identity()) * scale_s.asDiagonal();
-    const double sigma = std::max(std::sqrt(adj.cost / (8.0 * static_cast<double>(frames.size()))),
-                                  1.0 / std::sqrt(12.0));
+    const double sigma = std::max(rms_per_coordinate(adj.cost, frames.size()), 1.0 / std::sqrt(12.0));
     double worst_relative = 0;
     for (int c = 0; c < 2; ++c)
       for (int k = 0; k < 2; ++k) {
@@ -568,9 +600,8 @@ Result<CalibrationResult> calibrate_wand(std::span<const WandObservation> obs,
   CalibrationResult out;
   out.cam0 = Camera{adj.model.K[0], Eigen::Matrix3d::Identity(), Vec3::Zero()};
   out.cam1 = Camera{adj.model.K[1], adj.model.R1, adj.model.t1};
-  const double residual_count = 8.0 * static_cast<double>(frames.size());
-  out.reprojection_rms_px = std::sqrt(adj.cost / residual_count);
-  out.reprojection_rms_2d_px = std::sqrt(2.0 * adj.cost / residual_count);
+  out.reprojection_rms_px = rms_per_coordinate(adj.cost, frames.size());
+  out.reprojection_rms_2d_px = rms_per_coordinate(2.0 * adj.cost, frames.size());
   double length_sq = 0;
   for (const Frame& f : frames) {
     Vec3 X[2];

@@ -4,6 +4,7 @@
 // matrix -> relative pose -> metric scale from the wand length -> sparse bundle adjustment.
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <span>
 
 #include "engine/common.hpp"
@@ -20,10 +21,24 @@ struct WandObservation {
   std::array<Vec2, 2> cam1;
 };
 
+// The bundle adjustment's state, for showing it converge. Reported at the starting point, after
+// each accepted Levenberg-Marquardt step, where the adjustment resumes without the outlying frames
+// (fewer frames, same iteration), and once when it has stopped (finished).
+struct CalibrationProgress {
+  int iteration = 0;  // Levenberg-Marquardt iterations so far, rejected steps included
+  int frames = 0;     // wand frames in the adjustment
+  double reprojection_rms_px = 0;  // as CalibrationResult::reprojection_rms_px, bit for bit when finished
+  // The same per camera: sqrt(camera c's sum of squared residuals / (2 blobs * 2 coords * frames)).
+  std::array<double, 2> camera_rms_px{};
+  bool finished = false;  // the adjustment has stopped; iteration is CalibrationResult::iterations
+};
+
 struct CalibrationOptions {
   Intrinsics nominal0, nominal1;
   double wand_length_m = 0.3;
   int max_iterations = 100;  // Levenberg-Marquardt iterations of the bundle adjustment
+  // Only reads: the result is the same with or without it. Unset, nothing extra is computed.
+  std::function<void(const CalibrationProgress&)> on_iteration = nullptr;
 };
 
 struct CalibrationResult {

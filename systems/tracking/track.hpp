@@ -163,6 +163,7 @@ struct WandCalibration {
 
 // The whole pipeline for a wand log: frame clocks, stray blobs, observations, calibration;
 // then the time offset from the calibrated rig and calibration again until it settles.
+// options.on_iteration sees every round's bundle adjustment, each starting at iteration 0.
 Result<WandCalibration> calibrate_wand_streams(DeviceStreams streams, const CalibrationOptions& options);
 
 // --- what the live triangulation system (systems/triangulate) shares with calibration ---

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # fire calibrate --live against fake remotes (the --fake-rig hook): it records a session folder, shows
-# each camera's progress, and writes the rig that the offline fire calibrate gives on that folder, byte
-# for byte.
+# each camera's progress and the bundle adjustment converging, and writes the rig that the offline
+# fire calibrate gives on that folder, byte for byte.
 #   calibrate_live.sh FIRE_BINARY WORK_DIR
 set -euo pipefail
 fire="$1"
@@ -22,6 +22,16 @@ grep -q '^[0-9]* meta device 1 00:1F:32:FA:CE:01 camera1 0306$' live/input.log |
 cmp live.json offline.json || fail "the live rig differs from the offline one on the same reports"
 rms=$(sed -n 's/.*"reprojection_rms_px":\([0-9.e-]*\).*/\1/p' live.out)
 awk -v r="$rms" 'BEGIN { exit !(r > 0 && r < 1) }' || fail "reprojection RMS $rms px"
+# The bundle adjustment converging, on stderr; its last word is the rig's RMS to the printed precision.
+ba_line='^fire calibrate: bundle adjustment pass [0-9]*'
+grep -q "$ba_line, iteration 0: reprojection [0-9.]* px (camera 0 [0-9.]*, camera 1 [0-9.]*), [0-9]* wand frames$" live.err ||
+  fail "no bundle adjustment start on stderr: $(cat live.err)"
+grep -q "$ba_line, iteration [1-9][0-9]*: reprojection" live.err || fail "no bundle adjustment iteration on stderr: $(cat live.err)"
+last=$(grep "$ba_line" live.err | tail -1)
+echo "$last" | grep -q "$ba_line converged after [0-9]* iterations: reprojection [0-9.]* px" ||
+  fail "the last bundle adjustment line is not its end: $last"
+printed=$(echo "$last" | sed 's/.*: reprojection \([0-9.]*\) px.*/\1/')
+[ "$printed" = "$(awk -v r="$rms" 'BEGIN { printf "%.3f", r }')" ] || fail "last printed RMS $printed px, the rig's $rms px"
 echo "live and offline rigs equal; $(tail -1 live.err); $(cat live.out)"
 
 # Misuse is said in words.

@@ -1,5 +1,6 @@
 // Wand calibration on synthetic rigs: exact recovery, convergence from wrong nominal
-// intrinsics under the device's noise, and clear errors on unusable input; rig.json round trip.
+// intrinsics under the device's noise, the progress observer, and clear errors on unusable
+// input; rig.json round trip.
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -121,6 +122,51 @@ TEST_CASE("calibration: frames with a wrong blob are rejected, the rest still ca
   CHECK(r->reprojection_rms_px < 0.28);
   CHECK(std::abs(r->cam0.K.fx / true_intrinsics(0).fx - 1) < 0.003);
   CHECK((r->cam1.t - rig.cam1.t).norm() < 0.002);
+}
+
+TEST_CASE("calibration: the progress observer shows the adjustment converge and changes nothing",
+          "[calibration]") {
+  const Rig rig = distorted_rig();
+  std::mt19937_64 rng(16);
+  auto obs = wand_observations(rig, 800, 0.3, 0.3, true, rng);
+  // A few blobs off by 5 px: too little for the epipolar test to catch, so that the adjustment
+  // also resumes without outliers.
+  for (size_t i = 0; i < obs.size(); i += 40) obs[i].cam1[0] += Vec2(5, 0);
+  CalibrationOptions o{scaled_focal(wiimote_nominal_intrinsics(), 1.02), wiimote_nominal_intrinsics(), 0.3, 100};
+  const Result<CalibrationResult> plain = calibrate_wand(obs, o);
+  REQUIRE(plain.ok());
+
+  std::vector<CalibrationProgress> seen;
+  o.on_iteration = [&seen](const CalibrationProgress& p) { seen.push_back(p); };
+  const Result<CalibrationResult> observed = calibrate_wand(obs, o);
+  REQUIRE(observed.ok());
+  // rig.json writes each double as the shortest decimal that reads back to its bits.
+  CHECK(rig_to_json(*observed) == rig_to_json(*plain));
+
+  REQUIRE(seen.size() >= 3);
+  CHECK(seen.front().iteration == 0);
+  CHECK_FALSE(seen.front().finished);
+  CHECK(seen.front().frames > observed->observations_used);  // some outliers were dropped on the way
+  const CalibrationProgress& last = seen.back();
+  CHECK(last.finished);
+  CHECK(last.iteration == observed->iterations);
+  CHECK(last.frames == observed->observations_used);
+  CHECK(last.reprojection_rms_px == observed->reprojection_rms_px);  // the same expression on the same cost
+  for (size_t i = 0; i < seen.size(); ++i) {
+    const CalibrationProgress& p = seen[i];
+    INFO("report " << i << ": iteration " << p.iteration << ", rms " << p.reprojection_rms_px << " px");
+    CHECK(std::isfinite(p.reprojection_rms_px));
+    CHECK(std::isfinite(p.camera_rms_px[0]));
+    CHECK(std::isfinite(p.camera_rms_px[1]));
+    // The combined figure is the root of the mean of the cameras' squares (each has 4 of the 8 coordinates).
+    const double mean_square =
+        0.5 * (p.camera_rms_px[0] * p.camera_rms_px[0] + p.camera_rms_px[1] * p.camera_rms_px[1]);
+    CHECK(std::sqrt(mean_square) == Approx(p.reprojection_rms_px).epsilon(1e-9));
+    CHECK(p.finished == (i + 1 == seen.size()));
+    if (i == 0) continue;
+    CHECK(p.iteration >= seen[i - 1].iteration);
+    CHECK(p.reprojection_rms_px <= seen[i - 1].reprojection_rms_px);
+  }
 }
 
 TEST_CASE("calibration: unusable input gives a clear error", "[calibration]") {

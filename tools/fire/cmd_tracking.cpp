@@ -2,6 +2,7 @@
 // strokes, and the simulated rig that proves its accuracy (systems/tracking).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -246,6 +247,50 @@ struct CalibrateArgs {
   LiveWandOptions live_options;
 };
 
+// Shows the bundle adjustment converging on stderr: each pass's start, the frames it drops as
+// outliers and its end; between them the iterations that change the printed figures, and past the
+// 20th only those that lower the RMS by more than 1 % since the last line, so a slow pass stays short.
+class AdjustmentPrinter {
+ public:
+  explicit AdjustmentPrinter(int max_iterations) : max_iterations_(max_iterations) {}
+
+  void show(const CalibrationProgress& p) {
+    constexpr int kEveryIteration = 20;
+    char figures[160];
+    std::snprintf(figures, sizeof figures, ": reprojection %.3f px (camera 0 %.3f, camera 1 %.3f)",
+                  p.reprojection_rms_px, p.camera_rms_px[0], p.camera_rms_px[1]);
+    if (p.iteration == 0) ++pass_;  // an end report is never iteration 0: an adjustment runs at least one
+    std::string what = "bundle adjustment pass " + std::to_string(pass_);
+    std::string after;
+    if (p.finished) {
+      what += p.iteration >= max_iterations_ ? " stopped at the iteration limit after " : " converged after ";
+      what += std::to_string(p.iteration) + " iterations";
+    } else {
+      what += ", iteration " + std::to_string(p.iteration);
+      if (p.iteration == 0) {
+        after = ", " + std::to_string(p.frames) + " wand frames";
+      } else if (p.frames < frames_) {
+        const int dropped = frames_ - p.frames;
+        after = " without " + std::to_string(dropped) + (dropped == 1 ? " outlying frame" : " outlying frames");
+      } else if (figures == printed_figures_ ||
+                 (p.iteration > kEveryIteration && !(p.reprojection_rms_px < 0.99 * printed_rms_))) {
+        return;
+      }
+    }
+    frames_ = p.frames;
+    printed_rms_ = p.reprojection_rms_px;
+    printed_figures_ = figures;
+    std::cerr << "fire calibrate: " << what << figures << after << "\n";
+  }
+
+ private:
+  int max_iterations_;
+  int pass_ = 0;
+  int frames_ = 0;
+  double printed_rms_ = 0;
+  std::string printed_figures_;
+};
+
 // The wand's reports: the log or folder given, or (--live) those the remotes send now, recorded.
 Result<InputLog> wand_log(const CalibrateArgs& a, std::vector<std::string>& notes) {
   if (!a.live) return read_log_or_session(a.log_path, notes);
@@ -277,6 +322,8 @@ int run_calibrate(const CalibrateArgs& a) {
   options.nominal1 = truth.has_nominal[1] ? truth.nominal[1] : wiimote_nominal_intrinsics();
   options.wand_length_m = a.wand_length_m ? *a.wand_length_m : truth.has_wand_length ? truth.wand_length_m : 0.3;
   options.max_iterations = a.max_iterations;
+  AdjustmentPrinter printer(a.max_iterations);
+  options.on_iteration = [&printer](const CalibrationProgress& p) { printer.show(p); };
   if (!std::isfinite(options.wand_length_m) || !(options.wand_length_m > 0))
     return fail(command, "--wand-length must be a positive number of metres");
   DeviceStreams streams = decode_device_streams(log->events);
@@ -537,7 +584,9 @@ void add_tracking_commands(CLI::App& app, Registry& registry) {
       ->capture_default_str();
   c->footer(
       "Starts from the log's meta nominal_intrinsics (else the Wii Remote's 1330 px, centre 512 x 384); estimates "
-      "the cameras' time offset from the rig and calibrates again until it settles. Prints one JSON line: "
+      "the cameras' time offset from the rig and calibrates again until it settles, showing each pass's bundle "
+      "adjustment converge on stderr (reprojection RMS per coordinate, overall and per camera, at the iterations "
+      "that change it; past the 20th only drops of over 1 %). Prints one JSON line: "
       "reprojection_rms_px (per coordinate), reprojection_rms_2d_px (per blob), wand_length_error_mm, observations "
       "used and rejected, time_offset_ms, rejected report counts; for simulated logs also rig_* errors against the "
       "true cameras and true_time_offset_ms.");
