@@ -204,7 +204,7 @@ Renderer::~Renderer() {
   VkDevice device = context_.device();
   vkDeviceWaitIdle(device);  // nothing else to do on failure: everything is destroyed either way
   for (Buffer* b : {&readback_, &points_, &vertices_, &surface_vertices_, &surface_indices_, &reference_vertices_,
-                    &reference_indices_, &stroke_, &pen_})
+                    &reference_indices_, &stroke_, &pen_, &marks_})
     destroy(*b);
   for (Target* t : {&color_, &resolve_, &depth_}) destroy(*t);
   for (VkPipeline p : {surface_, reference_pipeline_, curves_, markers_, wireframe_, pen_face_})
@@ -581,6 +581,21 @@ Status Renderer::set_stroke(std::span<const Vec3> points) {
   return Status::success();
 }
 
+Status Renderer::set_marks(std::span<const Vec3> marks, size_t next) {
+  std::vector<glm::vec3> data;
+  data.reserve(marks.size());
+  for (const Vec3& p : marks) data.push_back(to_float(p));
+  next_mark_ = next;
+  if (data == marks_copy_) return Status::success();
+  if (!data.empty()) {
+    bool grown = false;
+    FIRE_TRY(reserve(marks_, data.size() * sizeof(glm::vec3), kVertex, grown));
+    copy_into(marks_, 0, data.data(), data.size() * sizeof(glm::vec3));
+  }
+  marks_copy_ = std::move(data);
+  return Status::success();
+}
+
 Status Renderer::set_pen_feedback(const Mesh& network, const PenFeedback& feedback) {
   std::vector<glm::vec3> data;
   uint32_t fan = 0;
@@ -765,6 +780,22 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
     push();
     vkCmdBindVertexBuffers(cmd, 0, 1, &stroke_.buffer, &zero);
     vkCmdDraw(cmd, 6, stroke_count_ - 1, 0, 0);
+  }
+  if (!marks_copy_.empty()) {  // over the surface, so a mark under it still shows where to touch
+    const auto count = uint32_t(marks_copy_.size());
+    pc.color = linear(Palette::mark);
+    pc.params.x = std::max(3.0f, 6.0f * scale);
+    pc.params.w = camera.line_depth_pull * 3.0f;
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, markers_);
+    push();
+    vkCmdBindVertexBuffers(cmd, 0, 1, &marks_.buffer, &zero);
+    vkCmdDraw(cmd, 6, count, 0, 0);
+    if (next_mark_ < count) {
+      pc.color = linear(Palette::next_mark);
+      pc.params.x = std::max(5.0f, 11.0f * scale);
+      push();
+      vkCmdDraw(cmd, 6, 1, 0, uint32_t(next_mark_));
+    }
   }
   if (pen_marker_) {  // last: the marker says where the stroke will end, over the stroke itself
     pc.color = linear(pen_closes_ ? Palette::close_border : Palette::snap_target);

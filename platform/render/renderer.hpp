@@ -7,7 +7,8 @@
 // screen-space line pulled slightly towards the camera so it shows on the surface it lies on; the
 // network's vertices as round markers; an optional see-through reference mesh; the pen's feedback
 // (engine/pen_feedback.hpp): the face under the pen tinted see-through over everything but the stroke, the snap target as a
-// large marker, and the border's first vertex as a larger one when a stroke ending at the pen would close it.
+// large marker, and the border's first vertex as a larger one when a stroke ending at the pen would close it;
+// in a live session the object's registration marks, the one to touch next larger and red.
 //
 // Uploads copy only what changed and count the bytes (UploadStats, per upload() call, i.e. per frame):
 // - points: the GPU keeps a float copy of the point pool at the pool's indices. An edge's points are
@@ -62,6 +63,8 @@ struct Palette {
   static constexpr uint8_t pen_face[3] = {255, 70, 200};       // tint of the face under the pen
   static constexpr uint8_t snap_target[3] = {40, 225, 255};    // where a stroke end at the pen snaps
   static constexpr uint8_t close_border[3] = {70, 235, 110};   // the first vertex, when a stroke end closes the border
+  static constexpr uint8_t mark[3] = {170, 120, 255};          // the object's registration marks
+  static constexpr uint8_t next_mark[3] = {255, 60, 60};       // the mark to touch next
   static constexpr float pen_face_alpha = 0.4f;
 };
 
@@ -97,6 +100,9 @@ class Renderer {
   // holds are not drawn. Copies from the first value that changed since the last call (the marker alone while the
   // pen moves over one face), counted in last_upload().
   Status set_pen_feedback(const Mesh& network, const PenFeedback& feedback);
+  // The object's registration marks, the one at `next` larger and in its own colour (none: no highlight);
+  // empty: none. Copied whole when they change: a handful of points.
+  Status set_marks(std::span<const Vec3> marks, size_t next);
   // A mesh drawn see-through over the scene (triangles: 3 indices each); empty triangles removes it.
   Status set_reference(std::span<const Vec3> positions, std::span<const uint32_t> triangles);
 
@@ -203,6 +209,9 @@ class Renderer {
   std::vector<glm::vec3> pen_copy_;  // what pen_ holds
   uint32_t pen_face_vertices_ = 0;
   bool pen_marker_ = false, pen_closes_ = false;
+  Buffer marks_;
+  std::vector<glm::vec3> marks_copy_;  // what marks_ holds
+  size_t next_mark_ = 0;
   Buffer reference_vertices_, reference_indices_;
   uint32_t reference_index_count_ = 0;
 

@@ -192,10 +192,17 @@ void AppLive::fill_hud(window::HudData& hud) const {
     else if (!v.warning.empty()) line += " (" + v.warning + ")";
     hud.live.push_back(line);
   }
-  if (!marks_.empty())
-    hud.live.push_back("touch mark " + std::to_string(shown_mark_) + " of " + std::to_string(marks_.size()) + " " +
-                       millimetres(marks_[shown_mark_]) + ", then press 2 (or M); Home (or R) registers");
+  if (!marks_.empty()) {
+    hud.live.push_back("next mark: " + std::to_string(shown_mark_) + " of " + std::to_string(marks_.size()) + " at " +
+                       millimetres(marks_[shown_mark_]));
+    hud.live.push_back("rest the pen on it, press 2 (or M); Home (or R) registers");
+  }
   hud.cameras = cameras_;
+}
+
+const std::vector<Vec3>& AppLive::marks_in_view() const {
+  static const std::vector<Vec3> none;
+  return world_.registration.transform ? marks_ : none;
 }
 
 Status AppLive::finish() {

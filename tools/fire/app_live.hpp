@@ -51,6 +51,10 @@ class AppLive {
   std::string act(PadAction action);
   // The HUD's live part: the remotes, the mark to touch next, each camera's IR view.
   void fill_hud(window::HudData& hud) const;
+  // The marks to draw, in the network's frame, and the one to touch next: none before the object is
+  // registered, when the network's frame is still the rig's.
+  const std::vector<Vec3>& marks_in_view() const;
+  size_t shown_mark() const { return shown_mark_; }
   // Whether the fake rig has shown its whole drawing (never with real remotes).
   bool fake_finished() const { return fake_ && fake_->finished(); }
   // Stops the driver, runs every frame left and closes the session's log; the first failed write.

@@ -112,6 +112,7 @@ bool AppWindow::display(const render::Orbit& orbit, render::Image* capture) {
   const std::span<const Vec3> stroke = w.sketch.pen_down ? std::span<const Vec3>(w.sketch.stroke) : std::span<const Vec3>();
   if (status_ = renderer_->set_stroke(stroke); !status_) return false;
   if (status_ = renderer_->set_pen_feedback(w.mesh, w.pen_feedback); !status_) return false;
+  if (status_ = renderer_->set_marks(marks_, next_mark_); !status_) return false;
   stages_.upload = ms_since(mark);
   const auto wall_now = WallClock::now();
   hud_data.frame_ms = std::chrono::duration<double, std::milli>(wall_now - last_frame_).count();

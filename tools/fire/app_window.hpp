@@ -54,6 +54,11 @@ class AppWindow {
   // A live session runs the frames itself as the remotes' reports complete them (app_live.hpp): display()
   // then calls `step` instead of running the fixed steps the wall clock has passed.
   void drive_frames_with(std::function<void()> step) { drive_frames_ = std::move(step); }
+  // The object's registration marks in the network's frame, the one at `next` highlighted; empty: none.
+  void show_marks(std::vector<Vec3> marks, size_t next) {
+    marks_ = std::move(marks);
+    next_mark_ = next;
+  }
   // One displayed frame, the camera from `orbit`. With `capture`, a presented frame is read back into it.
   // False: nothing was shown (minimised, the swapchain was remade for a new size, or status() failed).
   bool display(const render::Orbit& orbit, render::Image* capture = nullptr);
@@ -82,6 +87,8 @@ class AppWindow {
   Scheduler& scheduler_;
   SessionRecorder* recorder_ = nullptr;
   std::function<void()> drive_frames_;
+  std::vector<Vec3> marks_;
+  size_t next_mark_ = 0;
   std::unique_ptr<window::Window> window_;
   std::unique_ptr<render::Context> context_;
   std::unique_ptr<render::Presenter> presenter_;

@@ -369,9 +369,12 @@ int run_app(const AppArgs& a) {
     app.drive_frames_with([&] {
       for (std::string& message : live->step()) report(std::move(message));
       live->fill_hud(hud_data);
+      app.show_marks(live->marks_in_view(), live->shown_mark());
       if (!view_moved && w.mesh.edge_count() != framed_edges) {
         framed_edges = w.mesh.edge_count();
-        orbit = frame_orbit(scene_box(w.mesh, w.surface, reference_positions), app.width(), app.height());
+        render::Box box = scene_box(w.mesh, w.surface, reference_positions);
+        for (const Vec3& mark : live->marks_in_view()) box.add(mark);
+        orbit = frame_orbit(box, app.width(), app.height());
       }
     });
   auto log_command = [&](CommandKind command, const Vec3& p) {

@@ -567,7 +567,7 @@ TEST_CASE("fire app --live: fake remotes draw through the driver, the pad gives 
   const fs::path dir = scratch("live");
   const std::string session = (dir / "live").string(), shot = (dir / "shot.png").string();
   const Run app = run_app(230,
-                          "--live --fake-rig 7 --fake-strokes 8 --fake-speed 6 --snapshot-every 500 --size 800x600 "
+                          "--live --fake-rig 7 --fake-strokes 8 --fake-speed 6 --snapshot-every 500 --size 1200x760 "
                           "--session " + quote(session) + " --script " + quote(FIRE_WINDOW_TEST_DIR "/live.script") +
                               " --screenshot " + quote(shot),
                           dir);
@@ -628,6 +628,16 @@ TEST_CASE("fire app --live: fake remotes draw through the driver, the pad gives 
       for (size_t x = green_x0 + 1; x < green_x1; ++x) blob += near(im.pixel(uint32_t(x), uint32_t(y)), white, 10);
     CHECK(blob > 4);
     CHECK(curve_pixels(im) > 200);  // the curves drawn so far
+    // Registered: the object's marks in the view, the one to touch next larger and red.
+    size_t marks = 0, next_mark = 0;
+    for (uint32_t y = 0; y < im.height; ++y)
+      for (uint32_t x = 0; x < im.width; ++x) {
+        marks += near(im.pixel(x, y), Palette::mark, 10);
+        next_mark += near(im.pixel(x, y), Palette::next_mark, 10);
+      }
+    INFO("mark pixels " << marks << ", next mark " << next_mark);
+    CHECK(marks > 40);
+    CHECK(next_mark > 40);
   }
   fs::remove_all(dir);
 }
