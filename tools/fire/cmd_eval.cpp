@@ -61,6 +61,9 @@ int run_eval(const EvalArgs& a) {
   nlohmann::ordered_json out;
   out["rms"] = d.rms;
   out["hausdorff"] = d.hausdorff;
+  // From SURFACE's samples only: what a drawing that covers part of the object is measured by.
+  out["surface_rms"] = d.a_to_b.rms() / diagonal;
+  out["surface_max"] = d.a_to_b.max / diagonal;
   if (!network_points.empty()) {
     const double network_max = evaluate::distances_to(network_points, out_bvh).max / diagonal;
     if (!std::isfinite(network_max)) return fail(a.network_path + ": network distance is not finite");
@@ -81,8 +84,9 @@ void add_eval_commands(CLI::App& app, Registry& registry) {
       "Measure a surface against the Catmull-Clark limit surface of a control mesh. Both are sampled densely "
       "(vertices plus sub-triangle centroids); each sample's exact distance to the other surface is divided by the "
       "bounding-box diagonal of the reference limit surface. Prints one JSON line: rms (square root of the mean "
-      "squared distance over the samples of both directions), hausdorff (largest distance, both directions), with "
-      "--network network_max (largest distance from a polyline point to the surface), diagonal, samples.");
+      "squared distance over the samples of both directions), hausdorff (largest distance, both directions), "
+      "surface_rms and surface_max (the same from SURFACE's samples only: a drawing of part of the object is measured "
+      "where it is), with --network network_max (largest distance from a polyline point to the surface), diagonal, samples.");
   cmd->add_option("SURFACE", a->surface_path, "surface to measure: .obj, .ply, .stl or .glb as `fire reconstruct` writes")
       ->required();
   cmd->add_option("--reference", a->reference_path,

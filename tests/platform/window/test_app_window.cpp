@@ -367,6 +367,14 @@ TEST_CASE("fire app: a 24-face grid drawn with the mouse on the pawn, one split 
     REQUIRE(replay.exit_code == 0);
     CHECK(replay.out == json["hash"].get<std::string>() + "\n");
   }
+  // The grid covers the front of the head: its surface is measured where it is, against the pawn's limit surface.
+  const Run eval = run(quote(FIRE_BINARY) + " eval " + quote(exported) + " --reference " + quote(FIRE_PAWN), dir);
+  INFO("fire eval: " << eval.out << eval.err);
+  REQUIRE(eval.exit_code == 0);
+  const auto measured = nlohmann::json::parse(eval.out);
+  CHECK(measured["surface_rms"].get<double>() <= 0.01);
+  CHECK(measured["surface_max"].get<double>() <= 0.05);
+  CHECK(measured["rms"].get<double>() > measured["surface_rms"].get<double>());  // the rest of the pawn is not drawn
   fs::remove_all(dir);
 }
 
