@@ -344,6 +344,12 @@ int run_app(const AppArgs& a) {
   }
 
   auto opened = AppWindow::open(w, scheduler, width, height, reference.positions, reference.triangles);
+  if (!opened && live && live->frames_run() == 0) {
+    // Nothing was recorded yet: the new folder would only be an empty session.
+    live.reset();
+    std::error_code ignored;
+    std::filesystem::remove_all(live_dir, ignored);
+  }
   if (!opened) return fail(opened.error());
   AppWindow& app = **opened;
   if (recorder) app.record_into(&*recorder);

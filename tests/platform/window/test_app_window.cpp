@@ -664,6 +664,12 @@ TEST_CASE("fire app --live misused, or without remotes: a clear message, exit 1,
   const Run rig_alone = app("--rig x.json");
   CHECK(rig_alone.exit_code == 1);
   CHECK(rig_alone.err.find("are for --live") != std::string::npos);
+  // No display: the window cannot open, and the session folder made for the remotes is not left behind empty.
+  const std::string fake_session = (dir / "fake").string();
+  const Run no_display = app("--live --fake-rig 1 --fake-strokes 2 --session " + quote(fake_session));
+  CHECK(no_display.exit_code == 1);
+  CHECK(no_display.err.find("no display") != std::string::npos);
+  CHECK_FALSE(fs::exists(fake_session));
   const Run speed = app("--live --fake-rig 1 --fake-speed nan");
   CHECK(speed.exit_code == 1);
   CHECK(speed.err.find("--fake-speed must be") != std::string::npos);
