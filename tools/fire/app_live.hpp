@@ -62,7 +62,7 @@ class AppLive {
   uint64_t frames_run() const { return live_->frames_run(); }
 
  private:
-  AppLive(const AppLiveOptions& options) : options_(options) {}
+  explicit AppLive(const AppLiveOptions& options) : options_(options) {}
   void observe(std::span<const InputEvent> taken);
 
   AppLiveOptions options_;
