@@ -1,13 +1,15 @@
 // The live frame's latency: replays drawings through every system of the session (input, sketch,
 // split, refine, subdivide) on one core and reports the time of each frame with input (thread CPU
 // time: the machine is shared) as p50, p99 and max, per system and for the whole frame, plus how many
-// frames pass from the pen-up that commits a curve to the first frame whose surface shows its faces
+// frames pass from the frame that commits a curve to the first frame whose surface shows its faces
 // and to the frame where the surface has settled.
 //
 // Drawings: the bundled demo log (a dome, 14 faces) and a grid drawing of 200 faces on a wavy sheet
 // (a border, 19 long curves, then 180 short ones cell by cell), at subdivision levels 2 and 3.
 //
-//   bench_frame [--write-grid-log FILE]    (the grid drawing as an input log, for callgrind)
+//   bench_frame [--whole-fit]              (--whole-fit: the fit runs to its end in the commit frame, as
+//                                           before the frame budget; for comparisons in one session)
+//   bench_frame --write-grid-log FILE      (the grid drawing as an input log, for callgrind)
 #include <time.h>
 
 #include <algorithm>
@@ -42,11 +44,12 @@ struct Run {
   std::string problem;
 };
 
-Run replay(const std::vector<InputEvent>& events, uint32_t levels, double snap) {
+Run replay(const std::vector<InputEvent>& events, uint32_t levels, double snap, uint32_t fit_solves) {
   World w;
   w.log.events = events;
   w.sketch_settings.snap_distance = snap;
   w.surface_options.levels = levels;
+  w.surface_options.fit_solves_per_frame = fit_solves;
   std::vector<SystemSpec> systems = session_systems(w);
   auto scheduler = Scheduler::build(std::move(systems), thread_cpu_ns);
   Run run;
@@ -56,7 +59,9 @@ Run replay(const std::vector<InputEvent>& events, uint32_t levels, double snap) 
   }
   // The replay loop of tools/fire/session.cpp, watching each frame for a commit and for the surface.
   begin_frame(w, 0, w.log.events.front().t_us);
-  int64_t pending_commit = -1;  // frame index of a commit whose faces are not shown yet
+  // Frame index of the first commit whose faces are not shown yet, and of the first not settled yet (a
+  // commit while a fit runs abandons it: the earlier commit waits for the later one's fit).
+  int64_t pending_commit = -1, unsettled_commit = -1;
   while (!replay_done(w)) {
     if (!systems_waiting(w) && w.log.events[w.cursor.next].t_us >= w.frame.end_us) {
       const int64_t steps = (w.log.events[w.cursor.next].t_us - w.frame.begin_us) / kFrameStepUs;
@@ -68,12 +73,16 @@ Run replay(const std::vector<InputEvent>& events, uint32_t levels, double snap) 
     const int64_t ns = scheduler->frame_timing().samples_ns.back();
     if (w.history.undo_depth() > edits_before) {
       run.commit_frame_ns.push_back(ns);
-      pending_commit = int64_t(w.frame.index);
+      if (pending_commit < 0) pending_commit = int64_t(w.frame.index);
+      if (unsettled_commit < 0) unsettled_commit = int64_t(w.frame.index);
     }
     if (pending_commit >= 0 && w.surface_build.updates > updates_before && w.surface.frame == w.frame.index) {
       run.shown_after.push_back(int64_t(w.frame.index) - pending_commit);
-      if (w.surface.settled) run.settled_after.push_back(int64_t(w.frame.index) - pending_commit);
       pending_commit = -1;
+    }
+    if (pending_commit < 0 && unsettled_commit >= 0 && w.surface.settled && w.surface.frame == w.frame.index) {
+      run.settled_after.push_back(int64_t(w.frame.index) - unsettled_commit);
+      unsettled_commit = -1;
     }
     begin_frame(w, w.frame.index + 1, w.frame.end_us);
   }
@@ -124,23 +133,26 @@ int main(int argc, char** argv) {
     }
     return 0;
   }
-  if (argc != 1) {
-    std::fprintf(stderr, "usage: bench_frame [--write-grid-log FILE]\n");
+  const bool whole_fit = argc == 2 && std::strcmp(argv[1], "--whole-fit") == 0;
+  if (argc != 1 && !whole_fit) {
+    std::fprintf(stderr, "usage: bench_frame [--whole-fit | --write-grid-log FILE]\n");
     return 2;
   }
+  const uint32_t fit_solves = whole_fit ? reconstruct::kWholeFit : reconstruct::Options{}.fit_solves_per_frame;
   auto demo = read_input_log(FIRE_SOURCE_DIR "/tools/demo/sketch.log");
   if (!demo) {
     std::fprintf(stderr, "bench_frame: %s\n", demo.error().c_str());
     return 1;
   }
-  std::printf("# bench_frame: every frame with input, thread CPU time, one core\n\n");
+  std::printf("# bench_frame: every frame with input or a fit running, thread CPU time, one core; fit: %s\n\n",
+              whole_fit ? "whole in the commit frame" : (std::to_string(fit_solves) + " back-substitutions per frame").c_str());
   std::printf("| drawing | L | final | frames | p50 ms | p99 ms | max ms | commit p50 ms | commit max ms | "
               "shown after (frames) | settled after (frames) |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
   std::vector<std::pair<std::string, std::pair<uint32_t, Run>>> runs;
   for (uint32_t levels : {2u, 3u}) {
-    runs.push_back({"demo dome", {levels, replay(demo->events, levels, SketchSettings{}.snap_distance)}});
+    runs.push_back({"demo dome", {levels, replay(demo->events, levels, SketchSettings{}.snap_distance, fit_solves)}});
     report("demo dome", levels, runs.back().second.second);
-    runs.push_back({"grid 200", {levels, replay(grid, levels, 0.005)}});
+    runs.push_back({"grid 200", {levels, replay(grid, levels, 0.005, fit_solves)}});
     report("grid 200", levels, runs.back().second.second);
   }
   std::printf("\n| drawing | L | system | p50 ms | p99 ms | max ms |\n|---|---|---|---|---|---|\n");
