@@ -59,8 +59,9 @@ Run replay(const std::vector<InputEvent>& events, uint32_t levels, double snap, 
   }
   // The replay loop of tools/fire/session.cpp, watching each frame for a commit and for the surface.
   begin_frame(w, 0, w.log.events.front().t_us);
-  // Frame index of the first commit whose faces are not shown yet, and of the first not settled yet (a
-  // commit while a fit runs abandons it: the earlier commit waits for the later one's fit).
+  // Frame index of the last commit whose faces are not shown yet (a border stroke's never are), and of the
+  // first shown one whose surface has not settled yet (a commit while a fit runs abandons that fit: the
+  // earlier commit waits for the later one's).
   int64_t pending_commit = -1, unsettled_commit = -1;
   while (!replay_done(w)) {
     if (!systems_waiting(w) && w.log.events[w.cursor.next].t_us >= w.frame.end_us) {
@@ -73,14 +74,14 @@ Run replay(const std::vector<InputEvent>& events, uint32_t levels, double snap, 
     const int64_t ns = scheduler->frame_timing().samples_ns.back();
     if (w.history.undo_depth() > edits_before) {
       run.commit_frame_ns.push_back(ns);
-      if (pending_commit < 0) pending_commit = int64_t(w.frame.index);
-      if (unsettled_commit < 0) unsettled_commit = int64_t(w.frame.index);
+      pending_commit = int64_t(w.frame.index);
     }
     if (pending_commit >= 0 && w.surface_build.updates > updates_before && w.surface.frame == w.frame.index) {
       run.shown_after.push_back(int64_t(w.frame.index) - pending_commit);
+      if (unsettled_commit < 0) unsettled_commit = pending_commit;
       pending_commit = -1;
     }
-    if (pending_commit < 0 && unsettled_commit >= 0 && w.surface.settled && w.surface.frame == w.frame.index) {
+    if (unsettled_commit >= 0 && w.surface.settled && w.surface.frame == w.frame.index) {
       run.settled_after.push_back(int64_t(w.frame.index) - unsettled_commit);
       unsettled_commit = -1;
     }
