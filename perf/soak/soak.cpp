@@ -161,6 +161,9 @@ int main(int argc, char** argv) {
     if (op % s.check_every == 0) {
       ++checks;
       if (auto bad = snap.validate(mesh); !bad.empty()) return fail(op, "snapping index: " + bad);
+      // The fit of the last commit spreads over the frames after it (subdivide_system.hpp): run them.
+      while (build.problem.empty() && build.state.fitting())
+        subdivide_system(options, FrameTime{op, 0, 0}, build, surface);
       auto full = reconstruct::reconstruct_surface(mesh, options);
       if (!build.problem.empty()) {
         // A face the method refuses: the full rebuild must refuse it with the same reason.

@@ -245,7 +245,23 @@ bool ordered(const std::vector<Span>& spans, const Eigen::VectorXd& fractions) {
 }  // namespace
 
 LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points) const {
-  const Impl& m = *impl_;
+  FitRun run(*this, base);
+  run.advance(std::numeric_limits<uint32_t>::max());
+  points = run.points();
+  return run.report();
+}
+
+FitRun::FitRun(const LimitFit& fit, const BaseMesh& base) : steps_(fit_steps(*fit.impl_, base)) {}
+
+bool FitRun::advance(uint32_t solves) {
+  for (uint32_t k = 0; k < solves && steps_.running(); ++k) steps_.resume();
+  return steps_.finished();
+}
+
+// LimitFit::solve's body. Each `co_yield Step{}` stands just before a back-substitution, so that one
+// resume runs exactly one (and the target updates up to the next); the body starts eagerly (steps.hpp),
+// so the setup above the first one runs in FitRun's constructor, the only place `base` is read.
+Steps<FitRun::Fitted> FitRun::fit_steps(const LimitFit::Impl& m, const BaseMesh& base) {
   const uint32_t nb = m.base_vertices, pieces = base.pieces_per_edge;
   Eigen::MatrixX3d targets(m.rows.rows(), 3), initial(nb, 3);
   for (uint32_t v = 0; v < nb; ++v) {
@@ -270,7 +286,7 @@ LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points
   }
   const double tolerance = m.settings.tolerance * std::max(bounding_box_diagonal(base.positions), 1e-300);
 
-  Report report;
+  LimitFit::Report report;
   Eigen::MatrixX3d solution, fitted;
   auto solve_once = [&] {
     const Eigen::MatrixX3d rhs = Eigen::MatrixX3d(m.rows.transpose() * targets) + m.ridge * initial;
@@ -279,11 +295,13 @@ LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points
     ++report.iterations;
   };
   std::vector<double> scratch;
+  co_yield Step{};
   solve_once();
   // Phase 1: the split points slide too, to where the fitted surface puts them along the whole edge.
   for (uint32_t round = 0; round < m.settings.slide_iterations; ++round) {
     double move = 0;
     for (const Span& span : whole) move = std::max(move, slide(span, fitted, targets, scratch));
+    co_yield Step{};
     solve_once();
     if (move <= tolerance) break;
   }
@@ -362,6 +380,7 @@ LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points
     }
     x = next;
     place(x);
+    co_yield Step{};
     solve_once();
   }
   // The data term the fit minimizes: squared distances of the fitted points to their edges' polylines.
@@ -380,6 +399,7 @@ LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points
   std::vector<Span> split;
   if (pieces > 1) {
     for (const Span& span : whole) snap_split_points(span, pieces, targets, split);
+    co_yield Step{};
     solve_once();
   }
   const std::vector<Span>& sliding = pieces > 1 ? split : whole;
@@ -387,6 +407,7 @@ LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points
     double move = 0;
     for (const Span& span : sliding) move = std::max(move, slide(span, fitted, targets, scratch));
     if (move <= tolerance) break;
+    co_yield Step{};
     solve_once();
   }
   if (distance_to_curves() > feet_distance) {
@@ -394,10 +415,12 @@ LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points
     fitted = feet_fitted;
     targets = feet_targets;
   }
-  points.resize(nb);
-  for (uint32_t v = 0; v < nb; ++v) points[v] = solution.row(v).transpose();
+  Fitted out;
+  out.points.resize(nb);
+  for (uint32_t v = 0; v < nb; ++v) out.points[v] = solution.row(v).transpose();
   report.rms = m.rows.rows() ? std::sqrt((fitted - targets).squaredNorm() / double(m.rows.rows())) : 0.0;
-  return report;
+  out.report = report;
+  co_return out;
 }
 
 }  // namespace fire::reconstruct

@@ -32,10 +32,14 @@
 //   Without phase 2 the split points freeze where phase 1 left them (perf/RESULTS.md has the pawn's
 //   network_max with and without it).
 // Each phase stops when no target moves more than `tolerance` times the base mesh's size.
+//
+// FitRun is the same fit a few back-substitutions at a time, for the frame (the subdivide system spreads
+// it over the frames after a commit): solve() is a FitRun advanced to its end.
 #include <memory>
 #include <vector>
 
 #include "systems/reconstruct/reconstruct.hpp"
+#include "systems/reconstruct/steps.hpp"
 #include "systems/subdivide/subdivide.hpp"
 
 namespace fire::reconstruct {
@@ -73,8 +77,34 @@ class LimitFit {
   Report solve(const BaseMesh& base, std::vector<Vec3>& points) const;
 
  private:
+  friend class FitRun;
   struct Impl;
   std::unique_ptr<Impl> impl_;
+};
+
+// LimitFit::solve spread over calls: the same code, suspended before each back-substitution, so that a
+// run advanced to its end gives solve's points bit for bit however its solves were spread.
+class FitRun {
+ public:
+  FitRun() = default;  // no fit: not running
+  // Sets up the first targets from base's polylines; runs no back-substitution yet. Reads `base` only
+  // here (it may change or go once this returns); `fit` must outlive the run.
+  FitRun(const LimitFit& fit, const BaseMesh& base);
+  // Runs at most `solves` more back-substitutions, each with the target updates that follow it; true once
+  // the fit has finished.
+  bool advance(uint32_t solves);
+  bool running() const { return steps_.running(); }
+  // Once advance has returned true: the fitted base points and how the fit went.
+  const std::vector<Vec3>& points() const { return steps_.value().points; }
+  const LimitFit::Report& report() const { return steps_.value().report; }
+
+ private:
+  struct Fitted {
+    std::vector<Vec3> points;
+    LimitFit::Report report;
+  };
+  static Steps<Fitted> fit_steps(const LimitFit::Impl& m, const BaseMesh& base);
+  Steps<Fitted> steps_;
 };
 
 }  // namespace fire::reconstruct

@@ -37,6 +37,9 @@ struct ReconstructionCache {
   subdivide::Refinement refinement;
   subdivide::LimitStencils limit;
   LimitFit fit;
+  // The fit of `base` in progress (fire), between the frame that took the base and the one it ends in.
+  // Reset before `base` or `fit` is replaced; declared after `fit`, so destroyed before it.
+  FitRun run;
   UpdateStats stats;
   std::vector<Vec3> scratch;
 };
@@ -47,6 +50,7 @@ ReconstructionState::ReconstructionState(ReconstructionState&&) noexcept = defau
 ReconstructionState& ReconstructionState::operator=(ReconstructionState&&) noexcept = default;
 const UpdateStats& ReconstructionState::last_update() const { return cache_->stats; }
 const BaseMesh& ReconstructionState::base() const { return cache_->base; }
+bool ReconstructionState::fitting() const { return cache_->run.running(); }
 
 namespace {
 
@@ -107,6 +111,8 @@ Status check_reconstruction_input(const Mesh& net, const Options& options) {
                            std::to_string(options.levels));
   if (!(options.fairness >= 0 && options.fairness <= 1))
     return Status::failure("the fairness weight must be 0 to 1, not " + std::to_string(options.fairness));
+  if (options.fit_solves_per_frame < 1)
+    return Status::failure("the fit's back-substitutions per frame must be at least 1");
   if (std::string problem = net.validate(); !problem.empty()) return Status::failure("invalid network: " + problem);
   if (net.face_count() == 0) return Status::failure("the network has no faces");
   for (uint32_t e = 0; e < net.edge_slots(); ++e) {
@@ -280,6 +286,7 @@ Status rebuild_topology(const Options& options, ReconstructionCache& c) {
     weights.fairness = options.fairness;
     auto fit = LimitFit::build(*refinement, *limit, b, weights);
     if (!fit) return Status::failure(fit.error());
+    c.run = {};
     c.fit = std::move(*fit);
   }
   c.refinement = std::move(*refinement);
@@ -308,6 +315,7 @@ Result<bool> run_refine(const Mesh& net, const Options& options, ReconstructionC
   }
   c.built = false;
   c.options = options;
+  c.run = {};  // a fit of the previous base mesh is abandoned; subdivide starts one from the new
   update_elements(net, options, c, everything);
   c.base = assemble(net, options, c);
   c.rebuild_topology = c.rebuild_topology || everything || !same_topology(c, c.base);
@@ -318,19 +326,7 @@ Result<bool> run_refine(const Mesh& net, const Options& options, ReconstructionC
   return true;
 }
 
-Status run_subdivide(const Options& options, ReconstructionCache& c, SurfaceMesh& surface) {
-  if (!c.pending_subdivide) return Status::success();
-  if (c.rebuild_topology) {
-    if (auto s = rebuild_topology(options, c); !s) return s;
-    c.stats.topology_rebuilt = true;
-    c.rebuild_topology = false;
-  }
-  std::vector<Vec3> base_points = c.base.positions;
-  if (options.method == Method::fire) {
-    const LimitFit::Report report = c.fit.solve(c.base, base_points);
-    c.stats.fit_iterations = report.iterations;
-    c.stats.fit_rms = report.rms;
-  }
+void evaluate_surface(ReconstructionCache& c, std::span<const Vec3> base_points, SurfaceMesh& surface) {
   std::vector<Vec3> last_level;
   subdivide::evaluate(c.refinement, base_points, last_level, c.scratch);
   SurfaceMesh out;
@@ -338,8 +334,42 @@ Status run_subdivide(const Options& options, ReconstructionCache& c, SurfaceMesh
   out.face_offsets = c.refinement.last().face_offsets;
   out.face_vertices = c.refinement.last().face_vertices;
   surface = std::move(out);
-  c.pending_subdivide = false;
-  return Status::success();
+}
+
+static_assert(6 * Options{}.fit_solves_per_frame >= FitWeights{}.max_iterations,
+              "the default budget settles every fit within 6 frames of its commit (reconstruct.hpp)");
+
+Result<SurfaceWrite> run_subdivide(const Options& options, uint32_t fit_solves, ReconstructionCache& c,
+                                   SurfaceMesh& surface) {
+  if (c.pending_subdivide) {
+    if (c.rebuild_topology) {
+      if (auto s = rebuild_topology(options, c); !s) return Result<SurfaceWrite>::failure(s.error);
+      c.stats.topology_rebuilt = true;
+      c.rebuild_topology = false;
+    }
+    c.pending_subdivide = false;
+    if (options.method == Method::thesis) {
+      evaluate_surface(c, c.base.positions, surface);
+      return SurfaceWrite::settled;
+    }
+    // The fit starts from the base mesh's points, the transfinite patches': their surface is shown until
+    // it ends. In the frame, no back-substitution runs in this call: it has paid for topology and
+    // factorization already.
+    c.run = FitRun(c.fit, c.base);
+    if (fit_solves != kWholeFit) {
+      evaluate_surface(c, c.base.positions, surface);
+      return SurfaceWrite::provisional;
+    }
+  }
+  if (!c.run.running() || !c.run.advance(fit_solves)) return SurfaceWrite::none;
+  // Only the provisional surface and the settled one are written, not the fit's iterates between: each
+  // write costs an evaluation and moves every vertex (a whole upload), and the iterates are no better a
+  // preview (phase 2 creeps, and the fit keeps phase 2's or phase 3's solution only at its end).
+  c.stats.fit_iterations = c.run.report().iterations;
+  c.stats.fit_rms = c.run.report().rms;
+  evaluate_surface(c, c.run.points(), surface);
+  c.run = {};
+  return SurfaceWrite::settled;
 }
 
 }  // namespace
@@ -350,10 +380,11 @@ Result<bool> refine_update(const Mesh& net, const Options& options, Reconstructi
   return r;
 }
 
-Status subdivide_update(const Options& options, ReconstructionState& state, SurfaceMesh& surface) {
-  Status s = run_subdivide(options, state.cache(), surface);
-  if (!s) state.cache() = ReconstructionCache{};
-  return s;
+Result<SurfaceWrite> subdivide_update(const Options& options, uint32_t fit_solves, ReconstructionState& state,
+                                      SurfaceMesh& surface) {
+  Result<SurfaceWrite> r = run_subdivide(options, fit_solves, state.cache(), surface);
+  if (!r) state.cache() = ReconstructionCache{};
+  return r;
 }
 
 Status reconstruct_update(const Mesh& net, const Options& options, ReconstructionState& state, SurfaceMesh& surface) {
@@ -361,7 +392,8 @@ Status reconstruct_update(const Mesh& net, const Options& options, Reconstructio
   // A call with nothing changed still re-runs the global stages, as a fresh reconstruction would.
   if (c.built) c.pending_subdivide = true;
   if (auto r = refine_update(net, options, state); !r) return Status::failure(r.error());
-  return subdivide_update(options, state, surface);
+  if (auto r = subdivide_update(options, kWholeFit, state, surface); !r) return Status::failure(r.error());
+  return Status::success();
 }
 
 Result<SurfaceMesh> reconstruct_surface(const Mesh& net, const Options& options) {

@@ -17,7 +17,9 @@
 // after the frame it last saw and the faces stamped so, or one of whose edges is; its result equals a
 // fresh reconstruction of the same network bit for bit. What stays global: numbering the base mesh,
 // Catmull-Clark (its topology and, for FIRE, the fit's factorization are rebuilt only when the base
-// mesh's topology changed) and the fit's solves (back-substitutions over the whole base mesh).
+// mesh's topology changed) and the fit's solves (back-substitutions over the whole base mesh), which the
+// frame spreads over the frames after a commit (subdivide_update), showing the surface of the initial base
+// points meanwhile.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -38,6 +40,8 @@ inline constexpr double kBorderCornerTurnDegrees = 30.0;
 inline constexpr double kTangentReach = 0.15;
 // Surface levels the options allow (the Catmull-Clark library itself refines further).
 inline constexpr uint32_t kMaxSurfaceLevels = 6;
+// subdivide_update's budget that runs a fit to its end in one call, as a rebuild does.
+inline constexpr uint32_t kWholeFit = UINT32_MAX;
 
 struct Options {
   Method method = Method::fire;
@@ -48,6 +52,10 @@ struct Options {
   // interiors the curves leave open; larger is smoother, smaller follows exactly representable data
   // more closely.
   double fairness = 1e-3;
+  // FIRE, the live frame: back-substitutions of the fit per frame after a commit (the subdivide system);
+  // at least 1, kWholeFit for the whole fit in the commit frame. 19 is the fewest with which a fit (at
+  // most FitWeights::max_iterations = 110 of them) settles within 6 frames, 100 ms, of the commit.
+  uint32_t fit_solves_per_frame = 19;
   friend bool operator==(const Options&, const Options&) = default;
 };
 
@@ -106,6 +114,7 @@ class ReconstructionState {
   ReconstructionState& operator=(ReconstructionState&&) noexcept;
   const UpdateStats& last_update() const;
   const BaseMesh& base() const;  // the base mesh of the last successful update
+  bool fitting() const;          // a fit runs over the next subdivide_update calls
   ReconstructionCache& cache() { return *cache_; }
 
  private:
@@ -133,12 +142,23 @@ Status check_reconstruction_input(const Mesh& net, const Options& options);
 // `surface` is left as it was and `state` is emptied, so the next call rebuilds everything.
 Status reconstruct_update(const Mesh& net, const Options& options, ReconstructionState& state, SurfaceMesh& surface);
 
+// What a subdivide_update call wrote into its `surface`.
+enum class SurfaceWrite : uint8_t {
+  none,         // nothing new: `surface` is left as it was
+  provisional,  // the new base mesh's surface from its initial points (the transfinite patches); a fit runs
+  settled,      // the final surface, equal to a rebuild's bit for bit
+};
+
 // reconstruct_update in the two halves the frame runs as systems. refine_update recomputes the changed
 // edges and faces and assembles the base mesh; it returns false, doing nothing, when nothing changed since
-// its last call. subdivide_update then rebuilds topology where needed, fits and evaluates into `surface`,
-// and does nothing when refine_update found nothing new. On failure the state is emptied as above.
+// its last call (a new base mesh abandons a fit still running). subdivide_update then, for a new base
+// mesh, rebuilds topology where needed and (fire) starts the fit; it runs at most `fit_solves` of the
+// fit's back-substitutions per call, and evaluates into `surface` the new base mesh's provisional surface
+// (fire, unless the fit ends in the same call: kWholeFit) and the settled one when the fit ends. On
+// failure the state is emptied as above.
 Result<bool> refine_update(const Mesh& net, const Options& options, ReconstructionState& state);
-Status subdivide_update(const Options& options, ReconstructionState& state, SurfaceMesh& surface);
+Result<SurfaceWrite> subdivide_update(const Options& options, uint32_t fit_solves, ReconstructionState& state,
+                                      SurfaceMesh& surface);
 
 // One reconstruction from scratch.
 Result<SurfaceMesh> reconstruct_surface(const Mesh& net, const Options& options);

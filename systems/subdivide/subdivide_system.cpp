@@ -15,18 +15,19 @@ void subdivide_system(const reconstruct::Options& options, const FrameTime& fram
   }
   if (!build.problem.empty()) return;
   SurfaceMesh mesh;
-  if (Status s = reconstruct::subdivide_update(options, build.state, mesh); !s) {
-    build.problem = s.error;
+  const Result<reconstruct::SurfaceWrite> wrote =
+      reconstruct::subdivide_update(options, options.fit_solves_per_frame, build.state, mesh);
+  if (!wrote) {
+    build.problem = wrote.error();
     return;
   }
-  // subdivide_update leaves `mesh` empty when refine found nothing new.
-  if (mesh.face_count() == 0) return;
+  if (*wrote == reconstruct::SurfaceWrite::none) return;
   if (!assign_quads(mesh, frame.index, surface)) {
     build.problem = "internal error: the subdivided surface has a face that is not a quad";
     return;
   }
   surface.level = options.levels;
-  surface.settled = true;
+  surface.settled = *wrote == reconstruct::SurfaceWrite::settled;
   // Each base quad's descendants are 4^L consecutive last-level quads, in base face order, so a network
   // face's quads are one range: its patch.
   const std::vector<uint32_t>& source = build.state.base().face_source;

@@ -66,7 +66,14 @@ void set_rig(World& w, const TrackingRig& rig) {
   w.sketch_settings.blend_reach = kTrackedBlendReach;
 }
 
-bool systems_waiting(const World& w) { return !w.sketch.pending.empty() || (w.rig && w.triangulate.busy()); }
+// A provisional surface waits for its fit: running, or, in a session reopened from a snapshot taken
+// meanwhile (the fit's progress is not in it), started over by the next frame's refine and subdivide from
+// the same base mesh, which ends on the same settled surface. A refused network keeps its last surface,
+// provisional or not, and waits for nothing.
+bool systems_waiting(const World& w) {
+  const bool surface_settling = w.build_surface && !w.surface.settled && w.surface_build.problem.empty();
+  return !w.sketch.pending.empty() || (w.rig && w.triangulate.busy()) || surface_settling;
+}
 
 bool replay_done(const World& w) { return w.cursor.next >= w.log.events.size() && !systems_waiting(w); }
 

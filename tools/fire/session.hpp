@@ -74,8 +74,9 @@ struct ReplayHooks {
 // pen (SketchSettings::vertex_snap, blend_reach): every path that runs a tracked drawing (fire replay
 // --rig, a reopened session with a rig.json) runs it the same way.
 void set_rig(World& world, const TrackingRig& rig);
-// Whether a system still holds input that later frames will act on (the sketch system's requests, the
-// triangulation system's reports or open stroke): a replay out of events runs frames until it does not.
+// Whether a system still holds input or work that later frames will act on (the sketch system's requests,
+// the triangulation system's reports or open stroke, a surface whose fit has not settled): a replay out of
+// events runs frames until it does not.
 bool systems_waiting(const World& world);
 // Every event consumed and nothing waiting: where a replay ends.
 bool replay_done(const World& world);

@@ -1,0 +1,61 @@
+// FitRun, the fit spread over frames: however its back-substitutions are spread over calls, it ends on
+// LimitFit::solve's points bit for bit, runs exactly the budget per call, and needs no base mesh after it
+// starts.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstring>
+
+#include "networks.hpp"
+#include "systems/reconstruct/fit.hpp"
+
+using namespace fire;
+using namespace fire::reconstruct;
+using namespace fire::test;
+
+namespace {
+
+double height(double x, double y) { return 0.5 * std::sin(0.6 * x) * std::cos(0.5 * y) + 0.02 * x * y; }
+
+}  // namespace
+
+TEST_CASE("a fit advanced 1, 7 or all back-substitutions at a time ends on solve's points bit for bit",
+          "[reconstruct][fit]") {
+  // Two Coons steps: four pieces per network edge, so that phase 3 splits the spans too.
+  const Options options{Method::fire, 2, 2, Planarity::least_squares};
+  ReconstructionState state;
+  SurfaceMesh surface;
+  REQUIRE(reconstruct_update(grid_network(4, 3, 17, height), options, state, surface).ok());
+  const BaseMesh& base = state.base();
+  const subdivide::BaseTopology topology{base.vertex_count(), base.face_offsets, base.face_vertices, base.sharp_edges,
+                                         base.border_corners};
+  auto refinement = subdivide::build_refinement(topology, {int(options.levels), true});
+  REQUIRE(refinement.ok());
+  auto limit = subdivide::build_limit_stencils(*refinement);
+  REQUIRE(limit.ok());
+  auto fit = LimitFit::build(*refinement, *limit, base, FitWeights{});
+  REQUIRE(fit.ok());
+  std::vector<Vec3> solved;
+  const LimitFit::Report whole = fit->solve(base, solved);
+  INFO("solve ran " << whole.iterations << " back-substitutions");
+  REQUIRE(whole.iterations > 14);
+  REQUIRE(solved.size() == base.vertex_count());
+
+  for (uint32_t budget : {1u, 7u, kWholeFit}) {
+    INFO("budget " << budget);
+    BaseMesh copy = base;
+    FitRun run(*fit, copy);
+    copy = BaseMesh{};  // read only when the run starts
+    CHECK(run.running());
+    CHECK_FALSE(run.advance(0));
+    uint32_t calls = 1;
+    while (!run.advance(budget)) ++calls;
+    CHECK_FALSE(run.running());
+    // Every call ran its whole budget but the last: no call is left with nothing to do.
+    CHECK(calls == (budget == kWholeFit ? 1 : (whole.iterations + budget - 1) / budget));
+    CHECK(run.report().iterations == whole.iterations);
+    CHECK(run.report().rms == whole.rms);
+    REQUIRE(run.points().size() == solved.size());
+    CHECK(std::memcmp(run.points().data(), solved.data(), solved.size() * sizeof(Vec3)) == 0);
+  }
+  CHECK_FALSE(FitRun().running());
+}
