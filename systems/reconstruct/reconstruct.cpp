@@ -36,7 +36,11 @@ struct ReconstructionCache {
   uint32_t key_vertex_count = 0;
   subdivide::Refinement refinement;
   subdivide::LimitStencils limit;
+  // fit is the factorization of the current topology only when fit_built; fit_waiting: a new base mesh
+  // has been shown and its fit has not started yet.
   LimitFit fit;
+  bool fit_built = false;
+  bool fit_waiting = false;
   // The fit of `base` in progress (fire), between the frame that took the base and the one it ends in.
   // Reset before `base` or `fit` is replaced; declared after `fit`, so destroyed before it.
   FitRun run;
@@ -50,7 +54,7 @@ ReconstructionState::ReconstructionState(ReconstructionState&&) noexcept = defau
 ReconstructionState& ReconstructionState::operator=(ReconstructionState&&) noexcept = default;
 const UpdateStats& ReconstructionState::last_update() const { return cache_->stats; }
 const BaseMesh& ReconstructionState::base() const { return cache_->base; }
-bool ReconstructionState::fitting() const { return cache_->run.running(); }
+bool ReconstructionState::fitting() const { return cache_->fit_waiting || cache_->run.running(); }
 
 namespace {
 
@@ -273,24 +277,19 @@ bool same_topology(const ReconstructionCache& c, const BaseMesh& b) {
          c.key_curve_drawn == b.curve_drawn && c.key_vertex_drawn == b.vertex_drawn;
 }
 
+// Catmull-Clark topology and limit stencils of the base mesh; the fit's factorization (fire) is left to
+// build_fit, a frame later in the live frame.
 Status rebuild_topology(const Options& options, ReconstructionCache& c) {
   const BaseMesh& b = c.base;
   c.have_topology = false;
+  c.run = {};
+  c.fit_built = false;
   subdivide::BaseTopology topology{b.vertex_count(), b.face_offsets, b.face_vertices, b.sharp_edges, b.border_corners};
   auto refinement = subdivide::build_refinement(topology, {static_cast<int>(options.levels), true});
   if (!refinement) return Status::failure("the base mesh cannot be subdivided: " + refinement.error());
-  auto limit = subdivide::build_limit_stencils(*refinement);
-  if (!limit) return Status::failure("internal error: " + limit.error());
-  if (options.method == Method::fire) {
-    FitWeights weights;
-    weights.fairness = options.fairness;
-    auto fit = LimitFit::build(*refinement, *limit, b, weights);
-    if (!fit) return Status::failure(fit.error());
-    c.run = {};
-    c.fit = std::move(*fit);
-  }
   c.refinement = std::move(*refinement);
-  c.limit = std::move(*limit);
+  if (auto s = subdivide::build_limit_stencils(c.refinement, c.limit); !s)
+    return Status::failure("internal error: " + s.error);
   c.key_vertex_count = b.vertex_count();
   c.key_face_offsets = b.face_offsets;
   c.key_face_vertices = b.face_vertices;
@@ -300,6 +299,17 @@ Status rebuild_topology(const Options& options, ReconstructionCache& c) {
   c.key_curve_drawn = b.curve_drawn;
   c.key_vertex_drawn = b.vertex_drawn;
   c.have_topology = true;
+  return Status::success();
+}
+
+Status build_fit(const Options& options, ReconstructionCache& c) {
+  FitWeights weights;
+  weights.fairness = options.fairness;
+  auto fit = LimitFit::build(c.refinement, c.limit, c.base, weights);
+  if (!fit) return Status::failure(fit.error());
+  c.run = {};
+  c.fit = std::move(*fit);
+  c.fit_built = true;
   return Status::success();
 }
 
@@ -336,11 +346,13 @@ void evaluate_surface(ReconstructionCache& c, std::span<const Vec3> base_points,
   surface = std::move(out);
 }
 
-static_assert(6 * Options{}.fit_solves_per_frame >= FitWeights{}.max_iterations,
+// The commit frame shows the provisional surface, the next one factorizes: 5 frames are left for the solves.
+static_assert(5 * Options{}.fit_solves_per_frame >= FitWeights{}.max_iterations,
               "the default budget settles every fit within 6 frames of its commit (reconstruct.hpp)");
 
 Result<SurfaceWrite> run_subdivide(const Options& options, uint32_t fit_solves, ReconstructionCache& c,
                                    SurfaceMesh& surface) {
+  const bool whole = fit_solves == kWholeFit;
   if (c.pending_subdivide) {
     if (c.rebuild_topology) {
       if (auto s = rebuild_topology(options, c); !s) return Result<SurfaceWrite>::failure(s.error);
@@ -353,13 +365,21 @@ Result<SurfaceWrite> run_subdivide(const Options& options, uint32_t fit_solves, 
       return SurfaceWrite::settled;
     }
     // The fit starts from the base mesh's points, the transfinite patches': their surface is shown until
-    // it ends. In the frame, no back-substitution runs in this call: it has paid for topology and
-    // factorization already.
-    c.run = FitRun(c.fit, c.base);
-    if (fit_solves != kWholeFit) {
+    // it ends. In the frame, that is all this call does: topology and limit stencils were its work.
+    c.fit_waiting = true;
+    if (!whole) {
       evaluate_surface(c, c.base.positions, surface);
       return SurfaceWrite::provisional;
     }
+  }
+  if (c.fit_waiting) {
+    // A new factorization is the whole of its frame's work; with the old one the solves start at once.
+    const bool factorized = !c.fit_built;
+    if (factorized)
+      if (auto s = build_fit(options, c); !s) return Result<SurfaceWrite>::failure(s.error);
+    c.run = FitRun(c.fit, c.base);
+    c.fit_waiting = false;
+    if (factorized && !whole) return SurfaceWrite::none;
   }
   if (!c.run.running() || !c.run.advance(fit_solves)) return SurfaceWrite::none;
   // Only the provisional surface and the settled one are written, not the fit's iterates between: each

@@ -53,9 +53,10 @@ struct Options {
   // more closely.
   double fairness = 1e-3;
   // FIRE, the live frame: back-substitutions of the fit per frame after a commit (the subdivide system);
-  // at least 1, kWholeFit for the whole fit in the commit frame. 19 is the fewest with which a fit (at
-  // most FitWeights::max_iterations = 110 of them) settles within 6 frames, 100 ms, of the commit.
-  uint32_t fit_solves_per_frame = 19;
+  // at least 1, kWholeFit for the whole fit in the commit frame. The frame after a commit that changed
+  // the base topology factorizes; 22 is the fewest with which a fit (at most FitWeights::max_iterations
+  // = 110 of them) then settles within 6 frames, 100 ms, of the commit.
+  uint32_t fit_solves_per_frame = 22;
   friend bool operator==(const Options&, const Options&) = default;
 };
 
@@ -152,10 +153,11 @@ enum class SurfaceWrite : uint8_t {
 // reconstruct_update in the two halves the frame runs as systems. refine_update recomputes the changed
 // edges and faces and assembles the base mesh; it returns false, doing nothing, when nothing changed since
 // its last call (a new base mesh abandons a fit still running). subdivide_update then, for a new base
-// mesh, rebuilds topology where needed and (fire) starts the fit; it runs at most `fit_solves` of the
-// fit's back-substitutions per call, and evaluates into `surface` the new base mesh's provisional surface
-// (fire, unless the fit ends in the same call: kWholeFit) and the settled one when the fit ends. On
-// failure the state is emptied as above.
+// mesh, rebuilds topology and limit stencils where needed and evaluates into `surface` the new base
+// mesh's provisional surface (fire, unless the whole fit runs in the same call: kWholeFit). The next call
+// (fire) factorizes the fit if the topology changed, and then, or at once with the old factorization,
+// the calls run at most `fit_solves` of the fit's back-substitutions each and write the settled surface
+// when the fit ends. On failure the state is emptied as above.
 Result<bool> refine_update(const Mesh& net, const Options& options, ReconstructionState& state);
 Result<SurfaceWrite> subdivide_update(const Options& options, uint32_t fit_solves, ReconstructionState& state,
                                       SurfaceMesh& surface);

@@ -1,6 +1,7 @@
 // Limit position and tangent masks of Catmull-Clark vertices (the masks OpenSubdiv's Sdc::Scheme<CATMARK>
 // uses: Halstead et al. for smooth vertices, Biermann et al. across creases), for all-quad levels.
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -97,18 +98,21 @@ void crease_masks(Row& row, uint32_t c0, uint32_t c1) {
 }  // namespace
 
 Result<LimitStencils> build_limit_stencils(const Refinement& refinement) {
+  LimitStencils limit;
+  if (Status s = build_limit_stencils(refinement, limit); !s) return Result<LimitStencils>::failure(s.error);
+  return limit;
+}
+
+Status build_limit_stencils(const Refinement& refinement, LimitStencils& limit) {
   const Level& level = refinement.last();
   if (!level.has_adjacency())
-    return Result<LimitStencils>::failure(
-        "limit masks need the last level's adjacency (build with last_level_adjacency = true)");
+    return Status::failure("limit masks need the last level's adjacency (build with last_level_adjacency = true)");
   for (uint32_t f = 0; f < level.face_count(); ++f)
     if (level.face_offsets[f + 1] - level.face_offsets[f] != 4)
-      return Result<LimitStencils>::failure("limit masks need quads, but face " + std::to_string(f) +
-                                            " of the last level has " +
-                                            std::to_string(level.face_offsets[f + 1] - level.face_offsets[f]) +
-                                            " vertices (refine at least once)");
+      return Status::failure("limit masks need quads, but face " + std::to_string(f) + " of the last level has " +
+                             std::to_string(level.face_offsets[f + 1] - level.face_offsets[f]) +
+                             " vertices (refine at least once)");
 
-  LimitStencils limit;
   const uint32_t vertex_count = level.vertex_count;
   limit.offsets.resize(vertex_count + 1);
   uint32_t total = 0;
@@ -120,16 +124,22 @@ Result<LimitStencils> build_limit_stencils(const Refinement& refinement) {
     total += 1 + (r1 - r0) + faces;
   }
   limit.offsets[vertex_count] = total;
+  // resize, not assign: the previous build's pages are reused as they are, and each row is zeroed
+  // below while it is in cache (fresh pages cost a page fault each).
   limit.sources.resize(total);
-  limit.position.assign(total, 0.0);
-  limit.tangent1.assign(total, 0.0);
-  limit.tangent2.assign(total, 0.0);
+  limit.position.resize(total);
+  limit.tangent1.resize(total);
+  limit.tangent2.resize(total);
 
   for (uint32_t v = 0; v < vertex_count; ++v) {
     const uint32_t o = limit.offsets[v];
     const uint32_t r0 = level.ring_offsets[v], n = level.ring_offsets[v + 1] - r0;
     Row row{limit.position.data() + o, limit.tangent1.data() + o, limit.tangent2.data() + o, n,
             limit.offsets[v + 1] - o - 1 - n};
+    const uint32_t size = limit.offsets[v + 1] - o;
+    std::fill_n(row.position, size, 0.0);
+    std::fill_n(row.tangent1, size, 0.0);
+    std::fill_n(row.tangent2, size, 0.0);
     uint32_t* src = limit.sources.data() + o;
     src[0] = v;
     if (n == 0) {  // a vertex without faces stays where it is
@@ -159,7 +169,7 @@ Result<LimitStencils> build_limit_stencils(const Refinement& refinement) {
       case VertexRule::corner: corner_masks(row); break;
     }
   }
-  return limit;
+  return Status::success();
 }
 
 void evaluate_limit(const LimitStencils& limit, std::span<const Vec3> last_level_points, std::vector<Vec3>& positions,

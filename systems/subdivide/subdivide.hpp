@@ -195,6 +195,8 @@ struct LimitStencils {
 
 // Requires a last level with adjacency whose faces are all quads (true after one refinement).
 Result<LimitStencils> build_limit_stencils(const Refinement& refinement);
+// The same into `limit`, reusing its buffers (a frame that rebuilds topology then takes no fresh pages).
+Status build_limit_stencils(const Refinement& refinement, LimitStencils& limit);
 
 // Limit positions and unit normals (tangent1 x tangent2, zero where the tangents are parallel or the
 // vertex has no face) of the last level's vertices, from the last level's points.

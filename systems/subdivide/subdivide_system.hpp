@@ -1,12 +1,13 @@
 #pragma once
-// The subdivide system: when refine left a new base mesh, rebuilds Catmull-Clark topology (and the
-// fit's factorization) only if the base topology changed, evaluates the limit positions and normals of
-// the base mesh's initial points (the transfinite patches) through the stencils and writes them to the
-// engine's SurfaceLevels, not settled, for the renderer and the exporters, the quads grouped by network
-// face (SurfaceLevels' patches). Then, in each of the following frames, it runs at most
-// Options::fit_solves_per_frame back-substitutions of the fit that makes the limit surface pass through
-// the curves, and writes the fitted surface, settled, in the frame the fit ends (equal to a rebuild's bit
-// for bit). A new base mesh abandons a fit still running. Work per frame is a count, never a clock.
+// The subdivide system: when refine left a new base mesh, rebuilds Catmull-Clark topology and limit
+// stencils only if the base topology changed, evaluates the limit positions and normals of the base
+// mesh's initial points (the transfinite patches) through the stencils and writes them to the engine's
+// SurfaceLevels, not settled, for the renderer and the exporters, the quads grouped by network face
+// (SurfaceLevels' patches). The next frame factorizes the fit if the topology changed; from then on each
+// frame runs at most Options::fit_solves_per_frame back-substitutions of the fit that makes the limit
+// surface pass through the curves, and the frame the fit ends in writes the fitted surface, settled
+// (equal to a rebuild's bit for bit). A new base mesh abandons a fit still running. Work per frame is a
+// count, never a clock.
 #include "engine/surface.hpp"
 #include "engine/scheduler.hpp"
 #include "systems/reconstruct/reconstruct.hpp"
