@@ -60,13 +60,125 @@ struct LimitFit::Impl {
   FitWeights settings;
   uint32_t base_vertices = 0;
   SparseRows rows;  // limit positions of the selected level-L vertices, from base points
+  Sparse rows_by_column;  // the same by column: rows^T times the targets as one gather per base point
   // Per network edge, its rows in order along it (ends included) and its curves (pieces).
   std::vector<std::vector<Eigen::Index>> paths;
   std::vector<uint32_t> path_first_curve;
   std::vector<Eigen::Index> vertex_row;  // row of each drawn base vertex (-1 for the others)
   double ridge = 0;
   Eigen::SimplicialLDLT<Sparse> solver;
+  Eigen::VectorXd inverse_diagonal;  // 1 / D of the solver's L D L^T
 };
+
+namespace {
+
+// The fit's per-solve kernels, x, y and z in one pass over each sparse matrix where Eigen makes three
+// (it walks a sparse matrix once per column of a dense one). Each coordinate gets exactly Eigen's
+// operations in Eigen's order, so the results are Eigen's bit for bit (tests/engine/demo.hash holds
+// the fitted surface).
+using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+// Each outer slot i of a compressed sparse matrix (a row of a row-major one, a column of a column-major
+// one) dotted with the points, in storage order, as Eigen's products sum; done(i, x, y, z) takes it.
+template <class Compressed, class Done>
+void gather(const Compressed& matrix, const Eigen::MatrixX3d& points, Done&& done) {
+  const int* outer = matrix.outerIndexPtr();
+  const int* inner = matrix.innerIndexPtr();
+  const double* value = matrix.valuePtr();
+  const double* px = points.col(0).data();
+  const double* py = points.col(1).data();
+  const double* pz = points.col(2).data();
+  for (Eigen::Index i = 0; i < matrix.outerSize(); ++i) {
+    double x = 0, y = 0, z = 0;
+    for (int k = outer[i]; k < outer[i + 1]; ++k) {
+      const double w = value[k];
+      x += w * px[inner[k]];
+      y += w * py[inner[k]];
+      z += w * pz[inner[k]];
+    }
+    done(i, x, y, z);
+  }
+}
+
+// rows * points.
+void multiply_rows(const SparseRows& rows, const Eigen::MatrixX3d& points, Eigen::MatrixX3d& out) {
+  out.resize(rows.rows(), 3);
+  gather(rows, points, [&](Eigen::Index r, double x, double y, double z) { out.row(r) << x, y, z; });
+}
+
+// rows^T * targets + ridge * initial (rows^T stored as rows by column), into the solver's permuted order
+// (P b).
+void right_hand_side(const Sparse& by_column, const Eigen::SimplicialLDLT<Sparse>& solver, double ridge,
+                     const Eigen::MatrixX3d& targets, const Eigen::MatrixX3d& initial, Rows3& permuted) {
+  const auto& order = solver.permutationP().indices();
+  permuted.resize(by_column.cols(), 3);
+  gather(by_column, targets, [&](Eigen::Index i, double x, double y, double z) {
+    permuted.row(order[i]) << x + ridge * initial(i, 0), y + ridge * initial(i, 1), z + ridge * initial(i, 2);
+  });
+}
+
+// SimplicialLDLT's solve, from P b (in `permuted`, overwritten) to the solution.
+void solve_permuted(const Eigen::SimplicialLDLT<Sparse>& solver, const Eigen::VectorXd& inverse_diagonal,
+                    Rows3& permuted, Eigen::MatrixX3d& solution) {
+  const Sparse& lower = solver.matrixL().nestedExpression();
+  const int* outer = lower.outerIndexPtr();
+  const int* inner = lower.innerIndexPtr();
+  const double* value = lower.valuePtr();
+  const Eigen::Index n = lower.cols();
+  double* b = permuted.data();
+  // L y = P b, column by column (Eigen skips a coordinate that is zero, and so does this).
+  for (Eigen::Index i = 0; i < n; ++i) {
+    int k = outer[i];
+    while (k < outer[i + 1] && inner[k] <= i) ++k;
+    const double x = b[3 * i], y = b[3 * i + 1], z = b[3 * i + 2];
+    if (x != 0 && y != 0 && z != 0) {
+      for (; k < outer[i + 1]; ++k) {
+        double* to = b + 3 * inner[k];
+        to[0] -= x * value[k];
+        to[1] -= y * value[k];
+        to[2] -= z * value[k];
+      }
+    } else {
+      for (; k < outer[i + 1]; ++k) {
+        double* to = b + 3 * inner[k];
+        if (x != 0) to[0] -= x * value[k];
+        if (y != 0) to[1] -= y * value[k];
+        if (z != 0) to[2] -= z * value[k];
+      }
+    }
+  }
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double d = inverse_diagonal[i];
+    b[3 * i] = d * b[3 * i];
+    b[3 * i + 1] = d * b[3 * i + 1];
+    b[3 * i + 2] = d * b[3 * i + 2];
+  }
+  // L^T z = y, row by row of L^T.
+  for (Eigen::Index i = n - 1; i >= 0; --i) {
+    int k = outer[i];
+    while (k < outer[i + 1] && inner[k] <= i) ++k;
+    double x = b[3 * i], y = b[3 * i + 1], z = b[3 * i + 2];
+    for (; k < outer[i + 1]; ++k) {
+      const double* from = b + 3 * inner[k];
+      x -= value[k] * from[0];
+      y -= value[k] * from[1];
+      z -= value[k] * from[2];
+    }
+    b[3 * i] = x;
+    b[3 * i + 1] = y;
+    b[3 * i + 2] = z;
+  }
+  const auto& back = solver.permutationPinv().indices();
+  solution.resize(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::Index to = back[i];
+    solution(to, 0) = b[3 * i];
+    solution(to, 1) = b[3 * i + 1];
+    solution(to, 2) = b[3 * i + 2];
+  }
+}
+
+}  // namespace
 
 LimitFit::LimitFit() = default;
 LimitFit::~LimitFit() = default;
@@ -143,6 +255,8 @@ Result<LimitFit> LimitFit::build(const subdivide::Refinement& refinement, const 
   impl->solver.compute(normal);
   if (impl->solver.info() != Eigen::Success)
     return Result<LimitFit>::failure("the limit fit's normal matrix could not be factored");
+  impl->inverse_diagonal = impl->solver.vectorD().cwiseInverse();
+  impl->rows_by_column = impl->rows;
   LimitFit fit;
   fit.impl_ = std::move(impl);
   return fit;
@@ -288,10 +402,11 @@ Steps<FitRun::Fitted> FitRun::fit_steps(const LimitFit::Impl& m, const BaseMesh&
 
   LimitFit::Report report;
   Eigen::MatrixX3d solution, fitted;
+  Rows3 permuted;
   auto solve_once = [&] {
-    const Eigen::MatrixX3d rhs = Eigen::MatrixX3d(m.rows.transpose() * targets) + m.ridge * initial;
-    solution = m.solver.solve(rhs);
-    fitted = m.rows * solution;
+    right_hand_side(m.rows_by_column, m.solver, m.ridge, targets, initial, permuted);
+    solve_permuted(m.solver, m.inverse_diagonal, permuted, solution);
+    multiply_rows(m.rows, solution, fitted);
     ++report.iterations;
   };
   std::vector<double> scratch;
