@@ -462,35 +462,43 @@ Steps<FitRun::Fitted> FitRun::fit_steps(const LimitFit::Impl& m, const BaseMesh&
     }
     return largest_move;
   };
+  // Anderson mixing: next = g - values * gamma, gamma the least-squares solution of steps * gamma = f.
+  // It is solved through the steps' Gram matrix, kept up to date a column at a time (a QR of the
+  // inner-by-depth steps each round cost more than the back-substitution).
   std::vector<Eigen::VectorXd> step_history, value_history;
+  Eigen::MatrixXd gram;
   Eigen::VectorXd previous_g, previous_f;
   for (uint32_t round = 0; round < m.settings.feet_iterations; ++round) {
     if (feet(x, g) <= tolerance) break;
     const Eigen::VectorXd f = g - x;
     if (previous_g.size() > 0) {
-      value_history.push_back(g - previous_g);
-      step_history.push_back(f - previous_f);
-      if (step_history.size() > m.settings.anderson_depth) {
+      if (step_history.size() == m.settings.anderson_depth) {
         value_history.erase(value_history.begin());
         step_history.erase(step_history.begin());
+        const Eigen::Index kept = gram.rows() - 1;
+        gram = Eigen::MatrixXd(gram.bottomRightCorner(kept, kept));
       }
+      value_history.push_back(g - previous_g);
+      step_history.push_back(f - previous_f);
+      const Eigen::Index last = Eigen::Index(step_history.size()) - 1;
+      gram.conservativeResize(last + 1, last + 1);
+      for (Eigen::Index j = 0; j <= last; ++j)
+        gram(j, last) = gram(last, j) = step_history[size_t(j)].dot(step_history.back());
     }
     previous_g = g;
     previous_f = f;
     Eigen::VectorXd next = g;
     if (!step_history.empty()) {
-      Eigen::MatrixXd steps(inner, Eigen::Index(step_history.size()));
-      Eigen::MatrixXd values(inner, Eigen::Index(step_history.size()));
-      for (size_t j = 0; j < step_history.size(); ++j) {
-        steps.col(Eigen::Index(j)) = step_history[j];
-        values.col(Eigen::Index(j)) = value_history[j];
-      }
-      next = g - values * steps.colPivHouseholderQr().solve(f);
+      Eigen::VectorXd projected(gram.rows());
+      for (Eigen::Index j = 0; j < gram.rows(); ++j) projected[j] = step_history[size_t(j)].dot(f);
+      const Eigen::VectorXd gamma = gram.colPivHouseholderQr().solve(projected);
+      for (Eigen::Index j = 0; j < gamma.size(); ++j) next -= gamma[j] * value_history[size_t(j)];
     }
     if (!ordered(whole, next)) {
       next = g;
       step_history.clear();
       value_history.clear();
+      gram.resize(0, 0);
       previous_g.resize(0);
     }
     x = next;
