@@ -350,8 +350,8 @@ void evaluate_surface(ReconstructionCache& c, std::span<const Vec3> base_points,
 static_assert(5 * Options{}.fit_solves_per_frame >= FitWeights{}.max_iterations,
               "the default budget settles every fit within 6 frames of its commit (reconstruct.hpp)");
 
-Result<SurfaceWrite> run_subdivide(const Options& options, uint32_t fit_solves, ReconstructionCache& c,
-                                   SurfaceMesh& surface) {
+Result<SurfaceWrite> run_subdivide(const Options& options, ReconstructionCache& c, SurfaceMesh& surface) {
+  const uint32_t fit_solves = options.fit_solves_per_frame;
   const bool whole = fit_solves == kWholeFit;
   if (c.pending_subdivide) {
     if (c.rebuild_topology) {
@@ -400,9 +400,8 @@ Result<bool> refine_update(const Mesh& net, const Options& options, Reconstructi
   return r;
 }
 
-Result<SurfaceWrite> subdivide_update(const Options& options, uint32_t fit_solves, ReconstructionState& state,
-                                      SurfaceMesh& surface) {
-  Result<SurfaceWrite> r = run_subdivide(options, fit_solves, state.cache(), surface);
+Result<SurfaceWrite> subdivide_update(const Options& options, ReconstructionState& state, SurfaceMesh& surface) {
+  Result<SurfaceWrite> r = run_subdivide(options, state.cache(), surface);
   if (!r) state.cache() = ReconstructionCache{};
   return r;
 }
@@ -411,8 +410,10 @@ Status reconstruct_update(const Mesh& net, const Options& options, Reconstructio
   ReconstructionCache& c = state.cache();
   // A call with nothing changed still re-runs the global stages, as a fresh reconstruction would.
   if (c.built) c.pending_subdivide = true;
-  if (auto r = refine_update(net, options, state); !r) return Status::failure(r.error());
-  if (auto r = subdivide_update(options, kWholeFit, state, surface); !r) return Status::failure(r.error());
+  Options whole = options;
+  whole.fit_solves_per_frame = kWholeFit;
+  if (auto r = refine_update(net, whole, state); !r) return Status::failure(r.error());
+  if (auto r = subdivide_update(whole, state, surface); !r) return Status::failure(r.error());
   return Status::success();
 }
 

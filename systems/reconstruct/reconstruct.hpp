@@ -40,7 +40,7 @@ inline constexpr double kBorderCornerTurnDegrees = 30.0;
 inline constexpr double kTangentReach = 0.15;
 // Surface levels the options allow (the Catmull-Clark library itself refines further).
 inline constexpr uint32_t kMaxSurfaceLevels = 6;
-// subdivide_update's budget that runs a fit to its end in one call, as a rebuild does.
+// Options::fit_solves_per_frame that runs a fit to its end in one call, as a rebuild does.
 inline constexpr uint32_t kWholeFit = UINT32_MAX;
 
 struct Options {
@@ -156,11 +156,10 @@ enum class SurfaceWrite : uint8_t {
 // mesh, rebuilds topology and limit stencils where needed and evaluates into `surface` the new base
 // mesh's provisional surface (fire, unless the whole fit runs in the same call: kWholeFit). The next call
 // (fire) factorizes the fit if the topology changed, and then, or at once with the old factorization,
-// the calls run at most `fit_solves` of the fit's back-substitutions each and write the settled surface
-// when the fit ends. On failure the state is emptied as above.
+// the calls run at most Options::fit_solves_per_frame of the fit's back-substitutions each and write the
+// settled surface when the fit ends. On failure the state is emptied as above.
 Result<bool> refine_update(const Mesh& net, const Options& options, ReconstructionState& state);
-Result<SurfaceWrite> subdivide_update(const Options& options, uint32_t fit_solves, ReconstructionState& state,
-                                      SurfaceMesh& surface);
+Result<SurfaceWrite> subdivide_update(const Options& options, ReconstructionState& state, SurfaceMesh& surface);
 
 // One reconstruction from scratch.
 Result<SurfaceMesh> reconstruct_surface(const Mesh& net, const Options& options);

@@ -16,7 +16,7 @@ void subdivide_system(const reconstruct::Options& options, const FrameTime& fram
   if (!build.problem.empty()) return;
   SurfaceMesh mesh;
   const Result<reconstruct::SurfaceWrite> wrote =
-      reconstruct::subdivide_update(options, options.fit_solves_per_frame, build.state, mesh);
+      reconstruct::subdivide_update(options, build.state, mesh);
   if (!wrote) {
     build.problem = wrote.error();
     return;
