@@ -235,7 +235,12 @@ Result<LimitFit> LimitFit::build(const subdivide::Refinement& refinement, const 
     }
     table.offsets.push_back(static_cast<uint32_t>(table.sources.size()));
   }
-  for (uint32_t l = last; l-- > 0;) table = subdivide::compose(table, subdivide::stencil_table(refinement, l));
+  std::vector<uint8_t> read;  // the rows of the next level's stencils the table reads
+  for (uint32_t l = last; l-- > 0;) {
+    read.assign(refinement.levels[l + 1].vertex_count, 0);
+    for (uint32_t s : table.sources) read[s] = 1;
+    table = subdivide::compose(table, subdivide::stencil_table(refinement, l, read));
+  }
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(table.sources.size());
   for (uint32_t r = 0; r < table.row_count(); ++r)

@@ -98,26 +98,32 @@ class RowWriter {
 
 }  // namespace
 
-StencilTable stencil_table(const Refinement& refinement, size_t level) {
+StencilTable stencil_table(const Refinement& refinement, size_t level, std::span<const uint8_t> rows) {
   const Level& p = refinement.levels.at(level);
   const uint32_t V = p.vertex_count, F = p.face_count(), E = p.edge_count();
   const RowWriter writer(p);
   // Child r in OpenSubdiv's numbering is row row_of(r): the same, except in a renumbered last level.
   const bool renumbered = level + 2 == refinement.levels.size() && !refinement.last_from_osd.empty();
   const auto row_of = [&](uint32_t r) { return renumbered ? refinement.last_from_osd[r] : r; };
+  const auto wanted = [&](uint32_t row) { return rows.empty() || rows[row] != 0; };
   StencilTable table;
   table.offsets.assign(size_t{V} + F + E + 1, 0);
-  for (uint32_t v = 0; v < V; ++v) table.offsets[row_of(v) + 1] = writer.vertex_row_size(v);
-  for (uint32_t f = 0; f < F; ++f) table.offsets[row_of(V + f) + 1] = writer.face_size(f);
-  for (uint32_t e = 0; e < E; ++e) table.offsets[row_of(V + F + e) + 1] = writer.edge_row_size(e);
+  for (uint32_t v = 0; v < V; ++v)
+    if (wanted(row_of(v))) table.offsets[row_of(v) + 1] = writer.vertex_row_size(v);
+  for (uint32_t f = 0; f < F; ++f)
+    if (wanted(row_of(V + f))) table.offsets[row_of(V + f) + 1] = writer.face_size(f);
+  for (uint32_t e = 0; e < E; ++e)
+    if (wanted(row_of(V + F + e))) table.offsets[row_of(V + F + e) + 1] = writer.edge_row_size(e);
   for (size_t r = 1; r < table.offsets.size(); ++r) table.offsets[r] += table.offsets[r - 1];
   table.sources.resize(table.offsets.back());
   table.weights.resize(table.offsets.back());
   for (uint32_t v = 0; v < V; ++v) {
+    if (!wanted(row_of(v))) continue;
     const uint32_t o = table.offsets[row_of(v)];
     writer.vertex_row(v, table.sources.data() + o, table.weights.data() + o);
   }
   for (uint32_t f = 0; f < F; ++f) {
+    if (!wanted(row_of(V + f))) continue;
     const uint32_t b = p.face_offsets[f], n = writer.face_size(f), o = table.offsets[row_of(V + f)];
     for (uint32_t j = 0; j < n; ++j) {
       table.sources[o + j] = p.face_vertices[b + j];
@@ -125,6 +131,7 @@ StencilTable stencil_table(const Refinement& refinement, size_t level) {
     }
   }
   for (uint32_t e = 0; e < E; ++e) {
+    if (!wanted(row_of(V + F + e))) continue;
     const uint32_t o = table.offsets[row_of(V + F + e)];
     writer.edge_row(e, table.sources.data() + o, table.weights.data() + o);
   }

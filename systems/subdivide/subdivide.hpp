@@ -171,8 +171,9 @@ void evaluate_all_levels(const Refinement& refinement, std::span<const Vec3> bas
                          std::vector<std::vector<Vec3>>& level_points);
 
 // Level `level`'s points -> level `level + 1`'s points as explicit rows (level < levels.size() - 1), in
-// level `level + 1`'s numbering.
-StencilTable stencil_table(const Refinement& refinement, size_t level);
+// level `level + 1`'s numbering. With `rows` (one flag per row), only the flagged rows are written and
+// the others are left empty: a composition that reads a few rows need not build them all.
+StencilTable stencil_table(const Refinement& refinement, size_t level, std::span<const uint8_t> rows = {});
 
 // dst[r] = row r of table applied to src (dst.size() == table.row_count()).
 void apply(const StencilTable& table, std::span<const Vec3> src, std::span<Vec3> dst);
