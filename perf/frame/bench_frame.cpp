@@ -6,9 +6,12 @@
 // and to the frame where the surface has settled.
 //
 // Drawings: the bundled demo log (a dome, 14 faces) and a grid drawing of 200 faces on a wavy sheet
-// (a border, 19 long curves, then 180 short ones cell by cell), at subdivision levels 2 and 3.
+// (a border, 19 long curves, then 180 short ones cell by cell), at subdivision levels 2 and 3; with
+// --tracked, also a drawing of Wii Remote reports replayed with its rig through every system from
+// triangulation on (perf/frame/run.sh passes `fire simulate drawing`'s, 156 faces on the pawn).
 //
-//   bench_frame [--whole-fit]              (--whole-fit: the fit runs to its end in the commit frame, as
+//   bench_frame [--whole-fit] [--tracked LOG RIG.json]
+//                                          (--whole-fit: the fit runs to its end in the commit frame, as
 //                                           before the frame budget; for comparisons in one session)
 //   bench_frame --write-grid-log FILE      (the grid drawing as an input log, for callgrind)
 #include <time.h>
@@ -18,12 +21,14 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "perf/frame/grid_drawing.hpp"
 #include "platform/files.hpp"
 #include "tools/fire/session.hpp"
+#include "tools/fire/session_rig.hpp"
 
 using namespace fire;
 
@@ -46,10 +51,12 @@ struct Run {
   std::string problem;
 };
 
-Run replay(const std::vector<InputEvent>& events, uint32_t levels, double snap, uint32_t fit_solves) {
+Run replay(const std::vector<InputEvent>& events, uint32_t levels, double snap, uint32_t fit_solves,
+           const std::optional<TrackingRig>& rig = std::nullopt) {
   World w;
   w.log.events = events;
   w.sketch_settings.snap_distance = snap;
+  if (rig) set_rig(w, *rig);
   w.surface_options.levels = levels;
   w.surface_options.fit_solves_per_frame = fit_solves;
   std::vector<SystemSpec> systems = session_systems(w);
@@ -139,10 +146,34 @@ int main(int argc, char** argv) {
     }
     return 0;
   }
-  const bool whole_fit = argc == 2 && std::strcmp(argv[1], "--whole-fit") == 0;
-  if (argc != 1 && !whole_fit) {
-    std::fprintf(stderr, "usage: bench_frame [--whole-fit | --write-grid-log FILE]\n");
-    return 2;
+  bool whole_fit = false;
+  std::string tracked_log, tracked_rig;
+  for (int a = 1; a < argc; ++a) {
+    if (std::strcmp(argv[a], "--whole-fit") == 0) {
+      whole_fit = true;
+    } else if (std::strcmp(argv[a], "--tracked") == 0 && a + 2 < argc) {
+      tracked_log = argv[++a];
+      tracked_rig = argv[++a];
+    } else {
+      std::fprintf(stderr, "usage: bench_frame [--whole-fit] [--tracked LOG RIG.json] | --write-grid-log FILE\n");
+      return 2;
+    }
+  }
+  std::optional<InputLog> tracked;
+  std::optional<TrackingRig> rig;
+  if (!tracked_log.empty()) {
+    auto log = read_input_log(tracked_log);
+    if (!log) {
+      std::fprintf(stderr, "bench_frame: %s\n", log.error().c_str());
+      return 1;
+    }
+    auto loaded = load_tracking_rig(tracked_rig, *log, tracked_log);
+    if (!loaded) {
+      std::fprintf(stderr, "bench_frame: %s\n", loaded.error().c_str());
+      return 1;
+    }
+    tracked = std::move(*log);
+    rig = std::move(*loaded);
   }
   const uint32_t fit_solves = whole_fit ? reconstruct::kWholeFit : reconstruct::Options{}.fit_solves_per_frame;
   auto demo = read_input_log(FIRE_SOURCE_DIR "/tools/demo/sketch.log");
@@ -161,6 +192,10 @@ int main(int argc, char** argv) {
     report("demo dome", levels, runs.back().second.second);
     runs.push_back({"grid 200", {levels, replay(grid, levels, 0.005, fit_solves)}});
     report("grid 200", levels, runs.back().second.second);
+    if (tracked) {
+      runs.push_back({"tracked", {levels, replay(tracked->events, levels, SketchSettings{}.snap_distance, fit_solves, rig)}});
+      report("tracked", levels, runs.back().second.second);
+    }
   }
   std::printf("\n| drawing | L | system | p50 ms | p99 ms | max ms |\n|---|---|---|---|---|---|\n");
   for (const auto& [name, lr] : runs) report_systems(name.c_str(), lr.first, lr.second);

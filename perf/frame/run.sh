@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# tools/run bench frame: the frame latency table (bench_frame), then instructions and cache misses per
+# tools/run bench frame: the frame latency table (bench_frame, with `fire simulate drawing` replayed from its
+# Wii Remote reports besides its own drawings), then instructions and cache misses per
 # system under callgrind (valgrind 3.19's cachegrind cannot split per function): one run of `fire
 # replay` per drawing with --cache-sim=yes, each system's inclusive cost read off callgrind_annotate.
 # Drawings under callgrind: the bundled demo (whole), the grid drawing's first 30 strokes (the
@@ -10,14 +11,16 @@
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 build="${FIRE_BUILD_DIR:-$here/build}"
-"$build/perf/frame/bench_frame"
-
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+echo "perf/frame/run.sh: simulating a wand, calibrating, simulating a drawing (about a minute)" >&2
+"$build/fire" simulate wand -o "$tmp/wand.log" >/dev/null
+"$build/fire" calibrate "$tmp/wand.log" -o "$tmp/rig.json" >/dev/null
+"$build/fire" simulate drawing -o "$tmp/drawing.log" --marks-out "$tmp/marks.json" --object-out "$tmp/object.obj" >/dev/null
+"$build/perf/frame/bench_frame" --tracked "$tmp/drawing.log" "$tmp/rig.json"
+
 "$build/perf/frame/bench_frame" --write-grid-log "$tmp/grid.log"
 # The first 30 strokes: everything up to the 30th pen-up.
 awk '/ up$/ { n++ } { print } n == 30 { exit }' "$tmp/grid.log" >"$tmp/grid30.log"
-"$build/fire" simulate wand -o "$tmp/wand.log" >/dev/null
-"$build/fire" calibrate "$tmp/wand.log" -o "$tmp/rig.json" >/dev/null
 "$build/fire" simulate sketch --occlusion 0.5 -o "$tmp/tracked.log" >/dev/null
 echo
 echo "tracked drawing (fire simulate sketch --occlusion 0.5, replayed with --rig):"

@@ -315,14 +315,15 @@ Status build_fit(const Options& options, ReconstructionCache& c) {
 
 // Per-element stage and base mesh. Returns whether the base mesh may differ from the last update's.
 Result<bool> run_refine(const Mesh& net, const Options& options, ReconstructionCache& c) {
-  if (auto s = check_reconstruction_input(net, options); !s) return Result<bool>::failure(s.error);
   // Cached results name slots; after a compaction they would name the wrong ones.
   const bool everything =
       !c.built || !(c.options == options) || net.last_compaction().count != c.compactions_seen;
+  // An unchanged network passed the check when it was last built (a failed one empties the cache).
   if (!everything && !c.pending_subdivide && !net.written_after(c.seen)) {
     c.stats = {};
     return false;
   }
+  if (auto s = check_reconstruction_input(net, options); !s) return Result<bool>::failure(s.error);
   c.built = false;
   c.options = options;
   c.run = {};  // a fit of the previous base mesh is abandoned; subdivide starts one from the new
