@@ -1,5 +1,6 @@
 #include "tools/fire/app_live.hpp"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "platform/files.hpp"
@@ -68,9 +69,7 @@ Result<std::unique_ptr<AppLive>> AppLive::open(const AppLiveOptions& o) {
   app->driver_ = std::make_unique<wiimote::Driver>(*backend, *app->log_, *assigned, driver_options, clock);
   auto scan = app->driver_->open_all();
   if (!scan) return R::failure(scan.error());
-  int cameras = 0;
-  for (const wiimote::RemoteView& v : app->driver_->remotes())
-    cameras += wiimote::is_camera(v.role) && v.state != wiimote::LinkState::Missing;
+  const int cameras = app->driver_->cameras();
   if (cameras < 2) {
     std::string why = "--live needs the rig's two camera remotes and found " + std::to_string(cameras);
     for (const std::string& e : scan->open_errors) why += "\n  " + e;
@@ -159,16 +158,18 @@ std::string AppLive::act(PadAction action) {
       e.mark = uint32_t(shown_mark_);
       e.p = marks_[shown_mark_];
       log_->command(std::move(e));
-      const std::string done = "mark " + std::to_string(shown_mark_) + " touched (" + std::to_string(++marks_touched_) +
-                               " since the last registration)";
+      // The register system takes the command next frame; until then the world counts the marks before it.
+      const std::vector<MarkTouch>& touched = world_.registration.touched;
+      const bool again = std::any_of(touched.begin(), touched.end(),
+                                     [&](const MarkTouch& t) { return t.mark == shown_mark_; });
+      const std::string done = "mark " + std::to_string(shown_mark_) + " touched (" +
+                               std::to_string(touched.size() + (again ? 0 : 1)) + " since the last registration)";
       shown_mark_ = (shown_mark_ + 1) % marks_.size();
       return done;
     }
     case PadAction::Register: {
       command(CommandKind::Register);
-      const size_t touched = marks_touched_;
-      if (touched >= 3) marks_touched_ = 0;
-      return "registering on " + std::to_string(touched) + " mark(s)";
+      return "registering on " + std::to_string(world_.registration.touched.size()) + " mark(s)";
     }
     case PadAction::PreviousMark:
     case PadAction::NextMark:

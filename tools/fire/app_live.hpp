@@ -76,7 +76,6 @@ class AppLive {
   std::optional<LiveSession> live_;
   std::vector<Vec3> marks_;
   size_t shown_mark_ = 0;
-  size_t marks_touched_ = 0;  // since the last registration
   PadPresses pad_;
   std::vector<PadAction> pad_actions_;  // taken from the log, acted on after the frames ran
   std::array<window::CameraView, 2> cameras_{};
