@@ -299,6 +299,13 @@ std::vector<RemoteView> Driver::remotes() const {
   return out;
 }
 
+int Driver::cameras(std::optional<LinkState> state) const {
+  int count = 0;
+  for (const RemoteView& v : remotes())
+    count += is_camera(v.role) && (state ? v.state == *state : v.state != LinkState::Missing);
+  return count;
+}
+
 std::vector<Notice> Driver::take_notices() {
   std::lock_guard lock(notices_mutex_);
   std::vector<Notice> out;

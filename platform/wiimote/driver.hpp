@@ -76,6 +76,8 @@ class Driver {
   void stop();
 
   std::vector<RemoteView> remotes() const;
+  // How many remotes are cameras in `state`, or, without one, present (in any state but Missing).
+  int cameras(std::optional<LinkState> state = std::nullopt) const;
   std::vector<Notice> take_notices();
   bool pen_down() const;
 

@@ -94,13 +94,6 @@ bool key_pressed() {
   return true;
 }
 
-bool cameras_running(const wiimote::Driver& driver) {
-  int running = 0;
-  for (const wiimote::RemoteView& v : driver.remotes())
-    running += wiimote::is_camera(v.role) && v.state == wiimote::LinkState::Running;
-  return running == 2;
-}
-
 }  // namespace
 
 Result<std::vector<InputEvent>> record_live_wand(const LiveWandOptions& o) {
@@ -135,8 +128,7 @@ Result<std::vector<InputEvent>> record_live_wand(const LiveWandOptions& o) {
   auto scan = driver.open_all();
   if (!scan) return R::failure(scan.error());
   for (const std::string& e : scan->open_errors) std::cerr << "fire calibrate: " << e << "\n";
-  int cameras = 0;
-  for (const wiimote::RemoteView& v : driver.remotes()) cameras += wiimote::is_camera(v.role);
+  const int cameras = driver.cameras();
   if (cameras < 2)
     return R::failure("--live needs two Wii Remotes as cameras and found " + std::to_string(cameras) +
                       " (fire devices lists what this machine sees)");
@@ -166,7 +158,7 @@ Result<std::vector<InputEvent>> record_live_wand(const LiveWandOptions& o) {
       // One millisecond of the fake clock; a read per remote drains a report each.
       manual.advance(1'000'000);
       for (int k = 0; k < 2; ++k) driver.poll(0);
-      if (origin_ns < 0 && cameras_running(driver)) origin_ns = manual.now();
+      if (origin_ns < 0 && driver.cameras(wiimote::LinkState::Running) == 2) origin_ns = manual.now();
     } else {
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
