@@ -9,6 +9,8 @@
 #include <string>
 #include <unordered_map>
 
+#include "engine/assert.hpp"
+
 namespace fire::reconstruct {
 
 namespace {
@@ -82,6 +84,7 @@ using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 // one) dotted with the points, in storage order, as Eigen's products sum; done(i, x, y, z) takes it.
 template <class Compressed, class Done>
 void gather(const Compressed& matrix, const Eigen::MatrixX3d& points, Done&& done) {
+  FIRE_ASSERT(matrix.isCompressed(), "the kernels read a compressed sparse matrix's arrays");
   const int* outer = matrix.outerIndexPtr();
   const int* inner = matrix.innerIndexPtr();
   const double* value = matrix.valuePtr();
@@ -121,6 +124,7 @@ void right_hand_side(const Sparse& by_column, const Eigen::SimplicialLDLT<Sparse
 void solve_permuted(const Eigen::SimplicialLDLT<Sparse>& solver, const Eigen::VectorXd& inverse_diagonal,
                     Rows3& permuted, Eigen::MatrixX3d& solution) {
   const Sparse& lower = solver.matrixL().nestedExpression();
+  FIRE_ASSERT(lower.isCompressed(), "the kernels read a compressed sparse matrix's arrays");
   const int* outer = lower.outerIndexPtr();
   const int* inner = lower.innerIndexPtr();
   const double* value = lower.valuePtr();

@@ -282,7 +282,6 @@ bool same_topology(const ReconstructionCache& c, const BaseMesh& b) {
 Status rebuild_topology(const Options& options, ReconstructionCache& c) {
   const BaseMesh& b = c.base;
   c.have_topology = false;
-  c.run = {};
   c.fit_built = false;
   subdivide::BaseTopology topology{b.vertex_count(), b.face_offsets, b.face_vertices, b.sharp_edges, b.border_corners};
   auto refinement = subdivide::build_refinement(topology, {static_cast<int>(options.levels), true});
