@@ -35,8 +35,8 @@ Result<std::unique_ptr<AppLive>> AppLive::open(const AppLiveOptions& o) {
     rig_json = app->fake_->rig_json();
     marks_json = app->fake_->marks_json();
     rig_source = "the fake rig's rig.json";
-    backend = &app->fake_->backend();
-    clock = app->fake_->clock();
+    backend = &app->fake_->remotes().backend();
+    clock = app->fake_->remotes().clock();
   } else {
     auto text = read_text_file(o.rig_path);
     if (!text) return R::failure("--rig: " + text.error());
@@ -116,7 +116,7 @@ std::vector<std::string> AppLive::step() {
   if (fake_) {
     // A displayed frame is a 60th of a second of the drawing, times the speed.
     const auto ns = int64_t(1e9 / 60 * options_.fake_speed);
-    fake_->advance(ns, *driver_, [this] { live_->step(); });
+    fake_->remotes().advance(ns, *driver_, [this] { live_->step(); });
   } else {
     live_->step();
   }
@@ -210,7 +210,7 @@ Status AppLive::finish() {
   if (stopped_) return Status::success();
   stopped_ = true;
   driver_->stop();
-  if (fake_) fake_->advance(8'000'000, *driver_, [] {});  // what the fake remotes still hold
+  if (fake_) fake_->remotes().advance(8'000'000, *driver_, [] {});  // what the fake remotes still hold
   return live_->finish();
 }
 

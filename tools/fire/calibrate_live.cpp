@@ -24,8 +24,6 @@ namespace fire::cli {
 
 namespace {
 
-using wiimote::IrObjects;
-
 // What the wand has shown each camera: reports with both LEDs (samples for the bundle adjustment) and the
 // cells of an 8 x 6 grid over the 1024 x 768 image its blobs fell in.
 class WandCoverage {
@@ -98,28 +96,20 @@ bool key_pressed() {
 
 Result<std::vector<InputEvent>> record_live_wand(const LiveWandOptions& o) {
   using R = Result<std::vector<InputEvent>>;
-  std::optional<SimulatedBlobs> wand;
-  wiimote::ManualClock manual;
-  std::unique_ptr<wiimote::Backend> backend;
+  // The fake rig waves the simulated wand once both its cameras run.
+  std::unique_ptr<FakeRig> fake;
+  std::unique_ptr<wiimote::Backend> hidapi;
+  wiimote::Backend* backend = nullptr;
   wiimote::Clock clock = wiimote::system_clock();
-  std::vector<std::shared_ptr<wiimote::FakeRemote>> fakes;
-  int64_t origin_ns = -1;  // fake rig: the wand is waved once both cameras run
   if (o.fake_rig_seed) {
-    auto simulated = simulated_wand(*o.fake_rig_seed, o);
-    if (!simulated) return R::failure(simulated.error());
-    wand = std::move(*simulated);
-    clock = manual.clock();
-    auto bus = std::make_unique<wiimote::FakeBus>(clock);
-    for (int c = 0; c < 2; ++c) {
-      fakes.push_back(bus->add_remote({.address = c ? "00:1F:32:FA:CE:01" : "00:1F:32:FA:CE:00",
-                                       .phase_ns = (3 + 4 * c) * 1'000'000}));
-      fakes.back()->set_blob_source([&wand, &origin_ns, c](int64_t t) {
-        return origin_ns < 0 ? IrObjects{} : wand->at(c, t - origin_ns);
-      });
-    }
-    backend = std::move(bus);
+    auto wand = simulated_wand(*o.fake_rig_seed, o);
+    if (!wand) return R::failure(wand.error());
+    fake = std::make_unique<FakeRig>(std::move(*wand), false);
+    backend = &fake->backend();
+    clock = fake->clock();
   } else {
-    backend = std::make_unique<wiimote::HidapiBackend>();
+    hidapi = std::make_unique<wiimote::HidapiBackend>();
+    backend = hidapi.get();
   }
 
   wiimote::LogWriter log(clock);
@@ -154,11 +144,8 @@ Result<std::vector<InputEvent>> record_live_wand(const LiveWandOptions& o) {
   std::string stop;
   if (!o.fake_rig_seed) driver.start();
   while (stop.empty()) {
-    if (o.fake_rig_seed) {
-      // One millisecond of the fake clock; a read per remote drains a report each.
-      manual.advance(1'000'000);
-      for (int k = 0; k < 2; ++k) driver.poll(0);
-      if (origin_ns < 0 && driver.cameras(wiimote::LinkState::Running) == 2) origin_ns = manual.now();
+    if (fake) {
+      fake->advance(1'000'000, driver);
     } else {
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
@@ -176,7 +163,7 @@ Result<std::vector<InputEvent>> record_live_wand(const LiveWandOptions& o) {
     if (!live.status()) return R::failure(live.status().error);
   }
   driver.stop();
-  for (int k = 0; o.fake_rig_seed && k < 4; ++k) driver.poll(0);  // what the fake remotes still hold
+  for (int k = 0; fake && k < 4; ++k) driver.poll(0);  // what the fake remotes still hold
   if (Status s = live.finish(); !s) return R::failure(s.error);
   std::cerr << "fire calibrate: " << coverage.line() << "\nfire calibrate: " << stop << "; " << events.size()
             << " events recorded in " << o.session_dir << "\n";

@@ -114,31 +114,40 @@ Result<std::unique_ptr<FakeDrawingRig>> FakeDrawingRig::create(uint64_t seed, in
 
   std::unique_ptr<FakeDrawingRig> out(new FakeDrawingRig());
   nlohmann::ordered_json with_remotes = nlohmann::ordered_json::parse(*rig_json);
-  with_remotes["remotes"] = {{{"address", kAddresses[0]}, {"role", "camera0"}},
-                             {{"address", kAddresses[1]}, {"role", "camera1"}},
-                             {{"address", kAddresses[2]}, {"role", "pad"}}};
+  const auto& addresses = FakeRig::kAddresses;
+  with_remotes["remotes"] = {{{"address", addresses[0]}, {"role", "camera0"}},
+                             {{"address", addresses[1]}, {"role", "camera1"}},
+                             {{"address", addresses[2]}, {"role", "pad"}}};
   out->rig_json_ = with_remotes.dump(2) + "\n";
   out->marks_json_ = marks_to_json(drawing->marks);
   out->duration_s_ = drawing->session.stats.duration_s;
-  out->blobs_ = simulated_blobs_of(drawing->session.events);
-  out->presses_ = pad_presses_for(drawing->session.events, drawing->marks.size());
-  FakeDrawingRig* self = out.get();
-  for (size_t r = 0; r < kAddresses.size(); ++r) {
-    // The cameras report from phases apart, as two remotes switched on at different instants do.
-    self->remotes_[r] = self->bus_.add_remote({.address = kAddresses[r], .phase_ns = int64_t(3 + 4 * r) * 1'000'000});
-    if (r < 2)
-      self->remotes_[r]->set_blob_source([self, r](int64_t t) {
-        return self->origin_ns_ < 0 ? IrObjects{} : self->blobs_.at(int(r), t - self->origin_ns_);
-      });
-  }
+  out->remotes_ = std::make_unique<FakeRig>(simulated_blobs_of(drawing->session.events), true,
+                                            pad_presses_for(drawing->session.events, drawing->marks.size()));
   return out;
 }
 
-void FakeDrawingRig::advance(int64_t ns, wiimote::Driver& driver, const std::function<void()>& each_ms) {
+bool FakeDrawingRig::finished() const {
+  const int64_t shown = remotes_->elapsed_ns();
+  return shown >= 0 && double(shown) * 1e-9 > duration_s_ + 0.5;
+}
+
+FakeRig::FakeRig(SimulatedBlobs blobs, bool with_pad, std::vector<PadPress> presses)
+    : blobs_(std::move(blobs)), presses_(std::move(presses)) {
+  for (size_t r = 0; r < (with_pad ? 3u : 2u); ++r) {
+    // The cameras report from phases apart, as two remotes switched on at different instants do.
+    remotes_.push_back(bus_.add_remote({.address = kAddresses[r], .phase_ns = int64_t(3 + 4 * r) * 1'000'000}));
+    if (r < 2)
+      remotes_[r]->set_blob_source([this, r](int64_t t) {
+        return origin_ns_ < 0 ? IrObjects{} : blobs_.at(int(r), t - origin_ns_);
+      });
+  }
+}
+
+void FakeRig::advance(int64_t ns, wiimote::Driver& driver, const std::function<void()>& each_ms) {
   for (int64_t done = 0; done < ns; done += 1'000'000) {
     clock_.advance(1'000'000);
     const int64_t now = clock_.now();
-    if (origin_ns_ >= 0) {
+    if (origin_ns_ >= 0 && remotes_.size() == 3) {
       if (release_at_ >= 0 && now >= release_at_) {
         remotes_[2]->set_buttons(0);
         release_at_ = -1;
@@ -149,18 +158,9 @@ void FakeDrawingRig::advance(int64_t ns, wiimote::Driver& driver, const std::fun
       }
     }
     for (int k = 0; k < 4; ++k) driver.poll(0);  // a burst of held reports drains within the millisecond
-    if (origin_ns_ < 0) {
-      int running = 0;
-      for (const wiimote::RemoteView& v : driver.remotes())
-        running += wiimote::is_camera(v.role) && v.state == wiimote::LinkState::Running;
-      if (running == 2) origin_ns_ = now;
-    }
-    each_ms();
+    if (origin_ns_ < 0 && driver.cameras(wiimote::LinkState::Running) == 2) origin_ns_ = now;
+    if (each_ms) each_ms();
   }
-}
-
-bool FakeDrawingRig::finished() const {
-  return origin_ns_ >= 0 && double(clock_.now() - origin_ns_) * 1e-9 > duration_s_ + 0.5;
 }
 
 }  // namespace fire::cli
