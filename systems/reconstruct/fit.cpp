@@ -68,6 +68,7 @@ struct LimitFit::Impl {
   std::vector<uint32_t> path_first_curve;
   std::vector<Eigen::Index> vertex_row;  // row of each drawn base vertex (-1 for the others)
   double ridge = 0;
+  Sparse shape;  // the shape term's matrix (empty when no base quad is thin): its pull is shape * initial
   Eigen::SimplicialLDLT<Sparse> solver;
   Eigen::VectorXd inverse_diagonal;  // 1 / D of the solver's L D L^T
 };
@@ -109,14 +110,13 @@ void multiply_rows(const SparseRows& rows, const Eigen::MatrixX3d& points, Eigen
   gather(rows, points, [&](Eigen::Index r, double x, double y, double z) { out.row(r) << x, y, z; });
 }
 
-// rows^T * targets + ridge * initial (rows^T stored as rows by column), into the solver's permuted order
-// (P b).
-void right_hand_side(const Sparse& by_column, const Eigen::SimplicialLDLT<Sparse>& solver, double ridge,
-                     const Eigen::MatrixX3d& targets, const Eigen::MatrixX3d& initial, Rows3& permuted) {
+// rows^T * targets + anchor (rows^T stored as rows by column), into the solver's permuted order (P b).
+void right_hand_side(const Sparse& by_column, const Eigen::SimplicialLDLT<Sparse>& solver,
+                     const Eigen::MatrixX3d& targets, const Eigen::MatrixX3d& anchor, Rows3& permuted) {
   const auto& order = solver.permutationP().indices();
   permuted.resize(by_column.cols(), 3);
   gather(by_column, targets, [&](Eigen::Index i, double x, double y, double z) {
-    permuted.row(order[i]) << x + ridge * initial(i, 0), y + ridge * initial(i, 1), z + ridge * initial(i, 2);
+    permuted.row(order[i]) << x + anchor(i, 0), y + anchor(i, 1), z + anchor(i, 2);
   });
 }
 
@@ -183,6 +183,23 @@ void solve_permuted(const Eigen::SimplicialLDLT<Sparse>& solver, const Eigen::Ve
 }
 
 }  // namespace
+
+std::vector<double> shape_weights(const BaseMesh& base, const FitWeights& settings) {
+  std::vector<double> weight(base.vertex_count(), 0.0);
+  if (!(settings.shape > 0)) return weight;
+  for (uint32_t f = 0; f < base.face_count(); ++f) {
+    const uint32_t first = base.face_offsets[f];
+    if (base.face_offsets[f + 1] - first != 4) continue;
+    const double aspect = quad_aspect(base, f);
+    if (!(aspect > settings.shape_aspect)) continue;
+    const double excess = aspect / settings.shape_aspect - 1;
+    for (uint32_t k = 0; k < 4; ++k) {
+      double& w = weight[base.face_vertices[first + k]];
+      w = std::max(w, std::min(excess * excess, 1.0));
+    }
+  }
+  return weight;
+}
 
 LimitFit::LimitFit() = default;
 LimitFit::~LimitFit() = default;
@@ -259,6 +276,16 @@ Result<LimitFit> LimitFit::build(const subdivide::Refinement& refinement, const 
   const Sparse bilaplacian = laplacian * laplacian;
   const Sparse fairness = Sparse(bilaplacian.transpose()) * bilaplacian;
   normal += (settings.fairness * data_scale / fairness.diagonal().mean()) * fairness;
+  // The shape term: the change from the initial base points, measured by the umbrella, costs where base
+  // quads are thin. Zero everywhere (no term) when none is.
+  const std::vector<double> shape = shape_weights(base, settings);
+  if (std::any_of(shape.begin(), shape.end(), [](double w) { return w > 0; })) {
+    const Sparse plain = Sparse(laplacian.transpose()) * laplacian;
+    const Eigen::Map<const Eigen::VectorXd> per_vertex(shape.data(), Eigen::Index(nb));
+    const Sparse weighted = Sparse(laplacian.transpose()) * (per_vertex.asDiagonal() * laplacian);
+    impl->shape = (settings.shape * data_scale / plain.diagonal().mean()) * weighted;
+    normal += impl->shape;
+  }
   impl->ridge = settings.ridge * data_scale;
   for (Eigen::Index v = 0; v < normal.cols(); ++v) normal.coeffRef(v, v) += impl->ridge;
   impl->solver.compute(normal);
@@ -411,9 +438,11 @@ Steps<FitRun::Fitted> FitRun::fit_steps(const LimitFit::Impl& m, const BaseMesh&
 
   LimitFit::Report report;
   Eigen::MatrixX3d solution, fitted;
+  Eigen::MatrixX3d anchor = m.ridge * initial;
+  if (m.shape.nonZeros() > 0) anchor += m.shape * initial;
   Rows3 permuted;
   auto solve_once = [&] {
-    right_hand_side(m.rows_by_column, m.solver, m.ridge, targets, initial, permuted);
+    right_hand_side(m.rows_by_column, m.solver, targets, anchor, permuted);
     solve_permuted(m.solver, m.inverse_diagonal, permuted, solution);
     multiply_rows(m.rows, solution, fitted);
     ++report.iterations;

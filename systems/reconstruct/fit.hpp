@@ -49,6 +49,14 @@ struct FitWeights {
   // their normal matrices); Options::fairness.
   double fairness = 1e-3;
   double ridge = 1e-9;  // same scale, towards the initial base points
+  // Where the face split leaves thin base quads, the umbrella measures connectivity, not shape: on a
+  // sliver it pulls the points across the thin side and the surface folds (the demo dome). There the
+  // umbrella of the change from the initial base points (the transfinite patches, which do not fold)
+  // costs too, with this weight (same scale as `fairness`) times min((aspect / shape_aspect - 1)^2, 1)
+  // per vertex of a quad whose aspect (quad_aspect) exceeds `shape_aspect`. perf/RESULTS.md, "Thin
+  // quads keep their transfinite shape", has the sweep.
+  double shape = 0.1;
+  double shape_aspect = 3;
   uint32_t slide_iterations = 10;  // solves of phase 1
   uint32_t feet_iterations = 60;   // solves of phase 2
   // Phase 2: each target keeps at least this fraction of the equal arc-length step from its neighbours'
@@ -58,6 +66,10 @@ struct FitWeights {
   uint32_t max_iterations = 110;   // solves in all
   double tolerance = 1e-11;
 };
+
+// Per base vertex, the weight of the shape term (FitWeights::shape); all zero where no quad is thin. The
+// fit's matrix depends on them as it does on topology, so a changed set needs a new factorization.
+std::vector<double> shape_weights(const BaseMesh& base, const FitWeights& weights);
 
 class LimitFit {
  public:

@@ -37,9 +37,11 @@ struct ReconstructionCache {
   subdivide::Refinement refinement;
   subdivide::LimitStencils limit;
   // fit is the factorization of the current topology only when fit_built; fit_waiting: a new base mesh
-  // has been shown and its fit has not started yet.
+  // has been shown and its fit has not started yet. fit_shape: the shape weights it was built with,
+  // which depend on the base points (a change of them needs a new factorization too).
   LimitFit fit;
   bool fit_built = false;
+  std::vector<double> fit_shape;
   bool fit_waiting = false;
   // The fit of `base` in progress (fire), between the frame that took the base and the one it ends in.
   // Reset before `base` or `fit` is replaced; declared after `fit`, so destroyed before it.
@@ -91,18 +93,20 @@ bool border_corner(const Mesh& net, uint32_t v) {
 
 }  // namespace
 
+double quad_aspect(const BaseMesh& base, uint32_t face) {
+  const uint32_t first = base.face_offsets[face];
+  const Vec3* p[4];
+  for (uint32_t k = 0; k < 4; ++k) p[k] = &base.positions[base.face_vertices[first + k]];
+  double longest = 0;
+  for (uint32_t k = 0; k < 4; ++k) longest = std::max(longest, (*p[(k + 1) % 4] - *p[k]).norm());
+  const double area = 0.5 * (*p[2] - *p[0]).cross(*p[3] - *p[1]).norm();
+  return area > 0 ? longest * longest / area : std::numeric_limits<double>::infinity();
+}
+
 double worst_quad_aspect(const BaseMesh& base) {
   double worst = 0;
-  for (uint32_t f = 0; f < base.face_count(); ++f) {
-    const uint32_t first = base.face_offsets[f], n = base.face_offsets[f + 1] - first;
-    if (n != 4) continue;
-    const Vec3* p[4];
-    for (uint32_t k = 0; k < 4; ++k) p[k] = &base.positions[base.face_vertices[first + k]];
-    double longest = 0;
-    for (uint32_t k = 0; k < 4; ++k) longest = std::max(longest, (*p[(k + 1) % 4] - *p[k]).norm());
-    const double area = 0.5 * (*p[2] - *p[0]).cross(*p[3] - *p[1]).norm();
-    worst = std::max(worst, area > 0 ? longest * longest / area : std::numeric_limits<double>::infinity());
-  }
+  for (uint32_t f = 0; f < base.face_count(); ++f)
+    if (base.face_offsets[f + 1] - base.face_offsets[f] == 4) worst = std::max(worst, quad_aspect(base, f));
   return worst;
 }
 
@@ -301,14 +305,20 @@ Status rebuild_topology(const Options& options, ReconstructionCache& c) {
   return Status::success();
 }
 
-Status build_fit(const Options& options, ReconstructionCache& c) {
+FitWeights fit_weights(const Options& options) {
   FitWeights weights;
   weights.fairness = options.fairness;
+  return weights;
+}
+
+Status build_fit(const Options& options, ReconstructionCache& c) {
+  const FitWeights weights = fit_weights(options);
   auto fit = LimitFit::build(c.refinement, c.limit, c.base, weights);
   if (!fit) return Status::failure(fit.error());
   c.run = {};
   c.fit = std::move(*fit);
   c.fit_built = true;
+  c.fit_shape = shape_weights(c.base, weights);
   return Status::success();
 }
 
@@ -329,6 +339,8 @@ Result<bool> run_refine(const Mesh& net, const Options& options, ReconstructionC
   update_elements(net, options, c, everything);
   c.base = assemble(net, options, c);
   c.rebuild_topology = c.rebuild_topology || everything || !same_topology(c, c.base);
+  if (c.fit_built && options.method == Method::fire && shape_weights(c.base, fit_weights(options)) != c.fit_shape)
+    c.fit_built = false;
   c.pending_subdivide = true;
   c.seen = net.frame();
   c.compactions_seen = net.last_compaction().count;

@@ -94,6 +94,8 @@ struct BaseMesh {
 // 1 x w rectangle, about 2.4 for a rhombus with 25-degree corners (area from the diagonals' cross product);
 // infinite for a quad of zero area.
 double worst_quad_aspect(const BaseMesh& base);
+// The same measure for one base face, which must be a quad.
+double quad_aspect(const BaseMesh& base, uint32_t face);
 
 // What the last reconstruct_update() did.
 struct UpdateStats {

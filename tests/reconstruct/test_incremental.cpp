@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "networks.hpp"
+#include "systems/reconstruct/fit.hpp"
 #include "systems/reconstruct/reconstruct.hpp"
 #include "systems/split/edit.hpp"
 
@@ -85,6 +86,16 @@ TEST_CASE("adding, moving and deleting a curve on a 200-face network", "[reconst
     CHECK(state.last_update().faces_recomputed == 4);
     CHECK(state.last_update().edges_recomputed == 4);
     CHECK_FALSE(state.last_update().topology_rebuilt);
+    check_equals_full_rebuild(net, options, surface);
+
+    // Moved most of the way across its right-hand faces, it leaves them thin: their base quads' shape
+    // weights (FitWeights::shape) change with the same topology, and the fit, factorized again, still
+    // equals a full rebuild.
+    const std::vector<double> square = shape_weights(state.base(), FitWeights{});
+    net.move_vertex(v, net.vertices.position[v] + Vec3(0.8, 0, 0));
+    update(net, options, state, surface);
+    CHECK_FALSE(state.last_update().topology_rebuilt);
+    if (method == Method::fire) CHECK(shape_weights(state.base(), FitWeights{}) != square);
     check_equals_full_rebuild(net, options, surface);
 
     // Deleting the curve again.

@@ -1,10 +1,12 @@
 // The two pipelines on tiny hand-made networks: exact counts, the Coons centre, the FIRE fit passing
 // through the drawn samples, and rejected input.
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "networks.hpp"
+#include "systems/reconstruct/fit.hpp"
 #include "systems/reconstruct/reconstruct.hpp"
 
 using namespace fire;
@@ -146,6 +148,28 @@ TEST_CASE("the worst base quad's aspect: 1 for a square, 1/w for a 1 x w rectang
   b.positions[5] = {3, 0, 0};  // all four on one line: no area
   b.positions[6] = {1.5, 0, 0};
   CHECK(std::isinf(worst_quad_aspect(b)));
+}
+
+TEST_CASE("the fit's shape term weighs the vertices of thin base quads only, at most 1", "[reconstruct][fit]") {
+  BaseMesh b;
+  // A unit square and a 1 x w rectangle beside it, sharing the edge 1-2.
+  b.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {1.25, 0, 0}, {1.25, 1, 0}};
+  b.face_vertices = {0, 1, 2, 3, 1, 4, 5, 2};
+  b.face_offsets = {0, 4, 8};
+  FitWeights weights;
+  weights.shape_aspect = 3;
+  // w = 0.25: aspect 4, excess 4 / 3 - 1, squared.
+  std::vector<double> w = shape_weights(b, weights);
+  CHECK(w[0] == 0);
+  CHECK(w[3] == 0);
+  for (uint32_t v : {1u, 2u, 4u, 5u}) CHECK(w[v] == Approx(1.0 / 9.0));
+  // w = 0.1: aspect 10, capped.
+  b.positions[4].x() = b.positions[5].x() = 1.1;
+  w = shape_weights(b, weights);
+  CHECK(w[4] == 1.0);
+  weights.shape = 0;
+  w = shape_weights(b, weights);
+  CHECK(std::all_of(w.begin(), w.end(), [](double x) { return x == 0; }));
 }
 
 TEST_CASE("FIRE: the fitted limit surface passes through the drawn samples", "[reconstruct][fire][fit]") {
