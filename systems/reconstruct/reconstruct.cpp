@@ -42,6 +42,8 @@ struct ReconstructionCache {
   LimitFit fit;
   bool fit_built = false;
   std::vector<double> fit_shape;
+  double fit_fairness = 0;  // the fairness it was built with (fit_fairness of the network's noise)
+  double noise = 0;         // noise_estimate of the network at the last refine (fire)
   bool fit_waiting = false;
   // The fit of `base` in progress (fire), between the frame that took the base and the one it ends in.
   // Reset before `base` or `fit` is replaced; declared after `fit`, so destroyed before it.
@@ -101,6 +103,34 @@ double quad_aspect(const BaseMesh& base, uint32_t face) {
   for (uint32_t k = 0; k < 4; ++k) longest = std::max(longest, (*p[(k + 1) % 4] - *p[k]).norm());
   const double area = 0.5 * (*p[2] - *p[0]).cross(*p[3] - *p[1]).norm();
   return area > 0 ? longest * longest / area : std::numeric_limits<double>::infinity();
+}
+
+double noise_estimate(const Mesh& net) {
+  std::vector<double> cubed;  // squared third differences of the samples
+  double length = 0;
+  uint32_t lines = 0;
+  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+    if (!net.edge_alive(e) || !used_by_face(net, e)) continue;
+    const auto line = net.polyline(e);
+    for (size_t i = 1; i < line.size(); ++i) length += (line[i] - line[i - 1]).norm();
+    ++lines;
+    // On a few samples the curve's own shape dominates the differences.
+    if (line.size() < kNoiseSamples) continue;
+    for (size_t i = 3; i < line.size(); ++i)
+      cubed.push_back((line[i] - 3 * line[i - 1] + 3 * line[i - 2] - line[i - 3]).squaredNorm());
+  }
+  if (cubed.empty() || !(length > 0)) return 0;
+  auto middle = cubed.begin() + std::ptrdiff_t(cubed.size() / 2);
+  std::nth_element(cubed.begin(), middle, cubed.end());
+  // Independent noise of deviation s per coordinate: a third difference's squared norm is 20 s^2 times a
+  // chi-square of 3 degrees of freedom, whose median is 2.366.
+  return std::sqrt(*middle / (20 * 2.366)) / (length / lines);
+}
+
+double fit_fairness(const Options& options, double noise) {
+  if (!options.fairness_from_noise || !(noise > kExactCurveNoise)) return options.fairness;
+  const double ratio = noise / kExactCurveNoise;
+  return std::max(options.fairness, std::min(options.fairness * ratio * ratio, kNoisyFairness));
 }
 
 double worst_quad_aspect(const BaseMesh& base) {
@@ -305,20 +335,25 @@ Status rebuild_topology(const Options& options, ReconstructionCache& c) {
   return Status::success();
 }
 
-FitWeights fit_weights(const Options& options) {
+// The shape term comes with the noise too: exact curves are followed as drawn (it would cost the rook's
+// exact network its rms goal), noisy hand-drawn ones keep their thin quads' transfinite shape.
+FitWeights fit_weights(const Options& options, double noise) {
   FitWeights weights;
-  weights.fairness = options.fairness;
+  weights.fairness = fit_fairness(options, noise);
+  const double noisy = (weights.fairness - options.fairness) / (kNoisyFairness - options.fairness);
+  weights.shape = kNoisyFairness > options.fairness ? weights.shape * std::clamp(noisy, 0.0, 1.0) : 0;
   return weights;
 }
 
 Status build_fit(const Options& options, ReconstructionCache& c) {
-  const FitWeights weights = fit_weights(options);
+  const FitWeights weights = fit_weights(options, c.noise);
   auto fit = LimitFit::build(c.refinement, c.limit, c.base, weights);
   if (!fit) return Status::failure(fit.error());
   c.run = {};
   c.fit = std::move(*fit);
   c.fit_built = true;
   c.fit_shape = shape_weights(c.base, weights);
+  c.fit_fairness = weights.fairness;
   return Status::success();
 }
 
@@ -339,8 +374,12 @@ Result<bool> run_refine(const Mesh& net, const Options& options, ReconstructionC
   update_elements(net, options, c, everything);
   c.base = assemble(net, options, c);
   c.rebuild_topology = c.rebuild_topology || everything || !same_topology(c, c.base);
-  if (c.fit_built && options.method == Method::fire && shape_weights(c.base, fit_weights(options)) != c.fit_shape)
-    c.fit_built = false;
+  if (options.method == Method::fire) {
+    c.noise = options.fairness_from_noise ? noise_estimate(net) : 0;
+    const FitWeights weights = fit_weights(options, c.noise);
+    if (c.fit_built && (weights.fairness != c.fit_fairness || shape_weights(c.base, weights) != c.fit_shape))
+      c.fit_built = false;
+  }
   c.pending_subdivide = true;
   c.seen = net.frame();
   c.compactions_seen = net.last_compaction().count;

@@ -50,8 +50,10 @@ struct Options {
   Planarity planarity = Planarity::least_squares;  // the thesis's triquadrification measure
   // FIRE: weight of the fit's fairness term (systems/reconstruct/fit.hpp), 0 to 1. It chooses the face
   // interiors the curves leave open; larger is smoother, smaller follows exactly representable data
-  // more closely.
+  // more closely. With fairness_from_noise, the weight for exact curves: noisy ones raise it
+  // (fit_fairness); without, the weight itself (an explicit --fairness).
   double fairness = 1e-3;
+  bool fairness_from_noise = true;
   // FIRE, the live frame: back-substitutions of the fit per frame after a commit (the subdivide system);
   // at least 1, kWholeFit for the whole fit in the commit frame. The frame after a commit that changed
   // the base topology factorizes; 22 is the fewest with which a fit (at most FitWeights::max_iterations
@@ -94,6 +96,19 @@ struct BaseMesh {
 // 1 x w rectangle, about 2.4 for a rhombus with 25-degree corners (area from the diagonals' cross product);
 // infinite for a quad of zero area.
 double worst_quad_aspect(const BaseMesh& base);
+// The deviation of the noise on the network's polylines, as a fraction of their mean length: from the
+// median third difference of consecutive samples, robust to curvature and to a few outliers; only
+// polylines of at least kNoiseSamples samples count (0 when none has that many).
+inline constexpr size_t kNoiseSamples = 10;
+double noise_estimate(const Mesh& net);
+// Noise estimates at or below this are exact curves (sampled limit curves give 2e-5 to 3e-4).
+inline constexpr double kExactCurveNoise = 3e-4;
+// The fairness noisy curves reach: on pawn, rook and torus at 1 to 4 % noise and on the simulated tracked
+// drawing it gives fewer folds and a smaller rms and hausdorff than 1e-3 or 1e-2 (perf/RESULTS.md).
+inline constexpr double kNoisyFairness = 0.1;
+// The fairness the fit uses for a network whose noise_estimate is `noise`: Options::fairness for exact
+// curves, growing with the square of the noise above kExactCurveNoise up to kNoisyFairness.
+double fit_fairness(const Options& options, double noise);
 // The same measure for one base face, which must be a quad.
 double quad_aspect(const BaseMesh& base, uint32_t face);
 

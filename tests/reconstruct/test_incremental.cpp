@@ -115,3 +115,31 @@ TEST_CASE("adding, moving and deleting a curve on a 200-face network", "[reconst
     check_equals_full_rebuild(net, options, surface);
   }
 }
+
+TEST_CASE("a noisy network's fit follows its noise, and a move that changes the estimate refactorizes, equal to a rebuild",
+          "[reconstruct][incremental][noise]") {
+  // Every curve carries a ripple a little longer than its sample spacing (1/19): noise to the estimate.
+  auto noisy = [](double x, double y) { return height(x, y) + 0.004 * std::sin(97 * x + 53 * y); };
+  Mesh net = grid_network(6, 4, 20, noisy);
+  const Options options;
+  const double noise = noise_estimate(net);
+  CHECK(noise > kExactCurveNoise);
+  CHECK(fit_fairness(options, noise) > options.fairness);
+  CHECK(fit_fairness(options, noise) <= kNoisyFairness);
+  // The same curves without the ripple are exact; an explicit weight is used as is.
+  CHECK(fit_fairness(options, noise_estimate(grid_network(6, 4, 20, height))) == options.fairness);
+  Options explicit_weight;
+  explicit_weight.fairness_from_noise = false;
+  CHECK(fit_fairness(explicit_weight, noise) == explicit_weight.fairness);
+
+  ReconstructionState state;
+  SurfaceMesh surface;
+  update(net, options, state, surface);
+  check_equals_full_rebuild(net, options, surface);
+  const uint32_t v = 2 * 7 + 3;  // an interior vertex
+  net.move_vertex(v, net.vertices.position[v] + Vec3(0.3, 0.2, 0.1));
+  CHECK(fit_fairness(options, noise_estimate(net)) != fit_fairness(options, noise));
+  update(net, options, state, surface);
+  CHECK_FALSE(state.last_update().topology_rebuilt);
+  check_equals_full_rebuild(net, options, surface);
+}

@@ -223,7 +223,9 @@ void add_network_commands(CLI::App& app, Registry& registry) {
   replay->add_option("--levels", o->surface.levels, "subdivision levels of the surface")
       ->capture_default_str()
       ->check(CLI::Range(1u, reconstruct::kMaxSurfaceLevels));
-  replay->add_option("--fairness", o->surface.fairness, "fairness weight of the surface fit, 0 to 1")
+  replay->add_option("--fairness", o->surface.fairness,
+                     "fairness weight of the surface fit, 0 to 1, used as is (default: this for exact curves, raised "
+                     "with the noise the polylines show up to 0.1)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
   replay->add_flag("--hash", o->hash,
@@ -236,6 +238,7 @@ void add_network_commands(CLI::App& app, Registry& registry) {
   replay->callback([o, replay, &registry] {
     o->settings_given = replay->count("--snap") + replay->count("--levels") + replay->count("--fairness") +
                             replay->count("--no-surface") > 0;
+    if (replay->count("--fairness") > 0) o->surface.fairness_from_noise = false;
     registry.exit_code = run_replay(*o);
   });
 

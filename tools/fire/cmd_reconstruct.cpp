@@ -17,6 +17,7 @@ struct ReconstructArgs {
   std::string network_path, out_path, method = "fire", planarity = "least-squares";
   uint32_t coons_steps = 1, levels = 3;
   double fairness = reconstruct::Options{}.fairness;
+  bool fairness_given = false;
 };
 
 int fail(const std::string& message) {
@@ -36,6 +37,7 @@ int run_reconstruct(const ReconstructArgs& a) {
   options.coons_steps = a.coons_steps;
   options.levels = a.levels;
   options.fairness = a.fairness;
+  options.fairness_from_noise = !a.fairness_given;
   // The output's format is checked first, so a wrong extension costs no reconstruction.
   if (auto format = surface_format_of(a.out_path); !format) return fail(format.error());
   auto net = load_network(a.network_path);
@@ -58,6 +60,9 @@ int run_reconstruct(const ReconstructArgs& a) {
   out["vertices"] = surface.positions.size();
   out["seconds"] = seconds;
   out["worst_quad_aspect"] = reconstruct::worst_quad_aspect(state.base());
+  const double noise = reconstruct::noise_estimate(*net);
+  out["noise_estimate"] = noise;
+  out["fairness"] = reconstruct::fit_fairness(options, noise);
   std::cout << out.dump() << "\n";
   return 0;
 }
@@ -73,7 +78,10 @@ void add_reconstruct_commands(CLI::App& app, Registry& registry) {
       "Catmull-Clark limit surface passes through the drawn curves. Writes the level-L quads at their limit "
       "positions with limit normals, atomically; the format follows the extension (.obj .ply .stl .glb). Prints one "
       "JSON line: method, coons_steps, levels, base_faces, faces, vertices, seconds (reconstruction only, no I/O) "
-      "and worst_quad_aspect (the base mesh's worst quad: longest side squared over area, 1 for a square).");
+      "worst_quad_aspect (the base mesh's worst quad: longest side squared over area, 1 for a square), "
+      "noise_estimate (the polylines' noise from their samples' third differences, a fraction of their mean "
+      "length) and fairness (the fit's weight: --fairness if given, else the default for exact curves raised "
+      "with the noise estimate up to 0.1).");
   cmd->add_option("NET", a->network_path, "curve network file (format: engine/NETWORK_FORMAT.md)")->required();
   cmd->add_option("-o,--output", a->out_path, "surface file to write: .obj, .ply, .stl or .glb")->required();
   cmd->add_option("--method", a->method, "thesis or fire")->capture_default_str();
@@ -81,12 +89,16 @@ void add_reconstruct_commands(CLI::App& app, Registry& registry) {
   cmd->add_option("--levels", a->levels, "L: Catmull-Clark levels (1 to 6)")->capture_default_str();
   cmd->add_option("--fairness", a->fairness,
                   "fire: weight of the fit's smoothness term, 0 to 1 (smaller follows the curves more closely, larger "
-                  "keeps face interiors smoother; a hand-drawn network whose thin faces fold needs up to 1)")
+                  "keeps face interiors smoother). Default: this for exact curves, raised with the noise the "
+                  "polylines show up to 0.1; given, it is used as is")
       ->capture_default_str();
   cmd->add_option("--planarity", a->planarity,
                   "the thesis triquadrification's measure: least-squares, mean-normal or hough")
       ->capture_default_str();
-  cmd->callback([a, &registry] { registry.exit_code = run_reconstruct(*a); });
+  cmd->callback([a, cmd, &registry] {
+    a->fairness_given = cmd->count("--fairness") > 0;
+    registry.exit_code = run_reconstruct(*a);
+  });
 }
 
 }  // namespace fire::cli

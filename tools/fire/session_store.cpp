@@ -73,6 +73,7 @@ std::string settings_json(const World& w) {
   j["levels"] = w.surface_options.levels;
   j["planarity"] = static_cast<int>(w.surface_options.planarity);
   j["fairness"] = w.surface_options.fairness;
+  j["fairness_from_noise"] = w.surface_options.fairness_from_noise;
   return j.dump(2) + "\n";
 }
 
@@ -89,6 +90,10 @@ Status apply_settings_json(std::string_view text, const std::string& source, Wor
       !j["surface"].is_boolean() || !j["method"].is_string() || !j["coons_steps"].is_number_unsigned() ||
       !j["levels"].is_number_unsigned() || !j["planarity"].is_number_unsigned())
     return fail("a setting has the wrong type");
+  // Sessions written before the fairness followed the noise lack the key: they replay with the fixed weight.
+  if (j.contains("fairness_from_noise") && !j["fairness_from_noise"].is_boolean())
+    return fail("a setting has the wrong type");
+  const bool from_noise = j.contains("fairness_from_noise") && j["fairness_from_noise"].get<bool>();
   const double snap = j["snap_distance"], fairness = j["fairness"];
   const uint64_t close = j["close_samples"], coons = j["coons_steps"], levels = j["levels"], planarity = j["planarity"];
   const std::string method = j["method"];
@@ -104,6 +109,7 @@ Status apply_settings_json(std::string_view text, const std::string& source, Wor
   w.surface_options.levels = static_cast<uint32_t>(levels);
   w.surface_options.planarity = static_cast<reconstruct::Planarity>(planarity);
   w.surface_options.fairness = fairness;
+  w.surface_options.fairness_from_noise = from_noise;
   return Status::success();
 }
 
