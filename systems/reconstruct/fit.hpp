@@ -46,15 +46,17 @@ namespace fire::reconstruct {
 
 struct FitWeights {
   // Weight of the bi-Laplacian fairness, relative to the data (both measured by the mean diagonal of
-  // their normal matrices); Options::fairness.
+  // their normal matrices); fit_fairness (reconstruct.hpp): Options::fairness, raised for noisy curves.
   double fairness = 1e-3;
   double ridge = 1e-9;  // same scale, towards the initial base points
   // Where the face split leaves thin base quads, the umbrella measures connectivity, not shape: on a
   // sliver it pulls the points across the thin side and the surface folds (the demo dome). There the
   // umbrella of the change from the initial base points (the transfinite patches, which do not fold)
   // costs too, with this weight (same scale as `fairness`) times min((aspect / shape_aspect - 1)^2, 1)
-  // per vertex of a quad whose aspect (quad_aspect) exceeds `shape_aspect`. perf/RESULTS.md, "Thin
-  // quads keep their transfinite shape", has the sweep.
+  // per vertex of a quad whose aspect (quad_aspect) exceeds `shape_aspect`. The reconstruction scales
+  // it with the curves' noise, as the fairness: none for exact curves, this at kNoisyFairness.
+  // perf/RESULTS.md, "Thin quads keep their transfinite shape; the fairness follows the noise", has
+  // the sweeps.
   double shape = 0.1;
   double shape_aspect = 3;
   uint32_t slide_iterations = 10;  // solves of phase 1
