@@ -37,6 +37,14 @@ SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleBvh& a_bvh
 Result<TriangleMesh> reference_limit_surface(std::span<const Vec3> positions, std::span<const uint32_t> face_offsets,
                                              std::span<const uint32_t> face_vertices, int levels) {
   using R = Result<TriangleMesh>;
+  // Measuring against the reference costs about half a kilobyte per quad (limit points, triangles, BVH,
+  // samples): a dense surface given as the control mesh would exhaust memory, so it is refused up front.
+  const uint64_t quads = uint64_t{face_vertices.size()} << (2 * std::max(levels - 1, 0));
+  if (levels > 0 && quads > kMaxReferenceQuads)
+    return R::failure(std::to_string(face_offsets.size() - 1) + " faces make " + std::to_string(quads) +
+                      " quads at " + std::to_string(levels) + " Catmull-Clark levels, more than the " +
+                      std::to_string(kMaxReferenceQuads) +
+                      " a reference may have; give the coarse control mesh, not a dense surface");
   auto sub = subdivide::subdivide({positions, face_offsets, face_vertices, {}}, levels);
   if (!sub) return R::failure(sub.error());
   TriangleMesh mesh;

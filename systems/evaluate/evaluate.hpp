@@ -91,7 +91,9 @@ SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleBvh& a_bvh
 
 // The ground truth of a control mesh: Catmull-Clark (fire_subdivide, EdgeAndCorner) to `levels` and the
 // last level's vertices projected to their limit positions, each quad split along its shorter diagonal.
-// Errors are fire_subdivide's (non-manifold edge or vertex, bad faces, non-finite positions, size).
+// Errors are fire_subdivide's (non-manifold edge or vertex, bad faces, non-finite positions, size), and
+// more than kMaxReferenceQuads quads at `levels`.
+inline constexpr uint64_t kMaxReferenceQuads = uint64_t{1} << 24;
 Result<TriangleMesh> reference_limit_surface(std::span<const Vec3> positions, std::span<const uint32_t> face_offsets,
                                              std::span<const uint32_t> face_vertices, int levels);
 

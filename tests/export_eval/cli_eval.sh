@@ -59,6 +59,14 @@ expect_error "unsupported PLY" "fire eval: .*ascii.ply: unsupported PLY layout" 
 head -c 300 "$tmp/torus.fnet" >"$tmp/truncated.fnet"
 expect_error "truncated network" "fire eval: .*truncated.fnet" \
   "$fire" eval "$meshes/cube.obj" --reference "$meshes/cube.obj" --network "$tmp/truncated.fnet"
+# A dense surface given as the reference: 130 x 130 quads make 17.3 million at 5 levels, about 9 GB to measure
+# against; refused before anything is subdivided (it was killed by the kernel for memory).
+awk 'BEGIN { n = 130; for (j = 0; j <= n; ++j) for (i = 0; i <= n; ++i) print "v", i, j, 0;
+             for (j = 0; j < n; ++j) for (i = 0; i < n; ++i) { a = j * (n + 1) + i + 1; print "f", a, a + 1, a + n + 2, a + n + 1 } }' \
+  >"$tmp/dense.obj"
+expect_error "dense reference" \
+  "fire eval: .*dense.obj: reference mesh cannot be subdivided: 16900 faces make 17305600 quads at 5 Catmull-Clark levels, more than the 16777216 a reference may have" \
+  "$fire" eval "$meshes/cube.obj" --reference "$tmp/dense.obj"
 "$fire" eval "$meshes/cube.obj" --reference "$meshes/cube.obj" --reference-levels 4 >/dev/null 2>&1
 check "reference levels below 5 refused" "[ $? -ne 0 ]"
 "$fire" eval "$meshes/cube.obj" --reference "$meshes/cube.obj" --spacing 0 >/dev/null 2>&1

@@ -289,6 +289,19 @@ TEST_CASE("the reference limit surface refuses what cannot be subdivided", "[eva
   auto nan = reference_limit_surface(nan_points, offsets, quad, 5);
   REQUIRE_FALSE(nan.ok());
   CHECK_THAT(nan.error(), Contains("non-finite"));
+  // A dense surface as the reference: refused by its size at `levels`, before anything is subdivided.
+  std::vector<uint32_t> dense_offsets = {0}, dense_quads;
+  for (uint32_t f = 0; f < 16385; ++f) {
+    dense_quads.insert(dense_quads.end(), {0, 1, 2, 3});
+    dense_offsets.push_back(static_cast<uint32_t>(dense_quads.size()));
+  }
+  auto dense = reference_limit_surface(nan_points, dense_offsets, dense_quads, 5);
+  REQUIRE_FALSE(dense.ok());
+  CHECK_THAT(dense.error(), Contains("16385 faces make 16778240 quads at 5 Catmull-Clark levels, more than the 16777216"));
+  // At 4 levels (4.2 million quads) the size passes, and the NaN point is what is refused.
+  auto fewer_levels = reference_limit_surface(nan_points, dense_offsets, dense_quads, 4);
+  REQUIRE_FALSE(fewer_levels.ok());
+  CHECK_THAT(fewer_levels.error(), Contains("non-finite"));
   auto bad = triangulate(nan_points, offsets, std::vector<uint32_t>{0, 1, 9, 3});
   REQUIRE_FALSE(bad.ok());
   CHECK_THAT(bad.error(), Contains("vertex 2 has a non-finite coordinate"));
