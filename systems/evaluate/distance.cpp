@@ -39,8 +39,8 @@ Result<TriangleMesh> reference_limit_surface(std::span<const Vec3> positions, st
   using R = Result<TriangleMesh>;
   // Measuring against the reference costs about half a kilobyte per quad (limit points, triangles, BVH,
   // samples): a dense surface given as the control mesh would exhaust memory, so it is refused up front.
-  const uint64_t quads = uint64_t{face_vertices.size()} << (2 * std::max(levels - 1, 0));
-  if (levels > 0 && quads > kMaxReferenceQuads)
+  const uint64_t quads = levels > 0 ? subdivide::faces_at_level(face_vertices.size(), levels) : 0;
+  if (quads > kMaxReferenceQuads)
     return R::failure(std::to_string(face_offsets.size() - 1) + " faces make " + std::to_string(quads) +
                       " quads at " + std::to_string(levels) + " Catmull-Clark levels, more than the " +
                       std::to_string(kMaxReferenceQuads) +

@@ -50,10 +50,8 @@ Status validate_base(const BaseTopology& base) {
 
 // Counts of each level, to refuse a refinement that would not fit before allocating it.
 Status check_sizes(const BaseTopology& base, int levels) {
-  uint64_t corners = base.face_vertices.size();
   for (int level = 1; level <= levels; ++level) {
-    const uint64_t faces = corners;  // one quad per parent corner
-    corners = 4 * corners;
+    const uint64_t faces = faces_at_level(base.face_vertices.size(), level);
     if (faces > kMaxFaces)
       return Status::failure("level " + std::to_string(level) + " would have " + std::to_string(faces) +
                              " faces, more than the limit of " + std::to_string(kMaxFaces));

@@ -153,6 +153,10 @@ inline uint32_t last_level_vertex(const Refinement& refinement, uint32_t v) {
   return refinement.last_from_osd.empty() ? v : refinement.last_from_osd[v];
 }
 
+// Faces of level `level` (at least 1) of a mesh with `base_corners` face corners: one quad per corner at
+// level 1, four children per face after that.
+inline uint64_t faces_at_level(uint64_t base_corners, int level) { return base_corners << (2 * (level - 1)); }
+
 // Builds the levels. Errors name the offending face, edge or vertex: a face with fewer
 // than 3 vertices or a repeated vertex, an index out of range, an edge shared by more than 2 faces or
 // twice in the same direction (inconsistent orientation), a vertex whose faces do not form one fan,
