@@ -129,7 +129,7 @@ namespace {
 
 // What the pen would do now, against the mesh as the frame found it.
 void publish_feedback(const Mesh& mesh, const SnapIndex& snap, const SketchState& state, double start_radius,
-                      PenFeedback& fb) {
+                      double vertex_radius, PenFeedback& fb) {
   fb.pen_down = state.pen_down;
   fb.target_edge = {};
   fb.face = {};
@@ -147,10 +147,11 @@ void publish_feedback(const Mesh& mesh, const SnapIndex& snap, const SketchState
   if (state.pen_down && !state.stroke.empty()) {  // where the stroke would end, as the pen going up would place it
     const Snap s = snap_to_face(mesh, snap, state.stroke.front(), fb.pen, std::max(start_radius, fb.radius));
     if (s.face != kNone) {
+      const CurveEnd end = at_vertex(mesh, s.face, s.end, fb.pen, vertex_radius);
       fb.face = mesh.face_id(s.face);
-      fb.target_edge = mesh.edge_id(s.end.edge);
-      fb.target_point = s.end.point;
-      fb.target = mesh.polyline(s.end.edge)[s.end.point];
+      fb.target_edge = mesh.edge_id(end.edge);
+      fb.target_point = end.point;
+      fb.target = mesh.polyline(end.edge)[end.point];
       return;
     }
   }
@@ -171,6 +172,8 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
   // At most one request per frame, so every request is placed on the mesh as the previous one left it;
   // events after it wait in `pending` for the next frame.
   auto radius = [&](double logged) { return logged > 0 ? logged : settings.snap_distance; };
+  // A logged radius is the mouse's aperture: a vertex inside it takes the end, as the edge point would.
+  auto vertex_radius = [&](double logged) { return std::max(settings.vertex_snap, logged); };
   std::vector<InputEvent> events = std::move(state.pending);
   state.pending.clear();
   events.insert(events.end(), frame_events.begin(), frame_events.end());
@@ -240,8 +243,8 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           }
           r.command.kind = EditKind::SplitFace;
           r.command.face = s.face;
-          r.command.start = at_vertex(mesh, s.face, s.start, r.command.points.front(), settings.vertex_snap);
-          r.command.end = at_vertex(mesh, s.face, s.end, r.command.points.back(), settings.vertex_snap);
+          r.command.start = at_vertex(mesh, s.face, s.start, r.command.points.front(), vertex_radius(state.start_snap));
+          r.command.end = at_vertex(mesh, s.face, s.end, r.command.points.back(), vertex_radius(state.end_snap));
           blend_ends(r.command.points, mesh.polyline(r.command.start.edge)[r.command.start.point],
                      mesh.polyline(r.command.end.edge)[r.command.end.point], settings.blend_reach);
         }
@@ -286,7 +289,7 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
         break;  // device reports are the triangulate system's; truth and meta are not for replay
     }
   }
-  publish_feedback(mesh, snap, state, radius(state.start_snap), feedback);
+  publish_feedback(mesh, snap, state, radius(state.start_snap), vertex_radius(state.end_snap), feedback);
 }
 
 }  // namespace fire

@@ -22,7 +22,8 @@ struct SketchSettings {
   uint32_t close_samples = 16;  // points on the straight edge made by `cmd close`
   // A split's end within this distance of one of its face's vertices lands on that vertex (0: off, the nearest
   // polyline point always). A tracked pen never ends exactly on a vertex; a new vertex a millimetre from an old
-  // one leaves a sliver of an edge and faces with extra sides.
+  // one leaves a sliver of an edge and faces with extra sides. An end whose pen sample carries its own radius
+  // (the mouse) lands on a vertex within the larger of the two: a cursor cannot hit a vertex exactly either.
   double vertex_snap = 0;
   // A split's end corrections spread over this fraction of the stroke from each end (1: the whole
   // stroke; a border's always do). Under 1 the middle stays where it was drawn, so a curve snapped onto curves that were themselves

@@ -148,3 +148,33 @@ TEST_CASE("the pen's feedback is not part of the replay hash", "[sketch][feedbac
   CHECK(b->pen_feedback.pen_seen);
   CHECK(world_hash(*a) == world_hash(*b));
 }
+
+TEST_CASE("a mouse stroke's end lands on a vertex within its logged snap radius, and the feedback shows that vertex",
+          "[sketch][feedback]") {
+  // The square closed by a left curve with a point every 2 mm, so a polyline point lies nearer the pen than
+  // the corner (0, 0.1) does.
+  Log log = open_border();
+  log.event("down");
+  for (int k = 0; k <= 50; ++k) log.pen(0, 0.1 - 0.002 * k);
+  log.event("up");
+  Log plain = log, mouse = log;
+  // Each ends 1.1 mm from the left curve's point (0, 0.098) and 2.7 mm from the corner.
+  plain.event("down").pen(0.05, 0).pen(0.03, 0.05).pen(0.001, 0.0975);
+  mouse.event("down").pen(0.05, 0).pen(0.03, 0.05).event("pen 0.001 0.0975 0 0.005");
+
+  auto w = replay(mouse);
+  REQUIRE(w->mesh.face_count() == 1);
+  CHECK(w->pen_feedback.target == Vec3(0, 0.1, 0));
+  mouse.event("up");
+  w = replay(mouse);
+  REQUIRE(w->mesh.face_count() == 2);
+  CHECK(w->mesh.vertex_count() == 5);  // the corners and the bottom's middle: no new vertex beside the corner
+
+  // Without a logged radius (and no vertex snap in the session), the nearest polyline point.
+  w = replay(plain);
+  CHECK(w->pen_feedback.target == Vec3(0, 0.098, 0));
+  plain.event("up");
+  w = replay(plain);
+  REQUIRE(w->mesh.face_count() == 2);
+  CHECK(w->mesh.vertex_count() == 6);
+}
