@@ -233,8 +233,9 @@ void add_network_commands(CLI::App& app, Registry& registry) {
   replay->add_flag("--timings", o->timings, "print per-system timings (mean, p99, max per frame) and final counts");
   replay->add_option("--snap", o->snap,
                      "snap distance for stroke ends, in model units (a stroke end whose pen sample carries its own "
-                     "radius, as a mouse drawing from fire app does, uses that)")
+                     "radius, as a mouse drawing from fire app does, uses that, and lands on a vertex within it)")
       ->capture_default_str();
+  replay->footer("Pictures of the replay's frames: fire render LOG --every N --png-dir DIR.");
   replay->callback([o, replay, &registry] {
     o->settings_given = replay->count("--snap") + replay->count("--levels") + replay->count("--fairness") +
                             replay->count("--no-surface") > 0;
