@@ -1,5 +1,9 @@
 // fire eval: distance of a reconstructed surface to the limit surface of its control mesh (issue 3, item 6).
+#include <unistd.h>
+
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -25,7 +29,24 @@ int fail(const std::string& message) {
   return 1;
 }
 
+// A line per stage on a terminal: subdividing the reference and sampling both surfaces take seconds.
+class Stages {
+ public:
+  void done(const std::string& what) const {
+    if (!on_terminal_) return;
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+    char elapsed[32];
+    std::snprintf(elapsed, sizeof elapsed, " (%.1f s)", seconds);
+    std::cerr << "fire eval: " << what << elapsed << "\n";
+  }
+
+ private:
+  bool on_terminal_ = ::isatty(STDERR_FILENO) != 0;
+  std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
+};
+
 int run_eval(const EvalArgs& a) {
+  const Stages stages;
   auto surface = read_surface(a.surface_path);
   if (!surface) return fail(surface.error());
   auto out_mesh = evaluate::triangulate(surface->positions, surface->face_offsets, surface->face_vertices);
@@ -40,6 +61,8 @@ int run_eval(const EvalArgs& a) {
   if (!(diagonal > 0) || !std::isfinite(diagonal))
     return fail(a.reference_path + ": the reference limit surface has no extent (bounding-box diagonal " +
                 std::to_string(diagonal) + ")");
+  stages.done(a.reference_path + ": limit surface at " + std::to_string(a.reference_levels) + " levels, " +
+              std::to_string(reference->triangle_count()) + " triangles; measuring both ways");
 
   std::vector<Vec3> network_points;
   if (!a.network_path.empty()) {
@@ -57,6 +80,8 @@ int run_eval(const EvalArgs& a) {
   if (!std::isfinite(d.rms) || !std::isfinite(d.hausdorff))
     return fail(a.surface_path + ": distances are not finite (rms " + std::to_string(d.rms) + ", hausdorff " +
                 std::to_string(d.hausdorff) + ")");
+
+  stages.done(std::to_string(d.a_to_b.samples + d.b_to_a.samples) + " samples measured");
 
   nlohmann::ordered_json out;
   out["rms"] = d.rms;
