@@ -9,19 +9,21 @@
 
 #include "engine/input_log.hpp"
 #include "platform/clock.hpp"
+#include "platform/files.hpp"
 #include "platform/network_file.hpp"
 #include "platform/obj.hpp"
 #include "platform/render/renderer.hpp"
 #include "systems/reconstruct/reconstruct.hpp"
 #include "tools/fire/commands.hpp"
 #include "tools/fire/session.hpp"
+#include "tools/fire/session_rig.hpp"
 
 namespace fire::cli {
 
 namespace {
 
 struct RenderArgs {
-  std::string input_path, out_path, size = "1280x720", view = "iso", reference_path, png_dir;
+  std::string input_path, out_path, size = "1280x720", view = "iso", reference_path, png_dir, rig_path;
   uint32_t levels = 3, every = 0;
 };
 
@@ -34,13 +36,31 @@ bool ends_with(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
 
-// The network of a .fnet file, or the one an input log draws when replayed headless.
-Result<Mesh> load_input(const std::string& path) {
-  if (ends_with(path, ".fnet")) return load_network(path);
+// An input log ready to replay: with the rig of --rig when its Wii Remote reports are to be triangulated.
+Result<std::unique_ptr<World>> world_for_log(const std::string& path, const std::string& rig_path) {
+  using R = Result<std::unique_ptr<World>>;
   auto log = read_input_log(path);
-  if (!log) return Result<Mesh>::failure(log.error());
+  if (!log) return R::failure(log.error());
   auto world = std::make_unique<World>();
+  if (!rig_path.empty()) {
+    Result<std::string> text = read_text_file(rig_path);
+    Result<TrackingRig> rig =
+        text ? tracking_rig_from_json(*text, rig_path, *log, path) : Result<TrackingRig>::failure(text.error());
+    if (!rig) return R::failure(rig.error());
+    set_rig(*world, *rig);
+  } else if (has_device_reports(*log)) {
+    return R::failure(path + " holds Wii Remote reports; give the rig they were drawn with: --rig RIG.json (from fire calibrate)");
+  }
   world->log = std::move(*log);
+  return world;
+}
+
+// The network of a .fnet file, or the one an input log draws when replayed headless.
+Result<Mesh> load_input(const std::string& path, const std::string& rig_path) {
+  if (ends_with(path, ".fnet")) return load_network(path);
+  auto loaded = world_for_log(path, rig_path);
+  if (!loaded) return Result<Mesh>::failure(loaded.error());
+  std::unique_ptr<World> world = std::move(*loaded);
   Scheduler scheduler = make_scheduler(*world, monotonic_ns);
   replay_headless(*world, scheduler);
   for (const Rejection& r : world->rejections) std::cerr << path << ":" << r.line << ": rejected: " << r.reason << "\n";
@@ -57,10 +77,9 @@ int render_sequence(const RenderArgs& a, const Mesh& final_network, render::Rend
   std::error_code error;
   std::filesystem::create_directories(a.png_dir, error);
   if (error) return fail(a.png_dir + ": cannot create the directory (" + error.message() + ")");
-  auto log = read_input_log(a.input_path);
-  if (!log) return fail(log.error());
-  auto world = std::make_unique<World>();
-  world->log = std::move(*log);
+  auto loaded = world_for_log(a.input_path, a.rig_path);
+  if (!loaded) return fail(loaded.error());
+  std::unique_ptr<World> world = std::move(*loaded);
   world->surface_options.levels = a.levels;
 
   Status status;
@@ -134,7 +153,8 @@ int run_render(const RenderArgs& a) {
     }
   }
 
-  auto network = load_input(a.input_path);
+  if (!a.rig_path.empty() && ends_with(a.input_path, ".fnet")) return fail("--rig is for an input log, not a network");
+  auto network = load_input(a.input_path, a.rig_path);
   if (!network) return fail(network.error());
   reconstruct::Options options;
   options.levels = a.levels;
@@ -216,6 +236,9 @@ void add_render_commands(CLI::App& app, Registry& registry) {
   cmd->add_option("--view", a->view, "iso, front, top or side (Z up)")->capture_default_str();
   cmd->add_option("--reference", a->reference_path, "OBJ mesh drawn see-through over the scene");
   cmd->add_option("--levels", a->levels, "Catmull-Clark levels of the surface (1 to 6)")->capture_default_str();
+  cmd->add_option("--rig", a->rig_path,
+                  "rig file from fire calibrate, for an input log of Wii Remote reports (fire simulate drawing, a "
+                  "session's input.log): its reports go through the triangulation system as in fire replay --rig");
   cmd->callback([a, &registry] { registry.exit_code = run_render(*a); });
 }
 

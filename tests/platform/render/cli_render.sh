@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # `fire render` as a user runs it, on lavapipe or a GPU with the validation layer on (FIRE_VK_VALIDATION=1
 # from ctest): a network and an input log become PNGs of the asked size; bad input (no Vulkan device, a
-# reference mesh that does not load, a PNG that cannot be written, a bad view or size) exits 1 with a
-# message saying what is wrong, and writes nothing.
+# reference mesh that does not load, a PNG that cannot be written, a bad view or size, a log of Wii Remote
+# reports without its --rig) exits 1 with a message saying what is wrong, and writes nothing.
 set -u
 fire="$1" here="$2" log="$3"
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
@@ -62,4 +62,17 @@ expect_error "an unknown view" "--view must be iso, front, top or side" "$tmp/v.
   "$fire" render "$here/data/sketch.fnet" -o "$tmp/v.png" --view diagonal
 expect_error "a bad size" "--size must be WIDTHxHEIGHT" "$tmp/s.png" "$fire" render "$here/data/sketch.fnet" -o "$tmp/s.png" --size 0x10
 expect_error "a network that does not load" "missing.fnet" "$tmp/n.png" "$fire" render "$tmp/missing.fnet" -o "$tmp/n.png"
+
+# A log of Wii Remote reports (the demo's kind): drawn through the triangulation system with --rig, refused
+# without one. The simulated person draws the border of the pawn's --unrefine 4 network (24 curves made 18 edges).
+"$fire" simulate wand -o "$tmp/wand.log" >/dev/null && "$fire" calibrate "$tmp/wand.log" -o "$tmp/rig.json" >/dev/null 2>&1 &&
+  "$fire" simulate drawing -o "$tmp/drawing.log" --marks-out "$tmp/marks.json" --object-out "$tmp/pawn.obj" --unrefine 4 >/dev/null
+check "a simulated rig and drawing" "[ -s '$tmp/rig.json' ] && [ -s '$tmp/drawing.log' ]"
+out=$("$fire" render "$tmp/drawing.log" --rig "$tmp/rig.json" -o "$tmp/tracked.png" --size 320x180 2>"$tmp/err"); rc=$?
+check "a log of reports rendered with --rig: its tracked border and the surface inside it" \
+  "[ $rc -eq 0 ] && is_png '$tmp/tracked.png' && echo '$out' | grep -q '\"edges\":18,\"surface_quads\":[1-9]'"
+expect_error "a log of reports without --rig" "holds Wii Remote reports; give the rig" "$tmp/untracked.png" \
+  "$fire" render "$tmp/drawing.log" -o "$tmp/untracked.png"
+expect_error "--rig with a network" "--rig is for an input log" "$tmp/r.png" \
+  "$fire" render "$here/data/sketch.fnet" --rig "$tmp/rig.json" -o "$tmp/r.png"
 exit $fail
