@@ -9,7 +9,6 @@
 
 #include "engine/input_log.hpp"
 #include "platform/clock.hpp"
-#include "platform/files.hpp"
 #include "platform/network_file.hpp"
 #include "platform/obj.hpp"
 #include "platform/render/renderer.hpp"
@@ -43,9 +42,7 @@ Result<std::unique_ptr<World>> world_for_log(const std::string& path, const std:
   if (!log) return R::failure(log.error());
   auto world = std::make_unique<World>();
   if (!rig_path.empty()) {
-    Result<std::string> text = read_text_file(rig_path);
-    Result<TrackingRig> rig =
-        text ? tracking_rig_from_json(*text, rig_path, *log, path) : Result<TrackingRig>::failure(text.error());
+    Result<TrackingRig> rig = load_tracking_rig(rig_path, *log, path);
     if (!rig) return R::failure(rig.error());
     set_rig(*world, *rig);
   } else if (has_device_reports(*log)) {
