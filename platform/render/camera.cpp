@@ -81,8 +81,8 @@ glm::vec3 orbit_back(const Orbit& o) {
 }  // namespace
 
 void Orbit::rotate(float dx, float dy) {
-  yaw -= dx * 0.008f;
-  pitch = std::clamp(pitch + dy * 0.008f, -1.55f, 1.55f);  // short of the poles, where Z-up turns over
+  yaw -= dx * kOrbitRadiansPerPixel;
+  pitch = std::clamp(pitch + dy * kOrbitRadiansPerPixel, -1.55f, 1.55f);  // short of the poles, where Z-up turns over
 }
 
 void Orbit::pan(float dx, float dy, uint32_t height) {

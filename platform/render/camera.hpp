@@ -37,6 +37,9 @@ struct Camera {
 // most of the image and far enough that every corner stays inside it.
 Camera frame_box(const Box& box, View view, uint32_t width, uint32_t height);
 
+// How far a drag of one pixel turns the orbit (yaw and pitch), radians.
+inline constexpr float kOrbitRadiansPerPixel = 0.008f;
+
 // The app's camera: orbits `target` at `distance`, `yaw` about Z from +X, `pitch` above the XY plane.
 struct Orbit {
   glm::vec3 target{0.0f};
