@@ -17,7 +17,11 @@ OneSided distances_to(std::span<const Vec3> points, const TriangleBvh& target) {
     const TriangleBvh::Hit hit = target.closest(p, hint);
     hint = hit.triangle;
     out.sum_squared += hit.distance_squared;
-    out.max = std::max(out.max, std::sqrt(hit.distance_squared));
+    const double distance = std::sqrt(hit.distance_squared);
+    if (distance > out.max) {
+      out.max = distance;
+      out.max_index = out.samples;
+    }
     ++out.samples;
   }
   return out;
@@ -26,8 +30,11 @@ OneSided distances_to(std::span<const Vec3> points, const TriangleBvh& target) {
 SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleBvh& a_bvh, const TriangleMesh& b,
                                  const TriangleBvh& b_bvh, double spacing, double scale) {
   SurfaceDistance out;
-  out.a_to_b = distances_to(sample_triangles(a, spacing), b_bvh);
-  out.b_to_a = distances_to(sample_triangles(b, spacing), a_bvh);
+  const std::vector<Vec3> a_samples = sample_triangles(a, spacing), b_samples = sample_triangles(b, spacing);
+  out.a_to_b = distances_to(a_samples, b_bvh);
+  out.b_to_a = distances_to(b_samples, a_bvh);
+  if (out.a_to_b.max >= out.b_to_a.max && !a_samples.empty()) out.hausdorff_at = a_samples[out.a_to_b.max_index];
+  if (out.b_to_a.max > out.a_to_b.max) out.hausdorff_at = b_samples[out.b_to_a.max_index];
   const double samples = static_cast<double>(out.a_to_b.samples + out.b_to_a.samples);
   out.rms = samples == 0 ? 0 : std::sqrt((out.a_to_b.sum_squared + out.b_to_a.sum_squared) / samples) / scale;
   out.hausdorff = std::max(out.a_to_b.max, out.b_to_a.max) / scale;

@@ -75,6 +75,7 @@ std::vector<Vec3> sample_triangles(const TriangleMesh& mesh, double spacing);
 struct OneSided {
   double sum_squared = 0;
   double max = 0;
+  size_t max_index = 0;  // the point at distance max: where a figure is worst, to look there
   size_t samples = 0;
   double rms() const;
 };
@@ -85,6 +86,7 @@ struct SurfaceDistance {
   double rms = 0;        // sqrt of the mean squared distance over the samples of both directions
   double hausdorff = 0;  // largest distance, both directions
   OneSided a_to_b, b_to_a;  // unscaled
+  Vec3 hausdorff_at{};      // the sample, on a or on b, at the largest distance
 };
 SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleBvh& a_bvh, const TriangleMesh& b,
                                  const TriangleBvh& b_bvh, double spacing, double scale);

@@ -37,6 +37,17 @@ check "network on the surface: network_max ~ 0 ($network_max)" \
 "$fire" eval "$meshes/torus.obj" --reference "$meshes/torus.obj" --network "$tmp/noisy.fnet" --spacing 0.01 >"$tmp/out"
 noisy_max=$(field network_max)
 check "noisy network: network_max > 0.001 ($noisy_max)" "awk -v n='$noisy_max' 'BEGIN { exit !(n > 0.001) }'"
+# network_max_at names the point: its edge and index in the file, and its position there.
+python3 - "$tmp/out" "$tmp/noisy.fnet" >"$tmp/where" 2>&1 <<'PY'
+import json, sys
+out = json.loads(open(sys.argv[1]).read())
+at = out["network_max_at"]
+point = json.load(open(sys.argv[2]))["edges"][at["edge"]]["points"][at["point"]]
+print("same" if point == at["position"] else f"differs: {point} {at}")
+print("rms below max" if 0 < out["network_rms"] < out["network_max"] else f"network_rms {out['network_rms']}")
+PY
+check "network_max_at is the file's point ($(head -1 "$tmp/where"))" "[ \"\$(head -1 '$tmp/where')\" = same ]"
+check "0 < network_rms < network_max ($(tail -1 "$tmp/where"))" "[ \"\$(tail -1 '$tmp/where')\" = 'rms below max' ]"
 
 expect_error "non-manifold reference fan.obj" \
   "fire eval: .*fan.obj: reference mesh cannot be subdivided: .*shared by more than 2 faces" \

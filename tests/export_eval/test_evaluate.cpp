@@ -225,11 +225,23 @@ TEST_CASE("two-sided distance sees what one side misses", "[evaluate][analytic]"
   CHECK(d.a_to_b.max < 1e-15);  // rounding in the closest point of a coplanar sample
   CHECK(d.b_to_a.max == Approx(1).epsilon(1e-15));  // the corners at x = 2
   CHECK(d.hausdorff == Approx(0.5).epsilon(1e-15));
+  CHECK(d.hausdorff_at.x() == Approx(2).epsilon(1e-15));  // where it is: a sample of b at a corner x = 2
+  CHECK((d.hausdorff_at.y() == Approx(0).margin(1e-15) || d.hausdorff_at.y() == Approx(1).epsilon(1e-15)));
   double sum = 0;
   const std::vector<Vec3> b_samples = sample_triangles(b, spacing);
   for (const Vec3& p : b_samples) sum += std::pow(std::max(0.0, p.x() - 1), 2);
   const double all = static_cast<double>(d.a_to_b.samples + b_samples.size());
   CHECK(d.rms == Approx(std::sqrt(sum / all) / 2.0).epsilon(1e-12));
+}
+
+TEST_CASE("one-sided distances name the point that is farthest", "[evaluate][analytic]") {
+  const TriangleMesh a = square(0);
+  const TriangleBvh a_bvh(a);
+  const std::vector<Vec3> points{{0.5, 0.5, 0.1}, {0.2, 0.3, -0.4}, {0.9, 0.1, 0.3}, {0.5, 0.5, 0.4}};
+  const OneSided d = distances_to(points, a_bvh);
+  CHECK(d.max == Approx(0.4).epsilon(1e-12));
+  CHECK(d.max_index == 1);  // the first of the two at 0.4
+  CHECK(d.samples == points.size());
 }
 
 TEST_CASE("samples cover each triangle evenly", "[evaluate][sampling]") {

@@ -65,12 +65,18 @@ int run_eval(const EvalArgs& a) {
               std::to_string(reference->triangle_count()) + " triangles; measuring both ways");
 
   std::vector<Vec3> network_points;
+  std::vector<std::pair<uint32_t, uint32_t>> network_point_ids;  // (edge, index in its polyline) per point
   if (!a.network_path.empty()) {
     auto network = load_network(a.network_path);
     if (!network) return fail(network.error());
     for (uint32_t e = 0; e < network->edge_slots(); ++e)
-      if (network->edge_alive(e))
-        for (const Vec3& p : network->polyline(e)) network_points.push_back(p);
+      if (network->edge_alive(e)) {
+        const auto polyline = network->polyline(e);
+        for (uint32_t i = 0; i < polyline.size(); ++i) {
+          network_points.push_back(polyline[i]);
+          network_point_ids.emplace_back(e, i);
+        }
+      }
     if (network_points.empty()) return fail(a.network_path + ": the network has no polyline points");
   }
 
@@ -86,13 +92,20 @@ int run_eval(const EvalArgs& a) {
   nlohmann::ordered_json out;
   out["rms"] = d.rms;
   out["hausdorff"] = d.hausdorff;
+  out["hausdorff_at"] = {d.hausdorff_at.x(), d.hausdorff_at.y(), d.hausdorff_at.z()};
   // From SURFACE's samples only: what a drawing that covers part of the object is measured by.
   out["surface_rms"] = d.a_to_b.rms() / diagonal;
   out["surface_max"] = d.a_to_b.max / diagonal;
   if (!network_points.empty()) {
-    const double network_max = evaluate::distances_to(network_points, out_bvh).max / diagonal;
+    const evaluate::OneSided network = evaluate::distances_to(network_points, out_bvh);
+    const double network_max = network.max / diagonal;
     if (!std::isfinite(network_max)) return fail(a.network_path + ": network distance is not finite");
     out["network_max"] = network_max;
+    out["network_rms"] = network.rms() / diagonal;
+    const Vec3& worst = network_points[network.max_index];
+    out["network_max_at"] = {{"edge", network_point_ids[network.max_index].first},
+                             {"point", network_point_ids[network.max_index].second},
+                             {"position", {worst.x(), worst.y(), worst.z()}}};
   }
   out["diagonal"] = diagonal;
   out["samples"] = d.a_to_b.samples + d.b_to_a.samples;
@@ -109,9 +122,12 @@ void add_eval_commands(CLI::App& app, Registry& registry) {
       "Measure a surface against the Catmull-Clark limit surface of a control mesh. Both are sampled densely "
       "(vertices plus sub-triangle centroids); each sample's exact distance to the other surface is divided by the "
       "bounding-box diagonal of the reference limit surface. Prints one JSON line: rms (square root of the mean "
-      "squared distance over the samples of both directions), hausdorff (largest distance, both directions), "
+      "squared distance over the samples of both directions), hausdorff (largest distance, both directions) and "
+      "hausdorff_at (the sample there), "
       "surface_rms and surface_max (the same from SURFACE's samples only: a drawing of part of the object is measured "
-      "where it is), with --network network_max (largest distance from a polyline point to the surface), diagonal, samples.");
+      "where it is), with --network network_max (largest distance from a polyline point to the surface), network_rms (their "
+      "root mean square) and network_max_at (that point: its network edge, its index in the edge's polyline, its position), diagonal, "
+      "samples.");
   cmd->add_option("SURFACE", a->surface_path, "surface to measure: .obj, .ply, .stl or .glb as `fire reconstruct` writes")
       ->required();
   cmd->add_option("--reference", a->reference_path,
