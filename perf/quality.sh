@@ -5,7 +5,8 @@
 # (`fire network-from-mesh --limit`), reconstruct it with --method thesis and --method fire, and measure
 # each surface with `fire eval` against the control mesh's limit surface and with perf/folds.py. Then the
 # demo dome (tools/demo/sketch.log), which has no ground truth: folds, faces facing down and how far its
-# curves lie from the surface. Prints markdown tables for perf/RESULTS.md on stdout; progress on stderr.
+# curves lie from the surface. Then the simulated tracked drawing of the pawn (`fire simulate drawing` through the
+# simulated rig), measured against the pawn. Prints markdown tables for perf/RESULTS.md on stdout; progress on stderr.
 #
 # usage: perf/quality.sh [FIRE_BINARY]      (default: build/fire)
 # env:   BASELINE=FIRE    a fire binary built from the commit to compare times with (say, main before a
@@ -179,6 +180,41 @@ else
          "$(folds max_angle_deg "$tmp/folds") | $down | $mm | $(awk -v a="$aspect" 'BEGIN { printf "%.1f", a }') | $(seconds "$t") | $goal |"
   done
 fi
+
+# The simulated tracked drawing: a person draws the pawn's K = 2 network (at 20 cm) through the simulated rig;
+# the replay with the calibrated rig gives the network; its true surface is the pawn's limit surface.
+echo
+echo "The simulated tracked drawing (\`fire simulate drawing\`, \`simulate wand\`, \`calibrate\`, \`fire replay d.log"
+echo "--rig rig.json --no-surface -o NET\`, then \`fire reconstruct NET\`; \`fire eval\` against the pawn at 20 cm, the"
+echo "drawn object). network_rms: root mean square distance of the polyline points to the surface. No goal of its own."
+echo
+echo "| method | rms | hausdorff | network_max | network_rms | pairs over 30 deg | pairs over 60 deg | largest angle (deg) | aspect | time (s) |"
+echo "|---|---|---|---|---|---|---|---|---|---|"
+echo "quality: simulated tracked drawing" >&2
+sim="$tmp/sim"
+mkdir -p "$sim"
+if ! { "$fire" simulate drawing -o "$sim/d.log" --marks-out "$sim/marks.json" --object-out "$sim/pawn20.obj" &&
+       "$fire" simulate wand -o "$sim/w.log" && "$fire" calibrate "$sim/w.log" -o "$sim/rig.json" &&
+       "$fire" replay "$sim/d.log" --rig "$sim/rig.json" --no-surface -o "$sim/net.fnet"; } >/dev/null 2>"$tmp/err"; then
+  note "simulated drawing: $(tail -3 "$tmp/err" | tr '\n' ' ' | sed "s|$tmp/||g")"
+  echo "| failed [$(( ${#notes[@]} - 1 ))] | | | | | | | | | |"
+else
+  for method in thesis fire; do
+    out="$sim/$method.obj"
+    if ! t=$(best_seconds "$fire" "$sim/net.fnet" "$out" "$method") ||
+       ! "$fire" eval "$out" --reference "$sim/pawn20.obj" --network "$sim/net.fnet" >"$tmp/eval" 2>"$tmp/err"; then
+      note "simulated drawing $method: $(tr '\n' ' ' <"$tmp/err" | sed "s|$tmp/||g")"
+      echo "| $method | failed [$(( ${#notes[@]} - 1 ))] | | | | | | | | |"
+      continue
+    fi
+    python3 "$here/perf/folds.py" "$out" >"$tmp/folds"
+    echo "| $method | $(fmt "$(field rms "$tmp/eval")") | $(fmt "$(field hausdorff "$tmp/eval")") |" \
+         "$(fmt "$(field network_max "$tmp/eval")") | $(fmt "$(field network_rms "$tmp/eval")") |" \
+         "$(folds pairs_over_30_deg "$tmp/folds") | $(folds pairs_over_60_deg "$tmp/folds") | $(folds max_angle_deg "$tmp/folds") |" \
+         "$(awk -v a="$(field worst_quad_aspect "$tmp/rec")" 'BEGIN { printf "%.1f", a }') | $(seconds "$t") |"
+  done
+fi
+
 if [ ${#notes[@]} -gt 0 ]; then
   echo
   echo "Failures:"
