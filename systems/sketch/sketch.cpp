@@ -28,6 +28,26 @@ void blend_ends(std::vector<Vec3>& stroke, const Vec3& start, const Vec3& end, d
   stroke.back() = end;
 }
 
+// Drops the samples a stroke spends near each of its ends, within `start_radius` of `start` and `end_radius` of
+// `end` (searched in the half of the stroke next to that end): a pen pauses when it is put down and lifted, and
+// the samples of a pause wander within the tracking error while the stroke's length grows. Left in, a curve
+// spends part of its length on the spot, and the surface, whose rows follow the curves by length, is crumpled
+// where several such curves meet (the simulated drawing's pole, perf/RESULTS.md). The end samples stay, for
+// blend_ends to move onto the ends.
+void drop_pauses(std::vector<Vec3>& stroke, const Vec3& start, double start_radius, const Vec3& end, double end_radius) {
+  const size_t n = stroke.size(), half = n / 2;
+  size_t first = 1, last = n - 1;  // keep [first, last) between the end samples
+  for (size_t i = 1; i < half; ++i)
+    if ((stroke[i] - start).norm() < start_radius) first = i + 1;
+  for (size_t i = n - 1; i-- > half;)
+    if ((stroke[i] - end).norm() < end_radius) last = i;
+  if (first >= last) return;  // a stroke all pause: nothing to go by, keep it as drawn
+  std::vector<Vec3> kept{stroke.front()};
+  kept.insert(kept.end(), stroke.begin() + std::ptrdiff_t(first), stroke.begin() + std::ptrdiff_t(last));
+  kept.push_back(stroke.back());
+  stroke = std::move(kept);
+}
+
 // The vertex of `face` nearest to p if it lies within `radius`, as a curve end; else `end` as it was.
 CurveEnd at_vertex(const Mesh& mesh, uint32_t face, const CurveEnd& end, const Vec3& p, double radius) {
   CurveEnd best = end;
@@ -245,8 +265,10 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           r.command.face = s.face;
           r.command.start = at_vertex(mesh, s.face, s.start, r.command.points.front(), vertex_radius(state.start_snap));
           r.command.end = at_vertex(mesh, s.face, s.end, r.command.points.back(), vertex_radius(state.end_snap));
-          blend_ends(r.command.points, mesh.polyline(r.command.start.edge)[r.command.start.point],
-                     mesh.polyline(r.command.end.edge)[r.command.end.point], settings.blend_reach);
+          const Vec3& start = mesh.polyline(r.command.start.edge)[r.command.start.point];
+          const Vec3& end = mesh.polyline(r.command.end.edge)[r.command.end.point];
+          drop_pauses(r.command.points, start, vertex_radius(state.start_snap), end, vertex_radius(state.end_snap));
+          blend_ends(r.command.points, start, end, settings.blend_reach);
         }
         requests.push_back(std::move(r));
         break;

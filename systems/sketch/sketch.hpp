@@ -24,6 +24,7 @@ struct SketchSettings {
   // polyline point always). A tracked pen never ends exactly on a vertex; a new vertex a millimetre from an old
   // one leaves a sliver of an edge and faces with extra sides. An end whose pen sample carries its own radius
   // (the mouse) lands on a vertex within the larger of the two: a cursor cannot hit a vertex exactly either.
+  // The stroke's samples within that radius of where an end lands are the pen pausing there, and are not drawn.
   double vertex_snap = 0;
   // A split's end corrections spread over this fraction of the stroke from each end (1: the whole
   // stroke; a border's always do). Under 1 the middle stays where it was drawn, so a curve snapped onto curves that were themselves

@@ -1,6 +1,7 @@
 // What the sketch system publishes about the pen (engine/pen_feedback.hpp), for scripted input logs on a
 // 10 cm square drawn in the xy plane: the closing vertex in border mode, the snap target and the face under
-// the pen in split mode, the face a stroke in progress would split; none of it in the replay hash.
+// the pen in split mode, the face a stroke in progress would split; none of it in the replay hash. And where a
+// stroke's ends land: on a vertex within the snap radius, the pen's pauses there not drawn.
 #include <catch2/catch.hpp>
 
 #include "tools/fire/session.hpp"
@@ -177,4 +178,46 @@ TEST_CASE("a mouse stroke's end lands on a vertex within its logged snap radius,
   w = replay(plain);
   REQUIRE(w->mesh.face_count() == 2);
   CHECK(w->mesh.vertex_count() == 6);
+}
+
+TEST_CASE("a stroke's pauses at its ends are not drawn: no curve point lingers within the vertex snap of its ends",
+          "[sketch]") {
+  // A diagonal from corner to corner, the pen resting 21 samples on each end first (jittering within 1 mm)
+  // and moving in 1 cm steps between; the samples carry a 3 mm radius, as the mouse's do.
+  const auto split = [](double radius) {
+    Log log = closed_square();
+    log.event("down");
+    const auto sample = [&](double x, double y) {
+      std::string event = "pen " + format_double(x) + " " + format_double(y) + " 0";
+      if (radius > 0) event.append(" ").append(format_double(radius));
+      log.event(event);
+    };
+    for (int k = 0; k <= 20; ++k) sample(0.0005 + 0.0005 * ((k * 7) % 3), 0.0005 + 0.0004 * ((k * 5) % 3));
+    for (int k = 1; k <= 8; ++k) sample(0.011 * k, 0.011 * k);
+    for (int k = 0; k <= 20; ++k) sample(0.0995 - 0.0005 * ((k * 7) % 3), 0.0995 - 0.0004 * ((k * 5) % 3));
+    log.event("up");
+    return replay(log);
+  };
+  const auto diagonal = [](const World& w) -> std::span<const Vec3> {
+    for (uint32_t e = 0; e < w.mesh.edge_slots(); ++e)
+      if (w.mesh.edge_alive(e)) {
+        const auto line = w.mesh.polyline(e);
+        if ((line.front() - line.back()).norm() > 0.12) return line;  // only the diagonal spans the square
+      }
+    FAIL("no diagonal");
+    return {};
+  };
+
+  const auto w = split(0.003);
+  REQUIRE(w->mesh.face_count() == 2);
+  const auto line = diagonal(*w);
+  CHECK(line.size() == 10);  // the two ends and the 8 moving samples
+  for (size_t i = 1; i + 1 < line.size(); ++i) {
+    CHECK((line[i] - line.front()).norm() > 0.003);
+    CHECK((line[i] - line.back()).norm() > 0.003);
+  }
+  // Without a snap radius for vertices, the stroke is kept as drawn (each pause less its repeated samples).
+  const auto kept = split(0);
+  REQUIRE(kept->mesh.face_count() == 2);
+  CHECK(diagonal(*kept).size() > 20);
 }
