@@ -165,7 +165,10 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
     end_stroke(s, out);
   // Keeps the pen followed through a frame without a stereo sample, from whichever camera still sees it.
   auto follow_one_camera = [&] {
-    if (!s.down) return;
+    // Once both cameras have lost the pen for longer than a dropped report, a blob in one of them is no
+    // evidence of it: a reflection near where the pen vanished fits one ray as well, and would hold a
+    // lifted pen down until it is put down elsewhere, joining two strokes. Both cameras take it up again.
+    if (!s.down || (s.lost_now && t - s.last_seen_t > static_cast<double>(options.short_gap_us))) return;
     const double gate = reach_m(t - s.last_seen_t, options.short_gap_us);
     std::optional<Followed> x = follow_on_ray(rig.cam0, std::span<const Vec2>(f0.blobs[k].data(), f0.blob_count[k]),
                                               s.pen_px[0], s.last_position, gate);
