@@ -132,6 +132,39 @@ double reach_m(double dt_us, int64_t short_gap_us) {
   return kJumpGate_m + speed * dt_us * 1e-6;
 }
 
+// The blobs of a camera's frame j that may be the pen. Not one that continues, link by link, a light that
+// shone beside the pen in the camera's last frame at or before `seen_t` (the pen there being the blob nearest
+// `pen_px`): a reflection next to the pen fits the pen's ray as well once the pen is lifted, and following it
+// would hold the pen down until it is put down elsewhere, joining two strokes.
+struct Candidates {
+  std::array<Vec2, tracking::kIrSlots> px;
+  int count = 0;
+};
+Candidates maybe_pen(const CameraWindow& w, size_t j, double seen_t, const Vec2& pen_px) {
+  const CameraFrames& f = w.frames;
+  Candidates out;
+  for (int b = 0; b < f.blob_count[j]; ++b) {
+    int blob = b;
+    size_t m = j;
+    while (blob >= 0 && m > 0 && f.t_frame_us[m] > seen_t) {
+      int from = -1;
+      for (int i = 0; i < f.blob_count[m - 1]; ++i)
+        if (w.links[m - 1][i] == blob) from = i;
+      blob = from;
+      --m;
+    }
+    bool beside = false;
+    if (blob >= 0 && f.t_frame_us[m] <= seen_t && f.blob_count[m] > 1) {
+      int nearest = 0;
+      for (int i = 1; i < f.blob_count[m]; ++i)
+        if ((f.blobs[m][i] - pen_px).norm() < (f.blobs[m][nearest] - pen_px).norm()) nearest = i;
+      beside = blob != nearest;
+    }
+    if (!beside) out.px[size_t(out.count++)] = f.blobs[j][b];
+  }
+  return out;
+}
+
 // Stamped with the line of camera 0's report it came from, so a rejection names a line of the log.
 InputEvent pen_event(int64_t t_us, uint32_t line, EventKind kind, const Vec3& p = Vec3::Zero()) {
   InputEvent e;
@@ -170,12 +203,14 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
     // lifted pen down until it is put down elsewhere, joining two strokes. Both cameras take it up again.
     if (!s.down || (s.lost_now && t - s.last_seen_t > static_cast<double>(options.short_gap_us))) return;
     const double gate = reach_m(t - s.last_seen_t, options.short_gap_us);
-    std::optional<Followed> x = follow_on_ray(rig.cam0, std::span<const Vec2>(f0.blobs[k].data(), f0.blob_count[k]),
-                                              s.pen_px[0], s.last_position, gate);
+    const Candidates c0 = maybe_pen(s.cameras[0], k, s.last_seen_t, s.pen_px[0]);
+    std::optional<Followed> x =
+        follow_on_ray(rig.cam0, std::span<const Vec2>(c0.px.data(), size_t(c0.count)), s.pen_px[0], s.last_position, gate);
     int camera = 0;
     if (!x) {
       if (const auto j = frame_at_or_before(f1, t1)) {
-        x = follow_on_ray(rig.cam1, std::span<const Vec2>(f1.blobs[*j].data(), f1.blob_count[*j]), s.pen_px[1],
+        const Candidates c1 = maybe_pen(w1, *j, s.last_seen_t + s.time_offset_us, s.pen_px[1]);
+        x = follow_on_ray(rig.cam1, std::span<const Vec2>(c1.px.data(), size_t(c1.count)), s.pen_px[1],
                           s.last_position, gate);
         camera = 1;
       }

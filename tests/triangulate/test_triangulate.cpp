@@ -168,20 +168,26 @@ TEST_CASE("a lifted pen is not held down by a reflection one camera sees near wh
   const Vec2 reflection = rig.c1.project(pen_path(1.0)) + Vec2(24, 18);
   auto where = [](double t) -> Vec3 { return pen_path(t) + Vec3(t >= 1.6 ? 0.07 : 0.0, 0, 0); };
   auto lifted = [](double t) { return t >= 1.0 && t < 1.6; };
-  DeviceStreams s;
-  for (double t = 0.0; t < 2.2; t += 0.010) {
-    if (lifted(t)) push_frame(s.cameras[0], t * 1e6, {});
-    else push_frame(s.cameras[0], t * 1e6, {rig.c0.project(where(t))});
+  // From `shines` on, the reflection is in camera 1's frames: after the pen vanished (0.1 s into the lift),
+  // or all along, beside the pen while it draws.
+  for (const double shines : {1.1, 0.0}) {
+    INFO("the reflection from " << shines << " s");
+    DeviceStreams s;
+    for (double t = 0.0; t < 2.2; t += 0.010) {
+      if (lifted(t)) push_frame(s.cameras[0], t * 1e6, {});
+      else push_frame(s.cameras[0], t * 1e6, {rig.c0.project(where(t))});
+    }
+    for (double t = 0.005; t < 2.2; t += 0.010) {
+      const Vec2 pen = rig.c1.project(where(t));
+      if (t < shines) push_frame(s.cameras[1], t * 1e6, {pen});
+      else if (lifted(t)) push_frame(s.cameras[1], t * 1e6, {reflection});
+      else push_frame(s.cameras[1], t * 1e6, {pen, reflection});
+    }
+    const SystemRun run = run_system_full(s, rig, 0.0);
+    CHECK(run.track.strokes == 2);
+    for (const PenSample& p : run.track.samples)
+      CHECK((p.raw - where(static_cast<double>(p.t_us) * 1e-6)).norm() < 1e-4);
   }
-  for (double t = 0.005; t < 2.2; t += 0.010) {
-    if (!lifted(t)) push_frame(s.cameras[1], t * 1e6, {rig.c1.project(where(t))});
-    else if (t >= 1.1) push_frame(s.cameras[1], t * 1e6, {reflection});
-    else push_frame(s.cameras[1], t * 1e6, {});
-  }
-  const SystemRun run = run_system_full(s, rig, 0.0);
-  CHECK(run.track.strokes == 2);
-  for (const PenSample& p : run.track.samples)
-    CHECK((p.raw - where(static_cast<double>(p.t_us) * 1e-6)).norm() < 1e-4);
 }
 
 TEST_CASE("the system's own pen events are the strokes of its samples, and it is causal") {
