@@ -30,11 +30,17 @@ OneSided distances_to(std::span<const Vec3> points, const TriangleBvh& target) {
 SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleBvh& a_bvh, const TriangleMesh& b,
                                  const TriangleBvh& b_bvh, double spacing, double scale) {
   SurfaceDistance out;
-  const std::vector<Vec3> a_samples = sample_triangles(a, spacing), b_samples = sample_triangles(b, spacing);
-  out.a_to_b = distances_to(a_samples, b_bvh);
-  out.b_to_a = distances_to(b_samples, a_bvh);
-  if (out.a_to_b.max >= out.b_to_a.max && !a_samples.empty()) out.hausdorff_at = a_samples[out.a_to_b.max_index];
-  if (out.b_to_a.max > out.a_to_b.max) out.hausdorff_at = b_samples[out.b_to_a.max_index];
+  // One side's samples at a time: on a dense surface each set is tens of megabytes.
+  {
+    const std::vector<Vec3> samples = sample_triangles(a, spacing);
+    out.a_to_b = distances_to(samples, b_bvh);
+    if (!samples.empty()) out.hausdorff_at = samples[out.a_to_b.max_index];
+  }
+  {
+    const std::vector<Vec3> samples = sample_triangles(b, spacing);
+    out.b_to_a = distances_to(samples, a_bvh);
+    if (out.b_to_a.max > out.a_to_b.max) out.hausdorff_at = samples[out.b_to_a.max_index];
+  }
   const double samples = static_cast<double>(out.a_to_b.samples + out.b_to_a.samples);
   out.rms = samples == 0 ? 0 : std::sqrt((out.a_to_b.sum_squared + out.b_to_a.sum_squared) / samples) / scale;
   out.hausdorff = std::max(out.a_to_b.max, out.b_to_a.max) / scale;
