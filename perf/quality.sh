@@ -40,6 +40,21 @@ fmt() { [ -n "$1" ] && awk -v x="$1" 'BEGIN { printf "%.2e", x }' || printf 'n/a
 seconds() { awk -v s="$1" 'BEGIN { if (s == "" || s == "failed") print (s == "" ? "n/a" : s); else printf "%.4f", s }'; }
 less_than() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a < b) }'; }
 note() { notes+=("[${#notes[@]}] $1"); }
+err_text() { tr '\n' ' ' <"$tmp/err" | sed "s|$tmp/||g"; }  # the last command's stderr, on one line
+
+# measure NAME METHOD NET OUT REFERENCE: reconstruct NET with METHOD (best of REPEAT runs: seconds in $t,
+# JSON in $tmp/rec), `fire eval` OUT against REFERENCE with the network ($tmp/eval) and perf/folds.py
+# ($tmp/folds). On failure: a note, a "failed" row for an N-column table (N in $columns), status 1.
+measure() {
+  local name="$1" method="$2" net="$3" out="$4" reference="$5"
+  if ! t=$(best_seconds "$fire" "$net" "$out" "$method") ||
+     ! "$fire" eval "$out" --reference "$reference" --network "$net" >"$tmp/eval" 2>>"$tmp/err"; then
+    note "$name $method: $(err_text)"
+    printf '| %s | failed [%d] |%s\n' "$method" $(( ${#notes[@]} - 1 )) "$(printf ' |%.0s' $(seq 3 "$columns"))"
+    return 1
+  fi
+  python3 "$here/perf/folds.py" "$out" >"$tmp/folds"
+}
 
 # best_seconds BINARY NET OUT METHOD: the best `seconds` of REPEAT reconstructions (empty on failure; the
 # last run's JSON stays in $tmp/rec).
@@ -77,7 +92,7 @@ for mesh in "${meshes[@]}"; do
       echo "quality: $mesh K=$k noise=$noise" >&2
       if ! "$fire" network-from-mesh "$meshes_dir/$mesh.obj" --unrefine "$k" --noise "$percent" "${correlate[@]}" \
           --seed "$seed" --limit -o "$net" >/dev/null 2>"$tmp/err"; then
-        note "$mesh K=$k noise $noise: network-from-mesh failed: $(tr '\n' ' ' <"$tmp/err" | sed "s|$tmp/||g")"
+        note "$mesh K=$k noise $noise: network-from-mesh failed: $(err_text)"
         echo "| $mesh | $k | $noise | no network [$(( ${#notes[@]} - 1 ))] | | | | | | | | | | | | | |"
         continue
       fi
@@ -93,10 +108,10 @@ for mesh in "${meshes[@]}"; do
             t=$(repeat=1 best_seconds "$fire" "$net" "$out" fire) || { secs=""; break; }
             if [ -z "$secs" ] || less_than "$t" "$secs"; then secs=$t; fi
           done
-          [ -n "$secs" ] || { note "$mesh K=$k noise $noise fire: $(tr '\n' ' ' <"$tmp/err" | sed "s|$tmp/||g")"; err[fire]="failed [$(( ${#notes[@]} - 1 ))]"; continue; }
+          [ -n "$secs" ] || { note "$mesh K=$k noise $noise fire: $(err_text)"; err[fire]="failed [$(( ${#notes[@]} - 1 ))]"; continue; }
         else
           if ! t=$(best_seconds "$fire" "$net" "$out" "$method"); then
-            note "$mesh K=$k noise $noise $method: $(tr '\n' ' ' <"$tmp/err" | sed "s|$tmp/||g")"
+            note "$mesh K=$k noise $noise $method: $(err_text)"
             err[$method]="failed [$(( ${#notes[@]} - 1 ))]"
             continue
           fi
@@ -104,7 +119,7 @@ for mesh in "${meshes[@]}"; do
         fi
         [ "$method" = fire ] && aspect=$(field worst_quad_aspect "$tmp/rec")
         if ! "$fire" eval "$out" --reference "$meshes_dir/$mesh.obj" --network "$net" >"$tmp/eval" 2>"$tmp/err"; then
-          note "$mesh K=$k noise $noise $method: $(tr '\n' ' ' <"$tmp/err" | sed "s|$tmp/||g")"
+          note "$mesh K=$k noise $noise $method: $(err_text)"
           err[$method]="eval failed [$(( ${#notes[@]} - 1 ))]"
           continue
         fi
@@ -162,14 +177,8 @@ if ! "$fire" replay "$here/tools/demo/sketch.log" --no-surface -o "$net" >/dev/n
 else
   for method in thesis fire; do
     out="$tmp/demo-$method.obj"
-    if ! t=$(best_seconds "$fire" "$net" "$out" "$method") ||
-       ! "$fire" eval "$out" --reference "$out" --network "$net" >"$tmp/eval" 2>>"$tmp/err"; then
-      note "demo $method: $(tr '\n' ' ' <"$tmp/err" | sed "s|$tmp/||g")"
-      echo "| $method | failed [$(( ${#notes[@]} - 1 ))] | | | | | | | | |"
-      continue
-    fi
+    columns=10 measure demo "$method" "$net" "$out" "$out" || continue
     aspect=$(field worst_quad_aspect "$tmp/rec")
-    python3 "$here/perf/folds.py" "$out" >"$tmp/folds"
     mm=$(awk -v n="$(field network_max "$tmp/eval")" -v d="$(field diagonal "$tmp/eval")" 'BEGIN { printf "%.2f", n * d * 1000 }')
     p60=$(folds pairs_over_60_deg "$tmp/folds"); down=$(folds faces_facing_down "$tmp/folds")
     goal="—"
@@ -201,13 +210,7 @@ if ! { "$fire" simulate drawing -o "$sim/d.log" --marks-out "$sim/marks.json" --
 else
   for method in thesis fire; do
     out="$sim/$method.obj"
-    if ! t=$(best_seconds "$fire" "$sim/net.fnet" "$out" "$method") ||
-       ! "$fire" eval "$out" --reference "$sim/pawn20.obj" --network "$sim/net.fnet" >"$tmp/eval" 2>"$tmp/err"; then
-      note "simulated drawing $method: $(tr '\n' ' ' <"$tmp/err" | sed "s|$tmp/||g")"
-      echo "| $method | failed [$(( ${#notes[@]} - 1 ))] | | | | | | | | |"
-      continue
-    fi
-    python3 "$here/perf/folds.py" "$out" >"$tmp/folds"
+    columns=10 measure "simulated drawing" "$method" "$sim/net.fnet" "$out" "$sim/pawn20.obj" || continue
     echo "| $method | $(fmt "$(field rms "$tmp/eval")") | $(fmt "$(field hausdorff "$tmp/eval")") |" \
          "$(fmt "$(field network_max "$tmp/eval")") | $(fmt "$(field network_rms "$tmp/eval")") |" \
          "$(folds pairs_over_30_deg "$tmp/folds") | $(folds pairs_over_60_deg "$tmp/folds") | $(folds max_angle_deg "$tmp/folds") |" \
