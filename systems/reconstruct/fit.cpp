@@ -69,8 +69,21 @@ struct LimitFit::Impl {
   std::vector<Eigen::Index> vertex_row;  // row of each drawn base vertex (-1 for the others)
   double ridge = 0;
   Sparse shape;  // the shape term's matrix (empty when no base quad is thin): its pull is shape * initial
+  // The normal matrix's other terms, kept to factor it again with reweighted fairness rows.
+  Sparse data_normal;  // rows^T rows
+  Sparse bilaplacian;
+  double fairness_scale = 0;
   Eigen::SimplicialLDLT<Sparse> solver;
   Eigen::VectorXd inverse_diagonal;  // 1 / D of the solver's L D L^T
+
+  // rows^T rows + the fairness term (its scale applied here) + the shape term + the ridge.
+  Sparse normal_matrix(const Sparse& fairness) const {
+    Sparse normal = data_normal;
+    normal += fairness_scale * fairness;
+    if (shape.nonZeros() > 0) normal += shape;
+    for (Eigen::Index v = 0; v < normal.cols(); ++v) normal.coeffRef(v, v) += ridge;
+    return normal;
+  }
 };
 
 namespace {
@@ -270,12 +283,12 @@ Result<LimitFit> LimitFit::build(const subdivide::Refinement& refinement, const 
   impl->rows.resize(Eigen::Index(selected.size()), nb);
   impl->rows.setFromTriplets(triplets.begin(), triplets.end());
 
-  Sparse normal = Sparse(impl->rows.transpose()) * impl->rows;
-  const double data_scale = normal.diagonal().mean();
+  impl->data_normal = Sparse(impl->rows.transpose()) * impl->rows;
+  const double data_scale = impl->data_normal.diagonal().mean();
   const Sparse laplacian = umbrella(base);
-  const Sparse bilaplacian = laplacian * laplacian;
-  const Sparse fairness = Sparse(bilaplacian.transpose()) * bilaplacian;
-  normal += (settings.fairness * data_scale / fairness.diagonal().mean()) * fairness;
+  impl->bilaplacian = laplacian * laplacian;
+  const Sparse fairness = Sparse(impl->bilaplacian.transpose()) * impl->bilaplacian;
+  impl->fairness_scale = settings.fairness * data_scale / fairness.diagonal().mean();
   // The shape term: the change from the initial base points, measured by the umbrella, costs where base
   // quads are thin. Zero everywhere (no term) when none is.
   const std::vector<double> shape = shape_weights(base, settings);
@@ -284,11 +297,9 @@ Result<LimitFit> LimitFit::build(const subdivide::Refinement& refinement, const 
     const Eigen::Map<const Eigen::VectorXd> per_vertex(shape.data(), Eigen::Index(nb));
     const Sparse weighted = Sparse(laplacian.transpose()) * (per_vertex.asDiagonal() * laplacian);
     impl->shape = (settings.shape * data_scale / plain.diagonal().mean()) * weighted;
-    normal += impl->shape;
   }
   impl->ridge = settings.ridge * data_scale;
-  for (Eigen::Index v = 0; v < normal.cols(); ++v) normal.coeffRef(v, v) += impl->ridge;
-  impl->solver.compute(normal);
+  impl->solver.compute(impl->normal_matrix(fairness));
   if (impl->solver.info() != Eigen::Success)
     return Result<LimitFit>::failure("the limit fit's normal matrix could not be factored");
   impl->inverse_diagonal = impl->solver.vectorD().cwiseInverse();
@@ -392,6 +403,47 @@ bool ordered(const std::vector<Span>& spans, const Eigen::VectorXd& fractions) {
   return true;
 }
 
+// From x to the nearest point of the polyline's segments.
+double distance_to_polyline(std::span<const Vec3> line, const Vec3& x) {
+  double nearest = std::numeric_limits<double>::infinity();
+  for (size_t j = 0; j + 1 < line.size(); ++j) {
+    const Vec3 a = line[j], d = line[j + 1] - a;
+    const double squared = d.squaredNorm();
+    const double w = squared > 0 ? std::clamp((x - a).dot(d) / squared, 0.0, 1.0) : 0.0;
+    nearest = std::min(nearest, (a + w * d - x).squaredNorm());
+  }
+  return std::sqrt(nearest);
+}
+
+// FitWeights::followed_*: per base vertex, the weight of its fairness row, `low` unless it is a source of
+// a limit point of a network edge whose fitted points and polyline lie farther than `within` apart
+// (either from the other); empty when no vertex gets `low`, or when every edge within `within` lies
+// within `close` already.
+Eigen::VectorXd followed_weights(const SparseRows& rows, const std::vector<Span>& whole, const Eigen::MatrixX3d& fitted,
+                                 double within, double close, double low) {
+  std::vector<uint8_t> held(size_t(rows.cols()), 0);
+  bool closer = false;  // some followed edge could come closer
+  std::vector<Vec3> fitted_line;
+  for (const Span& span : whole) {
+    // Both ways: the fitted points can lie on the polyline while it bends away between them.
+    fitted_line.clear();
+    for (Eigen::Index r : span.rows) fitted_line.push_back(fitted.row(r).transpose());
+    double farthest = 0;
+    for (const Vec3& x : fitted_line) farthest = std::max(farthest, distance_to_polyline(span.line, x));
+    for (const Vec3& x : span.line) farthest = std::max(farthest, distance_to_polyline(fitted_line, x));
+    if (farthest <= within) {
+      closer = closer || farthest > close;
+      continue;
+    }
+    for (Eigen::Index r : span.rows)
+      for (SparseRows::InnerIterator it(rows, r); it; ++it) held[size_t(it.col())] = 1;
+  }
+  if (!closer || std::all_of(held.begin(), held.end(), [](uint8_t h) { return h != 0; })) return {};
+  Eigen::VectorXd weights(rows.cols());
+  for (Eigen::Index v = 0; v < weights.size(); ++v) weights[v] = held[size_t(v)] ? 1.0 : low;
+  return weights;
+}
+
 }  // namespace
 
 LimitFit::Report LimitFit::solve(const BaseMesh& base, std::vector<Vec3>& points) const {
@@ -434,16 +486,22 @@ Steps<FitRun::Fitted> FitRun::fit_steps(const LimitFit::Impl& m, const BaseMesh&
     }
     whole.push_back(make_span(line, rows));
   }
-  const double tolerance = m.settings.tolerance * std::max(bounding_box_diagonal(base.positions), 1e-300);
+  const double size = std::max(bounding_box_diagonal(base.positions), 1e-300);
+  const double tolerance = m.settings.tolerance * size;
 
   LimitFit::Report report;
   Eigen::MatrixX3d solution, fitted;
   Eigen::MatrixX3d anchor = m.ridge * initial;
   if (m.shape.nonZeros() > 0) anchor += m.shape * initial;
   Rows3 permuted;
+  // The factorization solves run on: the fit's own, or phase 2's reweighted one (below).
+  const Eigen::SimplicialLDLT<Sparse>* solver = &m.solver;
+  const Eigen::VectorXd* inverse_diagonal = &m.inverse_diagonal;
+  Eigen::SimplicialLDLT<Sparse> reweighted;
+  Eigen::VectorXd reweighted_inverse_diagonal;
   auto solve_once = [&] {
-    right_hand_side(m.rows_by_column, m.solver, targets, anchor, permuted);
-    solve_permuted(m.solver, m.inverse_diagonal, permuted, solution);
+    right_hand_side(m.rows_by_column, *solver, targets, anchor, permuted);
+    solve_permuted(*solver, *inverse_diagonal, permuted, solution);
     multiply_rows(m.rows, solution, fitted);
     ++report.iterations;
   };
@@ -500,49 +558,69 @@ Steps<FitRun::Fitted> FitRun::fit_steps(const LimitFit::Impl& m, const BaseMesh&
     }
     return largest_move;
   };
-  // Anderson mixing: next = g - values * gamma, gamma the least-squares solution of steps * gamma = f.
-  // It is solved through the steps' Gram matrix, kept up to date a column at a time (a QR of the
-  // inner-by-depth steps each round cost more than the back-substitution).
-  std::vector<Eigen::VectorXd> step_history, value_history;
-  Eigen::MatrixXd gram;
-  Eigen::VectorXd previous_g, previous_f;
-  for (uint32_t round = 0; round < m.settings.feet_iterations; ++round) {
-    if (feet(x, g) <= tolerance) break;
-    const Eigen::VectorXd f = g - x;
-    if (previous_g.size() > 0) {
-      if (step_history.size() == m.settings.anderson_depth) {
-        value_history.erase(value_history.begin());
-        step_history.erase(step_history.begin());
-        const Eigen::Index kept = gram.rows() - 1;
-        gram = Eigen::MatrixXd(gram.bottomRightCorner(kept, kept));
+  // Phase 2 runs twice where the first run leaves some curves followed (FitWeights::followed_*): again on
+  // the reweighted factorization, from where the first run stopped.
+  for (uint32_t rounds = m.settings.feet_iterations;;) {
+    // Anderson mixing: next = g - values * gamma, gamma the least-squares solution of steps * gamma = f.
+    // It is solved through the steps' Gram matrix, kept up to date a column at a time (a QR of the
+    // inner-by-depth steps each round cost more than the back-substitution).
+    std::vector<Eigen::VectorXd> step_history, value_history;
+    Eigen::MatrixXd gram;
+    Eigen::VectorXd previous_g, previous_f;
+    for (uint32_t round = 0; round < rounds; ++round) {
+      if (feet(x, g) <= tolerance) break;
+      const Eigen::VectorXd f = g - x;
+      if (previous_g.size() > 0) {
+        if (step_history.size() == m.settings.anderson_depth) {
+          value_history.erase(value_history.begin());
+          step_history.erase(step_history.begin());
+          const Eigen::Index kept = gram.rows() - 1;
+          gram = Eigen::MatrixXd(gram.bottomRightCorner(kept, kept));
+        }
+        value_history.push_back(g - previous_g);
+        step_history.push_back(f - previous_f);
+        const Eigen::Index last = Eigen::Index(step_history.size()) - 1;
+        gram.conservativeResize(last + 1, last + 1);
+        for (Eigen::Index j = 0; j <= last; ++j)
+          gram(j, last) = gram(last, j) = step_history[size_t(j)].dot(step_history.back());
       }
-      value_history.push_back(g - previous_g);
-      step_history.push_back(f - previous_f);
-      const Eigen::Index last = Eigen::Index(step_history.size()) - 1;
-      gram.conservativeResize(last + 1, last + 1);
-      for (Eigen::Index j = 0; j <= last; ++j)
-        gram(j, last) = gram(last, j) = step_history[size_t(j)].dot(step_history.back());
+      previous_g = g;
+      previous_f = f;
+      Eigen::VectorXd next = g;
+      if (!step_history.empty()) {
+        Eigen::VectorXd projected(gram.rows());
+        for (Eigen::Index j = 0; j < gram.rows(); ++j) projected[j] = step_history[size_t(j)].dot(f);
+        const Eigen::VectorXd gamma = gram.colPivHouseholderQr().solve(projected);
+        for (Eigen::Index j = 0; j < gamma.size(); ++j) next -= gamma[j] * value_history[size_t(j)];
+      }
+      if (!ordered(whole, next)) {
+        next = g;
+        step_history.clear();
+        value_history.clear();
+        gram.resize(0, 0);
+        previous_g.resize(0);
+      }
+      x = next;
+      place(x);
+      co_yield Step{};
+      solve_once();
     }
-    previous_g = g;
-    previous_f = f;
-    Eigen::VectorXd next = g;
-    if (!step_history.empty()) {
-      Eigen::VectorXd projected(gram.rows());
-      for (Eigen::Index j = 0; j < gram.rows(); ++j) projected[j] = step_history[size_t(j)].dot(f);
-      const Eigen::VectorXd gamma = gram.colPivHouseholderQr().solve(projected);
-      for (Eigen::Index j = 0; j < gamma.size(); ++j) next -= gamma[j] * value_history[size_t(j)];
-    }
-    if (!ordered(whole, next)) {
-      next = g;
-      step_history.clear();
-      value_history.clear();
-      gram.resize(0, 0);
-      previous_g.resize(0);
-    }
-    x = next;
-    place(x);
+    // The second run has the solves left but phase 3's.
+    const uint32_t spent = report.iterations + 1 + m.settings.phase3_iterations;
+    const uint32_t left = m.settings.max_iterations - std::min(m.settings.max_iterations, spent);
+    if (solver == &reweighted || !(m.settings.followed_fairness < 1) || left == 0) break;
+    const Eigen::VectorXd weights =
+        followed_weights(m.rows, whole, fitted, m.settings.followed_distance * size, m.settings.close_distance * size,
+                         m.settings.followed_fairness);
+    if (weights.size() == 0) break;
+    reweighted.compute(m.normal_matrix(Sparse(m.bilaplacian.transpose()) * (weights.asDiagonal() * m.bilaplacian)));
+    if (reweighted.info() != Eigen::Success) break;  // keeps the first run's result, a fit as good as before
+    reweighted_inverse_diagonal = reweighted.vectorD().cwiseInverse();
+    solver = &reweighted;
+    inverse_diagonal = &reweighted_inverse_diagonal;
     co_yield Step{};
     solve_once();
+    rounds = left;
   }
   // The data term the fit minimizes: squared distances of the fitted points to their edges' polylines.
   auto distance_to_curves = [&] {

@@ -23,7 +23,9 @@
 //      Alternating with the solve creeps along the curves, so the last steps are Anderson-mixed. Each
 //      foot keeps `min_target_spacing` of the equal step from its neighbours: where a curve bends faster
 //      than the surface can follow, the feet would otherwise gather at the bend, and the surface, pinched
-//      across the curve there, folds (the rook's K = 2 foot ring: tests/reconstruct/cli_folds.sh);
+//      across the curve there, folds (the rook's K = 2 foot ring: tests/reconstruct/cli_folds.sh).
+//      Where it leaves some edges followed closely, phase 2 runs again with less fairness around them,
+//      on a second factorization (FitWeights::followed_distance);
 //   3. the split points settle on the polyline samples nearest to where phase 2 put them, and each
 //      piece slides alone as in phase 1. Where the curves are representable this converges fast (about
 //      a factor 6 per solve on smooth data) to a surface through every sample, which phase 2's creep
@@ -65,6 +67,18 @@ struct FitWeights {
   // targets along its edge.
   double min_target_spacing = 0.3;
   size_t anderson_depth = 10;      // steps mixed in phase 2
+  // Where the surface can follow its curves, the fairness that keeps it from folding where it cannot
+  // holds it off them (the pawn's collar against the rook's foot ring: perf/RESULTS.md). So after phase 2
+  // the base vertices on which only network edges depend whose fitted points and polylines lie within
+  // `followed_distance` (times the base mesh's size) of each other get `followed_fairness` on their
+  // fairness rows, the fit is factored again, and phase 2 runs on with the solves left but
+  // `phase3_iterations`; only if some of those edges lie farther than `close_distance` (the quality
+  // table's network_max goal), since a second run costs a factorization and up to twice phase 2's solves.
+  // Exact curves the surface can represent come closer; noisy ones are never that close.
+  double followed_distance = 2e-4;
+  double close_distance = 1e-4;
+  double followed_fairness = 0.1;
+  uint32_t phase3_iterations = 4;
   uint32_t max_iterations = 110;   // solves in all
   double tolerance = 1e-11;
 };
