@@ -1,5 +1,8 @@
 #pragma once
-// Splitting a line of a text format (input log, OBJ) into whitespace-separated fields.
+// Splitting a line of a text format (input log, OBJ) into whitespace-separated fields; a distance in
+// metres (the drawing's unit) as a person reads it in a message.
+#include <cstdio>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -17,6 +20,12 @@ inline std::vector<std::string_view> split_fields(std::string_view line) {
     i = j;
   }
   return out;
+}
+
+inline std::string format_mm(double metres) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2f mm", metres * 1e3);
+  return buf;
 }
 
 }  // namespace fire

@@ -1,17 +1,12 @@
 #include "systems/register/register.hpp"
 
 #include <algorithm>
-#include <cstdio>
 #include <string>
+
+#include "engine/text.hpp"
 
 namespace fire {
 namespace {
-
-std::string mm(double metres) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.2f mm", metres * 1e3);
-  return buf;
-}
 
 Vec3 mapped(const RegistrationState& s, const Vec3& p) { return s.transform ? Vec3(s.transform->R * p + s.transform->t) : p; }
 
@@ -35,8 +30,8 @@ void touch_mark(const InputEvent& e, RegistrationState& s, std::vector<Rejection
   for (const auto& [t, p] : s.recent)
     if (t > e.t_us - kRestWindowUs && t <= e.t_us) spread = std::max(spread, (p - mean).norm());
   if (spread > kRestSpread) {
-    rejections.push_back({e.t_us, e.line, what + "the pen moved " + mm(spread) + " from its mean while resting on the mark (at most " +
-                                              mm(kRestSpread) + "); hold it still"});
+    rejections.push_back({e.t_us, e.line, what + "the pen moved " + format_mm(spread) + " from its mean while resting on the mark (at most " +
+                                              format_mm(kRestSpread) + "); hold it still"});
     return;
   }
   // A mark touched again replaces its earlier touch.
@@ -64,7 +59,7 @@ void register_marks(const InputEvent& e, RegistrationState& s, std::vector<Rejec
     return;
   }
   if (!(T->rms_residual <= kMaxResidual)) {
-    reject("the marks do not fit one rigid motion (residual " + mm(T->rms_residual) + ", at most " + mm(kMaxResidual) +
+    reject("the marks do not fit one rigid motion (residual " + format_mm(T->rms_residual) + ", at most " + format_mm(kMaxResidual) +
            "): a mark was touched in the wrong place or logged with the wrong number or coordinates");
     return;
   }
@@ -132,9 +127,9 @@ std::vector<std::string> describe_registration(const RegistrationState& s) {
   std::vector<std::string> out;
   for (size_t k = 0; k < s.done.size(); ++k)
     out.push_back("registration " + std::to_string(k + 1) + " (line " + std::to_string(s.done[k].line) + "): " +
-                  std::to_string(s.done[k].marks) + " marks, residual " + mm(s.done[k].residual));
+                  std::to_string(s.done[k].marks) + " marks, residual " + format_mm(s.done[k].residual));
   if (s.touches_dropped)
-    out.push_back(std::to_string(s.touches_dropped) + " touch(es) of the pen that never moved " + mm(kTouchRadius) +
+    out.push_back(std::to_string(s.touches_dropped) + " touch(es) of the pen that never moved " + format_mm(kTouchRadius) +
                   " from where it started: not drawn");
   if (!s.touched.empty())
     out.push_back(std::to_string(s.touched.size()) + " mark(s) touched after the last registration, not registered");

@@ -5,6 +5,8 @@
 #include <iterator>
 #include <limits>
 
+#include "engine/text.hpp"
+
 namespace fire {
 
 namespace {
@@ -257,8 +259,11 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
         } else {
           Snap s = snap_to_face(mesh, snap, r.command.points.front(), r.command.points.back(), both_snap);
           if (s.face == kNone) {
-            reject("the stroke does not start and end on the boundary of one face (no face has both ends within " +
-                   std::to_string(both_snap) + ")");
+            // How far each end is from any curve tells a person which end missed.
+            const SnapHit start = snap.nearest(r.command.points.front()), end = snap.nearest(r.command.points.back());
+            reject("the stroke does not start and end on the boundary of one face: no face has both ends within " +
+                   format_mm(both_snap) + " (the start is " + format_mm(start.distance) + " from the nearest curve, the end " +
+                   format_mm(end.distance) + ")");
             break;
           }
           r.command.kind = EditKind::SplitFace;

@@ -158,7 +158,9 @@ TEST_CASE("a snap radius logged with the end samples replaces the session's sett
   auto w = replay_text(square + split(""));
   CHECK(w->mesh.face_count() == 1);
   REQUIRE(w->rejections.size() == 1);
-  CHECK_THAT(w->rejections[0].reason, Catch::Matchers::Contains("within 0.010000"));
+  // It says which end missed and by how much: here both, by 3 cm.
+  CHECK_THAT(w->rejections[0].reason,
+             Catch::Matchers::Contains("within 10.00 mm (the start is 30.00 mm from the nearest curve, the end 30.00 mm)"));
   w = replay_text(square + split(" 0.04"));
   CHECK(w->rejections.empty());
   CHECK(w->mesh.face_count() == 2);
