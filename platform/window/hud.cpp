@@ -4,7 +4,11 @@
 #include <imgui_impl_glfw.h>
 #include <imgui_impl_vulkan.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace fire::window {
 
@@ -157,16 +161,37 @@ void Hud::build(const HudData& d) {
   if (d.cameras[0].present && d.cameras[1].present) ImGui::SameLine();
   if (d.cameras[1].present) draw_camera(1, d.cameras[1]);
   ImGui::TextDisabled("H: help");
+  const float panel_right = ImGui::GetWindowPos().x + ImGui::GetWindowSize().x;
   ImGui::End();
 
   if (d.help) {
     const ImVec2 size = ImGui::GetIO().DisplaySize;
+    const ImGuiStyle& style = ImGui::GetStyle();
     ImGui::SetNextWindowPos(ImVec2(size.x - 10, 10), ImGuiCond_Always, ImVec2(1.0f, 0.0f));
     ImGui::SetNextWindowBgAlpha(0.85f);
     ImGui::Begin("Keys", nullptr, fixed);
     ImGui::TextUnformatted("Keys and mouse");
     ImGui::Separator();
-    for (const std::string& line : d.keys) ImGui::TextUnformatted(line.c_str());
+    // Each line is "key  description": the keys in a column, the descriptions wrapped to the room right of the
+    // panel above, so that in a narrow window the help does not cover the panel's figures.
+    std::vector<std::pair<std::string, std::string>> rows;
+    float key_width = 0;
+    for (const std::string& line : d.keys) {
+      const size_t gap = line.find("  ");
+      const size_t text = gap == std::string::npos ? std::string::npos : line.find_first_not_of(' ', gap);
+      rows.emplace_back(line.substr(0, gap), text == std::string::npos ? std::string() : line.substr(text));
+      key_width = std::max(key_width, ImGui::CalcTextSize(rows.back().first.c_str()).x);
+    }
+    const float column = key_width + 2 * style.ItemSpacing.x;
+    const float room = size.x - 10 - panel_right - 10 - 2 * style.WindowPadding.x - column;
+    const float wrap = std::max(room, ImGui::CalcTextSize("a description wraps here").x);
+    for (const auto& [key, text] : rows) {
+      ImGui::TextUnformatted(key.c_str());
+      ImGui::SameLine(style.WindowPadding.x + column);
+      ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + wrap);
+      ImGui::TextUnformatted(text.c_str());
+      ImGui::PopTextWrapPos();
+    }
     ImGui::End();
   }
   ImGui::Render();

@@ -40,7 +40,8 @@ struct HudData {
   // A live session's news: the remotes' states and batteries, the mark to touch next; and each camera's view.
   std::vector<std::string> live;
   std::array<CameraView, 2> cameras;
-  // The keys, one line each ("Ctrl+Z  undo"), for the help overlay.
+  // The keys, one line each: the key, two or more spaces, what it does ("Ctrl+Z  undo"); the help overlay
+  // shows them in two columns.
   std::vector<std::string> keys;
 };
 
