@@ -368,6 +368,12 @@ void snap_split_points(const Span& whole, uint32_t pieces, Eigen::MatrixX3d& tar
   }
 }
 
+// Where along the segment from a to a + d the point nearest to x lies, from 0 to 1 (0 if it has no length).
+double segment_fraction(const Vec3& a, const Vec3& d, const Vec3& x) {
+  const double squared = d.squaredNorm();
+  return squared > 0 ? std::clamp((x - a).dot(d) / squared, 0.0, 1.0) : 0.0;
+}
+
 // The arc-length fraction of the point of `span.line` closest to x, searched between fractions lo and hi
 // (the neighbouring rows' targets), so that the targets stay in order along the line.
 double foot_fraction(const Span& span, const Vec3& x, double lo, double hi) {
@@ -379,8 +385,7 @@ double foot_fraction(const Span& span, const Vec3& x, double lo, double hi) {
   double best = std::numeric_limits<double>::infinity(), best_t = 0.5 * (lo + hi);
   for (size_t j = first; j < last; ++j) {
     const Vec3 a = span.line[j], d = span.line[j + 1] - a;
-    const double squared = d.squaredNorm();
-    const double w = squared > 0 ? std::clamp((x - a).dot(d) / squared, 0.0, 1.0) : 0.0;
+    const double w = segment_fraction(a, d, x);
     const double distance = (a + w * d - x).squaredNorm();
     if (distance < best) {
       best = distance;
@@ -408,9 +413,7 @@ double distance_to_polyline(std::span<const Vec3> line, const Vec3& x) {
   double nearest = std::numeric_limits<double>::infinity();
   for (size_t j = 0; j + 1 < line.size(); ++j) {
     const Vec3 a = line[j], d = line[j + 1] - a;
-    const double squared = d.squaredNorm();
-    const double w = squared > 0 ? std::clamp((x - a).dot(d) / squared, 0.0, 1.0) : 0.0;
-    nearest = std::min(nearest, (a + w * d - x).squaredNorm());
+    nearest = std::min(nearest, (a + segment_fraction(a, d, x) * d - x).squaredNorm());
   }
   return std::sqrt(nearest);
 }
