@@ -132,36 +132,37 @@ double reach_m(double dt_us, int64_t short_gap_us) {
   return kJumpGate_m + speed * dt_us * 1e-6;
 }
 
-// The blobs of a camera's frame j that may be the pen. Not one that continues, link by link, a light that
-// shone beside the pen in the camera's last frame at or before `seen_t` (the pen there being the blob nearest
-// `pen_px`): a reflection next to the pen fits the pen's ray as well once the pen is lifted, and following it
-// would hold the pen down until it is put down elsewhere, joining two strokes.
+// Whether blob b of a camera's frame j continues, link by link, a light that shone beside the pen in the
+// camera's last frame at or before `seen_t` (the pen there being the blob nearest `pen_px`): a reflection
+// next to the pen fits the pen's ray as well once the pen is lifted, and following it would hold the pen
+// down until it is put down elsewhere, joining two strokes.
+bool beside_pen(const CameraWindow& w, size_t j, int b, double seen_t, const Vec2& pen_px) {
+  const CameraFrames& f = w.frames;
+  int blob = b;
+  size_t m = j;
+  while (blob >= 0 && m > 0 && f.t_frame_us[m] > seen_t) {
+    int from = -1;
+    for (int i = 0; i < f.blob_count[m - 1]; ++i)
+      if (w.links[m - 1][i] == blob) from = i;
+    blob = from;
+    --m;
+  }
+  if (blob < 0 || f.t_frame_us[m] > seen_t || f.blob_count[m] < 2) return false;
+  int nearest = 0;
+  for (int i = 1; i < f.blob_count[m]; ++i)
+    if ((f.blobs[m][i] - pen_px).norm() < (f.blobs[m][nearest] - pen_px).norm()) nearest = i;
+  return blob != nearest;
+}
+
+// The blobs of a camera's frame j that may be the pen: not one beside it.
 struct Candidates {
   std::array<Vec2, tracking::kIrSlots> px;
   int count = 0;
 };
 Candidates maybe_pen(const CameraWindow& w, size_t j, double seen_t, const Vec2& pen_px) {
-  const CameraFrames& f = w.frames;
   Candidates out;
-  for (int b = 0; b < f.blob_count[j]; ++b) {
-    int blob = b;
-    size_t m = j;
-    while (blob >= 0 && m > 0 && f.t_frame_us[m] > seen_t) {
-      int from = -1;
-      for (int i = 0; i < f.blob_count[m - 1]; ++i)
-        if (w.links[m - 1][i] == blob) from = i;
-      blob = from;
-      --m;
-    }
-    bool beside = false;
-    if (blob >= 0 && f.t_frame_us[m] <= seen_t && f.blob_count[m] > 1) {
-      int nearest = 0;
-      for (int i = 1; i < f.blob_count[m]; ++i)
-        if ((f.blobs[m][i] - pen_px).norm() < (f.blobs[m][nearest] - pen_px).norm()) nearest = i;
-      beside = blob != nearest;
-    }
-    if (!beside) out.px[size_t(out.count++)] = f.blobs[j][b];
-  }
+  for (int b = 0; b < w.frames.blob_count[j]; ++b)
+    if (!beside_pen(w, j, b, seen_t, pen_px)) out.px[size_t(out.count++)] = w.frames.blobs[j][b];
   return out;
 }
 
@@ -234,13 +235,22 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
   }
   ++s.counts.frames_seen_by_both;
   // Epipolar lines run along the baseline, so a stray blob level with the LED in the other camera also
-  // fits the geometry. While the pen is down the candidate nearest its last position wins; a stroke only
-  // starts from a frame where every fitting pair agrees.
+  // fits the geometry. While the pen is down and both cameras saw it last, a light beside it in either
+  // camera is not paired: once the pen leaves one camera's view, that reflection fits the other camera's
+  // pen centimetres deeper, and the stroke would end there. Of the rest, the fit nearest the pen's last
+  // position wins. A stroke only starts from a frame where every fitting pair agrees.
   std::array<tracking::Triangulation, tracking::kIrSlots * tracking::kIrSlots> fits;
   std::array<std::array<int, 2>, tracking::kIrSlots * tracking::kIrSlots> fit_blobs;
   int fit_count = 0;
+  const bool pen_pixels_current = s.down && s.last_seen_t == s.last_sample_t;
+  int tried = 0;
   for (int i = 0; i < f0.blob_count[k]; ++i)
     for (int j = 0; j < ip.count; ++j) {
+      if (pen_pixels_current &&
+          (beside_pen(s.cameras[0], k, i, s.last_seen_t, s.pen_px[0]) ||
+           beside_pen(w1, ip.frame, ip.source[size_t(j)], s.last_seen_t + s.time_offset_us, s.pen_px[1])))
+        continue;
+      ++tried;
       const tracking::Triangulation tri =
           tracking::triangulate(rig.cam0, rig.cam1, f0.blobs[k][i], ip.px[j], options.method, options.max_reprojection_px);
       if (!tri.accepted) continue;
@@ -248,7 +258,7 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
       fits[fit_count++] = tri;
     }
   if (fit_count == 0) {
-    ++s.counts.rejected_reprojection;
+    if (tried > 0) ++s.counts.rejected_reprojection;
     follow_one_camera();
     return;
   }
@@ -273,6 +283,22 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
       if ((fits[c].X - fits[best].X).norm() > kJumpGate_m) best = -1;
       if (best < 0) break;
       if (fits[c].reprojection_error_px < fits[best].reprojection_error_px) best = c;
+    }
+    // A light that appears in camera 1's later frame is not interpolated yet; the pen put down between
+    // the two frames is one, and then the reflection level with it is all camera 1 offers, and fits
+    // centimetres off. Such a light that fits elsewhere makes the start wait for the next frame.
+    if (best >= 0 && ip.frame + 1 < f1.size()) {
+      const size_t later = ip.frame + 1;
+      for (int b = 0; b < f1.blob_count[later] && best >= 0; ++b) {
+        bool continues = false;
+        for (int i = 0; i < f1.blob_count[ip.frame]; ++i) continues |= w1.links[ip.frame][i] == b;
+        if (continues) continue;
+        for (int i = 0; i < f0.blob_count[k] && best >= 0; ++i) {
+          const tracking::Triangulation tri = tracking::triangulate(rig.cam0, rig.cam1, f0.blobs[k][i], f1.blobs[later][b],
+                                                                    options.method, options.max_reprojection_px);
+          if (tri.accepted && (tri.X - fits[best].X).norm() > kJumpGate_m) best = -1;
+        }
+      }
     }
     if (best < 0) {
       ++s.counts.ambiguous;

@@ -190,6 +190,52 @@ TEST_CASE("a lifted pen is not held down by a reflection one camera sees near wh
   }
 }
 
+TEST_CASE("a reflection level with the pen in camera 1 is not paired with camera 0's pen as it lights or goes out") {
+  const Rig rig;
+  // A reflection on the pen's epipolar line in camera 1, 4 % farther along camera 0's ray (3 cm deeper,
+  // about 33 px from the pen): camera 0's pen fits it within the distance a hand moves the pen in a frame.
+  auto reflection = [&](double t) {
+    return rig.c1.project(rig.c0.centre() + 1.04 * (pen_path(t) - rig.c0.centre()));
+  };
+  SECTION("the pen goes out between camera 1's exposure and camera 0's: the stroke ends where it was") {
+    // Lit until 0.992 s: camera 0's frame at 0.990 s still sees it, camera 1's at 0.995 s only the reflection.
+    auto lit = [](double t) { return t < 0.992; };
+    DeviceStreams s;
+    for (double t = 0.0; t < 1.6; t += 0.010)
+      if (lit(t)) push_frame(s.cameras[0], t * 1e6, {rig.c0.project(pen_path(t))});
+      else push_frame(s.cameras[0], t * 1e6, {});
+    for (double t = 0.005; t < 1.6; t += 0.010) {
+      if (t < 0.3) push_frame(s.cameras[1], t * 1e6, {rig.c1.project(pen_path(t))});
+      else if (lit(t)) push_frame(s.cameras[1], t * 1e6, {rig.c1.project(pen_path(t)), reflection(t)});
+      else push_frame(s.cameras[1], t * 1e6, {reflection(t)});
+    }
+    const PenTrack track = run_system(s, rig, 0.0);
+    CHECK(track.strokes == 1);
+    REQUIRE(track.samples.size() > 90);
+    for (const PenSample& p : track.samples)
+      CHECK((p.raw - pen_path(static_cast<double>(p.t_us) * 1e-6)).norm() < 1e-4);
+  }
+  SECTION("the pen lights between camera 1's exposure and camera 0's: the stroke waits until one point fits") {
+    // Lit from 0.048 s: camera 0's frame at 0.050 s sees it, camera 1's at 0.045 s only the reflection,
+    // which shines until 0.1 s.
+    DeviceStreams s;
+    for (double t = 0.0; t < 1.0; t += 0.010)
+      if (t >= 0.048) push_frame(s.cameras[0], t * 1e6, {rig.c0.project(pen_path(t))});
+      else push_frame(s.cameras[0], t * 1e6, {});
+    for (double t = 0.005; t < 1.0; t += 0.010) {
+      if (t < 0.048) push_frame(s.cameras[1], t * 1e6, {reflection(t)});
+      else if (t < 0.1) push_frame(s.cameras[1], t * 1e6, {reflection(t), rig.c1.project(pen_path(t))});
+      else push_frame(s.cameras[1], t * 1e6, {rig.c1.project(pen_path(t))});
+    }
+    const PenTrack track = run_system(s, rig, 0.0);
+    CHECK(track.strokes == 1);
+    CHECK(track.ambiguous >= 5);
+    REQUIRE(track.samples.size() > 80);
+    for (const PenSample& p : track.samples)
+      CHECK((p.raw - pen_path(static_cast<double>(p.t_us) * 1e-6)).norm() < 1e-4);
+  }
+}
+
 TEST_CASE("the system's own pen events are the strokes of its samples, and it is causal") {
   const Rig rig;
   DeviceStreams s;
