@@ -52,12 +52,14 @@ Result<std::unique_ptr<World>> world_for_log(const std::string& path, const std:
   return world;
 }
 
-// The network of a .fnet file, or the one an input log draws when replayed headless.
+// The network of a .fnet file, or the one an input log draws when replayed headless. Without the surface
+// systems: the surface is reconstructed from the network afterwards (and --every replays with them).
 Result<Mesh> load_input(const std::string& path, const std::string& rig_path) {
   if (ends_with(path, ".fnet")) return load_network(path);
   auto loaded = world_for_log(path, rig_path);
   if (!loaded) return Result<Mesh>::failure(loaded.error());
   std::unique_ptr<World> world = std::move(*loaded);
+  world->build_surface = false;
   Scheduler scheduler = make_scheduler(*world, monotonic_ns);
   replay_headless(*world, scheduler);
   for (const Rejection& r : world->rejections) std::cerr << path << ":" << r.line << ": rejected: " << r.reason << "\n";
