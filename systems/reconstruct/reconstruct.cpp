@@ -130,7 +130,10 @@ double noise_estimate(const Mesh& net) {
 double fit_fairness(const Options& options, double noise) {
   if (!options.fairness_from_noise || !(noise > kExactCurveNoise)) return options.fairness;
   const double ratio = noise / kExactCurveNoise;
-  return std::max(options.fairness, std::min(options.fairness * ratio * ratio, kNoisyFairness));
+  const double fairness = std::max(options.fairness, std::min(options.fairness * ratio * ratio, kNoisyFairness));
+  if (!(noise > kNoisierCurves)) return fairness;
+  const double beyond = noise / kNoisierCurves;
+  return std::clamp(kNoisyFairness * beyond * beyond, fairness, kNoisiestFairness);
 }
 
 double worst_quad_aspect(const BaseMesh& base) {

@@ -131,6 +131,10 @@ TEST_CASE("a noisy network's fit follows its noise, and a move that changes the 
   Options explicit_weight;
   explicit_weight.fairness_from_noise = false;
   CHECK(fit_fairness(explicit_weight, noise) == explicit_weight.fairness);
+  // Noisier curves than the plateau's: the fairness grows on from it, with the square of the noise.
+  CHECK(fit_fairness(options, kNoisierCurves) == kNoisyFairness);
+  CHECK(fit_fairness(options, 2 * kNoisierCurves) == Approx(4 * kNoisyFairness));
+  CHECK(fit_fairness(options, 10 * kNoisierCurves) == kNoisiestFairness);
 
   ReconstructionState state;
   SurfaceMesh surface;

@@ -81,7 +81,7 @@ void add_reconstruct_commands(CLI::App& app, Registry& registry) {
       "worst_quad_aspect (the base mesh's worst quad: longest side squared over area, 1 for a square), "
       "noise_estimate (the polylines' noise from their samples' third differences, a fraction of their mean "
       "length) and fairness (the fit's weight: --fairness if given, else the default for exact curves raised "
-      "with the noise estimate up to 0.1).");
+      "with the noise estimate: 0.1 from 3e-3 to 1.3e-2, beyond with its square, up to 1).");
   cmd->add_option("NET", a->network_path, "curve network file (format: engine/NETWORK_FORMAT.md)")->required();
   cmd->add_option("-o,--output", a->out_path, "surface file to write: .obj, .ply, .stl or .glb")->required();
   cmd->add_option("--method", a->method, "thesis or fire")->capture_default_str();
@@ -90,7 +90,8 @@ void add_reconstruct_commands(CLI::App& app, Registry& registry) {
   cmd->add_option("--fairness", a->fairness,
                   "fire: weight of the fit's smoothness term, 0 to 1 (smaller follows the curves more closely, larger "
                   "keeps face interiors smoother). Default: this for exact curves, raised with the noise the "
-                  "polylines show up to 0.1; given, it is used as is")
+                  "polylines show (0.1 for a noise estimate of 3e-3 to 1.3e-2, beyond with its square, up to 1); given, it "
+                  "is used as is")
       ->capture_default_str();
   cmd->add_option("--planarity", a->planarity,
                   "the thesis triquadrification's measure: least-squares, mean-normal or hough")
