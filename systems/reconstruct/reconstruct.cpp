@@ -6,6 +6,7 @@
 #include <numbers>
 #include <string>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include "systems/reconstruct/fit.hpp"
@@ -125,6 +126,52 @@ double noise_estimate(const Mesh& net) {
   // Independent noise of deviation s per coordinate: a third difference's squared norm is 20 s^2 times a
   // chi-square of 3 degrees of freedom, whose median is 2.366.
   return std::sqrt(*middle / (20 * 2.366)) / (length / lines);
+}
+
+double tangent_spread_deg(const Mesh& net) {
+  // Per vertex: the sum of t t^T over the unit tangents of the curves leaving it, their count, and
+  // whether a crease meets there (its curves need not share a plane).
+  std::vector<Eigen::Matrix3d> moments(net.vertex_slots(), Eigen::Matrix3d::Zero());
+  std::vector<uint32_t> counts(net.vertex_slots(), 0);
+  std::vector<bool> crease(net.vertex_slots(), false);
+  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+    if (!net.edge_alive(e) || !used_by_face(net, e)) continue;
+    const auto line = net.polyline(e);
+    for (int end = 0; end < 2; ++end) {
+      const uint32_t v = net.edges.vertex[e][end];
+      if (net.edges.flags[e] & kSharpEdge) crease[v] = true;
+      if (line.size() < 3) continue;
+      // The derivative at the end of the parabola through its first three samples: a chord's direction
+      // is off by half the angle the curve turns over it, which on exact curves is what this measures.
+      const size_t n = line.size() - 1;
+      const Vec3& p0 = end == 0 ? line[0] : line[n];
+      const Vec3& p1 = end == 0 ? line[1] : line[n - 1];
+      const Vec3& p2 = end == 0 ? line[2] : line[n - 2];
+      const double s1 = (p1 - p0).norm(), s2 = s1 + (p2 - p1).norm();
+      if (!(s1 > 0) || !(s2 > s1)) continue;
+      const Vec3 d = p0 * (-(s1 + s2) / (s1 * s2)) + p1 * (s2 / (s1 * (s2 - s1))) - p2 * (s1 / (s2 * (s2 - s1)));
+      if (!(d.norm() > 0)) continue;
+      const Vec3 t = d.normalized();
+      moments[v] += t * t.transpose();
+      ++counts[v];
+    }
+  }
+  std::vector<double> spread;
+  for (uint32_t v = 0; v < net.vertex_slots(); ++v) {
+    if (!net.vertex_alive(v) || crease[v] || counts[v] < 3) continue;
+    const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(moments[v], Eigen::EigenvaluesOnly).eigenvalues()(0);
+    spread.push_back(std::asin(std::sqrt(std::clamp(smallest / counts[v], 0.0, 1.0))) * 180.0 / std::numbers::pi);
+  }
+  if (spread.size() < kSpreadVertices) return 0;
+  auto middle = spread.begin() + std::ptrdiff_t(spread.size() / 2);
+  std::nth_element(spread.begin(), middle, spread.end());
+  return *middle;
+}
+
+double fit_noise(const Mesh& net) {
+  const double noise = noise_estimate(net);
+  if (noise > kExactCurveNoise || !(tangent_spread_deg(net) > kDisagreeingTangentsDeg)) return noise;
+  return kExactCurveNoise * std::sqrt(kNoisyFairness / Options{}.fairness);
 }
 
 double fit_fairness(const Options& options, double noise) {
@@ -378,7 +425,7 @@ Result<bool> run_refine(const Mesh& net, const Options& options, ReconstructionC
   c.base = assemble(net, options, c);
   c.rebuild_topology = c.rebuild_topology || everything || !same_topology(c, c.base);
   if (options.method == Method::fire) {
-    c.noise = options.fairness_from_noise ? noise_estimate(net) : 0;
+    c.noise = options.fairness_from_noise ? fit_noise(net) : 0;
     const FitWeights weights = fit_weights(options, c.noise);
     if (c.fit_built && (weights.fairness != c.fit_fairness || shape_weights(c.base, weights) != c.fit_shape))
       c.fit_built = false;

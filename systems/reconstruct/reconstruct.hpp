@@ -103,6 +103,20 @@ inline constexpr size_t kNoiseSamples = 10;
 double noise_estimate(const Mesh& net);
 // Noise estimates at or below this are exact curves (sampled limit curves give 2e-5 to 3e-4).
 inline constexpr double kExactCurveNoise = 3e-4;
+// How far out of one plane the curves leaving a network vertex start, in degrees: the median over the
+// vertices where three or more curves with at least three samples meet and no crease does (the curves'
+// directions from a parabola through each one's first three samples). Curves of one smooth surface share
+// its tangent plane; noise that is smooth along each curve (a tracked pen's) tilts them apart, which the
+// third differences of noise_estimate cannot see. 0 when fewer than kSpreadVertices vertices count.
+inline constexpr size_t kSpreadVertices = 4;
+double tangent_spread_deg(const Mesh& net);
+// Over this, curves that noise_estimate finds exact are not: the quality table's exact networks give at
+// most 0.6 degrees, its correlated-noise ones 3.8 or more (perf/RESULTS.md).
+inline constexpr double kDisagreeingTangentsDeg = 2.0;
+// The noise the fit's fairness follows: noise_estimate, except for curves it finds exact whose tangents
+// disagree (tangent_spread_deg over kDisagreeingTangentsDeg), which count as noisy as the noise at which
+// the fairness reaches kNoisyFairness.
+double fit_noise(const Mesh& net);
 // The fairness noisy curves reach, and keep up to kNoisierCurves: on pawn, rook and torus at 1 to 4 % noise
 // and on the simulated tracked drawing it gives fewer folds and a smaller rms and hausdorff than 1e-3 or
 // 1e-2 (perf/RESULTS.md).

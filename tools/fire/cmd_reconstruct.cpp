@@ -60,9 +60,9 @@ int run_reconstruct(const ReconstructArgs& a) {
   out["vertices"] = surface.positions.size();
   out["seconds"] = seconds;
   out["worst_quad_aspect"] = reconstruct::worst_quad_aspect(state.base());
-  const double noise = reconstruct::noise_estimate(*net);
-  out["noise_estimate"] = noise;
-  out["fairness"] = reconstruct::fit_fairness(options, noise);
+  out["noise_estimate"] = reconstruct::noise_estimate(*net);
+  out["tangent_spread_deg"] = reconstruct::tangent_spread_deg(*net);
+  out["fairness"] = reconstruct::fit_fairness(options, reconstruct::fit_noise(*net));
   std::cout << out.dump() << "\n";
   return 0;
 }
@@ -80,8 +80,10 @@ void add_reconstruct_commands(CLI::App& app, Registry& registry) {
       "JSON line: method, coons_steps, levels, base_faces, faces, vertices, seconds (reconstruction only, no I/O) "
       "worst_quad_aspect (the base mesh's worst quad: longest side squared over area, 1 for a square), "
       "noise_estimate (the polylines' noise from their samples' third differences, a fraction of their mean "
-      "length) and fairness (the fit's weight: --fairness if given, else the default for exact curves raised "
-      "with the noise estimate: 0.1 from 3e-3 to 1.3e-2, beyond with its square, up to 1).");
+      "length), tangent_spread_deg (the median angle by which the curves leaving a vertex lie out of one plane: "
+      "over 2, curves with a noise estimate under 3e-4 count as noisy as 3e-3) and fairness (the fit's weight: "
+      "--fairness if given, else the default for exact curves raised with the noise estimate: 0.1 from 3e-3 to "
+      "1.3e-2, beyond with its square, up to 1).");
   cmd->add_option("NET", a->network_path, "curve network file (format: engine/NETWORK_FORMAT.md)")->required();
   cmd->add_option("-o,--output", a->out_path, "surface file to write: .obj, .ply, .stl or .glb")->required();
   cmd->add_option("--method", a->method, "thesis or fire")->capture_default_str();
