@@ -180,7 +180,7 @@ double fit_fairness(const Options& options, double noise) {
   const double fairness = std::max(options.fairness, std::min(options.fairness * ratio * ratio, kNoisyFairness));
   if (!(noise > kNoisierCurves)) return fairness;
   const double beyond = noise / kNoisierCurves;
-  return std::clamp(kNoisyFairness * beyond * beyond, fairness, kNoisiestFairness);
+  return std::max(fairness, std::min(kNoisyFairness * beyond * beyond, kNoisiestFairness));
 }
 
 double worst_quad_aspect(const BaseMesh& base) {
