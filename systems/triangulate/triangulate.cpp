@@ -243,13 +243,16 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
   std::array<std::array<int, 2>, tracking::kIrSlots * tracking::kIrSlots> fit_blobs;
   int fit_count = 0;
   const bool pen_pixels_current = s.down && s.last_seen_t == s.last_sample_t;
+  std::array<bool, tracking::kIrSlots> beside0{}, beside1{};
+  if (pen_pixels_current) {
+    for (int i = 0; i < f0.blob_count[k]; ++i) beside0[size_t(i)] = beside_pen(s.cameras[0], k, i, s.last_seen_t, s.pen_px[0]);
+    for (int j = 0; j < ip.count; ++j)
+      beside1[size_t(j)] = beside_pen(w1, ip.frame, ip.source[size_t(j)], s.last_seen_t + s.time_offset_us, s.pen_px[1]);
+  }
   int tried = 0;
   for (int i = 0; i < f0.blob_count[k]; ++i)
     for (int j = 0; j < ip.count; ++j) {
-      if (pen_pixels_current &&
-          (beside_pen(s.cameras[0], k, i, s.last_seen_t, s.pen_px[0]) ||
-           beside_pen(w1, ip.frame, ip.source[size_t(j)], s.last_seen_t + s.time_offset_us, s.pen_px[1])))
-        continue;
+      if (beside0[size_t(i)] || beside1[size_t(j)]) continue;
       ++tried;
       const tracking::Triangulation tri =
           tracking::triangulate(rig.cam0, rig.cam1, f0.blobs[k][i], ip.px[j], options.method, options.max_reprojection_px);
