@@ -45,6 +45,8 @@ struct ReconstructionCache {
   std::vector<double> fit_shape;
   double fit_fairness = 0;  // the fairness it was built with (fit_fairness of the network's noise)
   double noise = 0;         // noise_estimate of the network at the last refine (fire)
+  double mean_length = 0;   // mean_curve_length of the network at the last refine (fire)
+  std::vector<double> fit_curve_weights;  // curve_weights it was built with
   bool fit_waiting = false;
   // The fit of `base` in progress (fire), between the frame that took the base and the one it ends in.
   // Reset before `base` or `fit` is replaced; declared after `fit`, so destroyed before it.
@@ -65,6 +67,19 @@ namespace {
 
 bool used_by_face(const Mesh& net, uint32_t e) {
   return net.edges.face[e][0] != kNone || net.edges.face[e][1] != kNone;
+}
+
+// The mean length of the polylines that bound a face: the scale of noise_estimate.
+double mean_curve_length(const Mesh& net) {
+  double length = 0;
+  uint32_t lines = 0;
+  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+    if (!net.edge_alive(e) || !used_by_face(net, e)) continue;
+    const auto line = net.polyline(e);
+    for (size_t i = 1; i < line.size(); ++i) length += (line[i] - line[i - 1]).norm();
+    ++lines;
+  }
+  return lines ? length / lines : 0.0;
 }
 
 // The unit direction in which edge e leaves its end v, from v to the polyline's point a fraction
@@ -108,24 +123,21 @@ double quad_aspect(const BaseMesh& base, uint32_t face) {
 
 double noise_estimate(const Mesh& net) {
   std::vector<double> cubed;  // squared third differences of the samples
-  double length = 0;
-  uint32_t lines = 0;
   for (uint32_t e = 0; e < net.edge_slots(); ++e) {
     if (!net.edge_alive(e) || !used_by_face(net, e)) continue;
     const auto line = net.polyline(e);
-    for (size_t i = 1; i < line.size(); ++i) length += (line[i] - line[i - 1]).norm();
-    ++lines;
     // On a few samples the curve's own shape dominates the differences.
     if (line.size() < kNoiseSamples) continue;
     for (size_t i = 3; i < line.size(); ++i)
       cubed.push_back((line[i] - 3 * line[i - 1] + 3 * line[i - 2] - line[i - 3]).squaredNorm());
   }
+  const double length = mean_curve_length(net);
   if (cubed.empty() || !(length > 0)) return 0;
   auto middle = cubed.begin() + std::ptrdiff_t(cubed.size() / 2);
   std::nth_element(cubed.begin(), middle, cubed.end());
   // Independent noise of deviation s per coordinate: a third difference's squared norm is 20 s^2 times a
   // chi-square of 3 degrees of freedom, whose median is 2.366.
-  return std::sqrt(*middle / (20 * 2.366)) / (length / lines);
+  return std::sqrt(*middle / (20 * 2.366)) / length;
 }
 
 double tangent_spread_deg(const Mesh& net) {
@@ -386,23 +398,26 @@ Status rebuild_topology(const Options& options, ReconstructionCache& c) {
 }
 
 // The shape term comes with the noise too: exact curves are followed as drawn (it would cost the rook's
-// exact network its rms goal), noisy hand-drawn ones keep their thin quads' transfinite shape.
-FitWeights fit_weights(const Options& options, double noise) {
+// exact network its rms goal), noisy hand-drawn ones keep their thin quads' transfinite shape. So does the
+// lighter weight of curves as short as a few times the noise (`noise` is relative to `mean_length`).
+FitWeights fit_weights(const Options& options, double noise, double mean_length) {
   FitWeights weights;
   weights.fairness = fit_fairness(options, noise);
   const double noisy = (weights.fairness - options.fairness) / (kNoisyFairness - options.fairness);
   weights.shape = kNoisyFairness > options.fairness ? weights.shape * std::clamp(noisy, 0.0, 1.0) : 0;
+  if (options.fairness_from_noise && noise > kExactCurveNoise) weights.short_curve = kShortCurveNoises * noise * mean_length;
   return weights;
 }
 
 Status build_fit(const Options& options, ReconstructionCache& c) {
-  const FitWeights weights = fit_weights(options, c.noise);
+  const FitWeights weights = fit_weights(options, c.noise, c.mean_length);
   auto fit = LimitFit::build(c.refinement, c.limit, c.base, weights);
   if (!fit) return Status::failure(fit.error());
   c.run = {};
   c.fit = std::move(*fit);
   c.fit_built = true;
   c.fit_shape = shape_weights(c.base, weights);
+  c.fit_curve_weights = curve_weights(c.base, weights);
   c.fit_fairness = weights.fairness;
   return Status::success();
 }
@@ -426,8 +441,10 @@ Result<bool> run_refine(const Mesh& net, const Options& options, ReconstructionC
   c.rebuild_topology = c.rebuild_topology || everything || !same_topology(c, c.base);
   if (options.method == Method::fire) {
     c.noise = options.fairness_from_noise ? fit_noise(net) : 0;
-    const FitWeights weights = fit_weights(options, c.noise);
-    if (c.fit_built && (weights.fairness != c.fit_fairness || shape_weights(c.base, weights) != c.fit_shape))
+    c.mean_length = mean_curve_length(net);
+    const FitWeights weights = fit_weights(options, c.noise, c.mean_length);
+    if (c.fit_built && (weights.fairness != c.fit_fairness || shape_weights(c.base, weights) != c.fit_shape ||
+                        curve_weights(c.base, weights) != c.fit_curve_weights))
       c.fit_built = false;
   }
   c.pending_subdivide = true;

@@ -131,6 +131,10 @@ inline constexpr double kNoisiestFairness = 1.0;  // the top of --fairness's ran
 // curves, growing with the square of the noise above kExactCurveNoise up to kNoisyFairness, and again
 // above kNoisierCurves up to kNoisiestFairness.
 double fit_fairness(const Options& options, double noise);
+// A noisy curve reaching less far than this many noise deviations (fit_noise times the mean polyline
+// length) from its ends weighs less in the fit (FitWeights::short_curve): the rook's noisy folds were
+// nearly all at its 1.3 mm hole, whose curves are as short as 1 to 4 % noise (perf/RESULTS.md).
+inline constexpr double kShortCurveNoises = 16;
 // The same measure for one base face, which must be a quad.
 double quad_aspect(const BaseMesh& base, uint32_t face);
 

@@ -1,6 +1,7 @@
 // Incremental reconstruction: an edit recomputes only the faces it touched and their neighbours, and
 // the result equals a reconstruction from scratch bit for bit.
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -146,6 +147,61 @@ TEST_CASE("a noisy network's fit follows its noise, and a move that changes the 
   CHECK(fit_fairness(options, noise_estimate(net)) != fit_fairness(options, noise));
   update(net, options, state, surface);
   CHECK_FALSE(state.last_update().topology_rebuilt);
+  check_equals_full_rebuild(net, options, surface);
+}
+
+TEST_CASE("a noisy curve as short as its noise weighs less, and a change of that weight refactorizes, equal to a rebuild",
+          "[reconstruct][incremental][noise]") {
+  auto noisy = [](double x, double y) { return height(x, y) + 0.03 * std::sin(97 * x + 53 * y); };
+  // The grid's fourth column of faces squeezed to 1/20 of its width: its 5 horizontal curves are 0.05 wide,
+  // and 2 of them also end level (the other 3 climb 0.09 to 0.12, more than 16 noise deviations).
+  auto squeeze = [](Vec3 p) {
+    p.x() = p.x() <= 3 ? p.x() * 3.95 / 3 : p.x() <= 4 ? 3.95 + (p.x() - 3) * 0.05 : p.x();
+    return p;
+  };
+  Mesh net = grid_network(6, 4, 20, noisy);
+  for (uint32_t v = 0; v < net.vertex_slots(); ++v) net.vertices.position.set(v, squeeze(net.vertices.position[v]));
+  for (uint32_t i = 0; i < uint32_t(net.points.size()); ++i) net.points.set(i, squeeze(net.points[i]));
+  const Options options;
+  const double noise = fit_noise(net);
+  REQUIRE(noise > kExactCurveNoise);
+  REQUIRE(fit_fairness(options, noise) == kNoisyFairness);
+  auto weights_of = [&](const Mesh& m, const BaseMesh& base) {
+    double length = 0;
+    uint32_t lines = 0;
+    for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+      if (!m.edge_alive(e)) continue;
+      for (size_t i = 1; i < m.polyline(e).size(); ++i) length += (m.polyline(e)[i] - m.polyline(e)[i - 1]).norm();
+      ++lines;
+    }
+    FitWeights w;
+    w.short_curve = kShortCurveNoises * fit_noise(m) * length / lines;
+    return curve_weights(base, w);
+  };
+
+  ReconstructionState state;
+  SurfaceMesh surface;
+  update(net, options, state, surface);
+  check_equals_full_rebuild(net, options, surface);
+  // Exact curves (no short_curve) all weigh 1; here the short curves alone weigh less.
+  const std::vector<double> plain = curve_weights(state.base(), FitWeights{});
+  CHECK(plain.size() == net.edge_count());
+  CHECK(std::all_of(plain.begin(), plain.end(), [](double w) { return w == 1; }));
+  const std::vector<double> before = weights_of(net, state.base());
+  REQUIRE(before.size() == plain.size());
+  CHECK(std::count_if(before.begin(), before.end(), [](double w) { return w < 1; }) == 2);
+  CHECK(*std::min_element(before.begin(), before.end()) > 0);
+
+  // A vertex far from it raised: the curves' mean length, and with it the short curve's weight, change;
+  // the fairness (on its plateau) and the thin quads' shape weights do not. The fit is factorized again.
+  const uint32_t far = 3 * 7 + 5;
+  const std::vector<double> shape = shape_weights(state.base(), FitWeights{});
+  net.move_vertex(far, net.vertices.position[far] + Vec3(0, 0, 0.3));
+  update(net, options, state, surface);
+  CHECK_FALSE(state.last_update().topology_rebuilt);
+  REQUIRE(fit_fairness(options, fit_noise(net)) == kNoisyFairness);
+  REQUIRE(shape_weights(state.base(), FitWeights{}) == shape);
+  REQUIRE(weights_of(net, state.base()) != before);
   check_equals_full_rebuild(net, options, surface);
 }
 
