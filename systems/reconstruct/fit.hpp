@@ -63,7 +63,7 @@ struct FitWeights {
   double shape_aspect = 3;
   // A noisy curve that reaches less far from its ends than this (a length; 0: no curve is short) carries
   // little shape but as many rows as a long one, and where it is as short as the noise its samples cross
-  // its neighbours' (the rook's 1.3 mm hole): its inner rows are weighted (reach / short_curve)^2.
+  // its neighbours' (the hole in the rook's bottom): its inner rows are weighted (reach / short_curve)^2.
   // The reconstruction sets it from the noise (kShortCurveNoises), none for exact curves.
   double short_curve = 0;
   uint32_t slide_iterations = 10;  // solves of phase 1

@@ -62,6 +62,10 @@ ReconstructionState& ReconstructionState::operator=(ReconstructionState&&) noexc
 const UpdateStats& ReconstructionState::last_update() const { return cache_->stats; }
 const BaseMesh& ReconstructionState::base() const { return cache_->base; }
 bool ReconstructionState::fitting() const { return cache_->fit_waiting || cache_->run.running(); }
+uint32_t ReconstructionState::short_curves() const {
+  const std::vector<double>& w = cache_->fit_curve_weights;
+  return static_cast<uint32_t>(std::count_if(w.begin(), w.end(), [](double x) { return x < 1; }));
+}
 
 namespace {
 

@@ -159,6 +159,8 @@ class ReconstructionState {
   const UpdateStats& last_update() const;
   const BaseMesh& base() const;  // the base mesh of the last successful update
   bool fitting() const;          // a fit runs over the next subdivide_update calls
+  // fire: how many curves the current fit weighs less as short noisy ones (FitWeights::short_curve).
+  uint32_t short_curves() const;
   ReconstructionCache& cache() { return *cache_; }
 
  private:
