@@ -98,8 +98,8 @@ Vec3 leaving_direction(const Mesh& net, uint32_t e, uint32_t v) {
 }
 
 // A border network vertex is a corner of the surface where the border turns by more than
-// kBorderCornerTurnDegrees; where it goes straight on it is a smooth point of the border.
-bool border_corner(const Mesh& net, uint32_t v) {
+// `threshold_deg`; where it goes straight on it is a smooth point of the border.
+bool border_corner(const Mesh& net, uint32_t v, double threshold_deg) {
   uint32_t border[2], count = 0;
   for (uint32_t e : net.vertex_edges(v))
     if (used_by_face(net, e) && net.is_border_edge(e)) {
@@ -109,7 +109,7 @@ bool border_corner(const Mesh& net, uint32_t v) {
   if (count != 2) return true;
   const double cosine = leaving_direction(net, border[0], v).dot(leaving_direction(net, border[1], v));
   const double turn = 180.0 - std::acos(std::clamp(cosine, -1.0, 1.0)) * 180.0 / std::numbers::pi;
-  return !(turn <= kBorderCornerTurnDegrees);
+  return !(turn <= threshold_deg);
 }
 
 
@@ -289,6 +289,10 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
 // Global numbering, in slot order: network vertices used by faces, then the split points of each edge,
 // then the vertices made inside each face.
 BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionCache& c) {
+  // Noise turns a curve's first stretch too: a border turn within the spread of the curves' directions
+  // where they meet is the noise's, not a corner (the pawn's border at 4 % correlated noise).
+  const double corner_turn =
+      kBorderCornerTurnDegrees + (options.method == Method::fire ? tangent_spread_deg(net) : 0.0);
   BaseMesh base;
   const uint32_t pieces = 1u << options.coons_steps;
   base.pieces_per_edge = pieces;
@@ -302,7 +306,7 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
       vertex_id[v] = base.vertex_count();
       base.positions.push_back(net.vertices.position[v]);
       base.vertex_drawn.push_back(1);
-      if (options.method == Method::fire) base.border_corners.push_back(border_corner(net, v) ? 1 : 0);
+      if (options.method == Method::fire) base.border_corners.push_back(border_corner(net, v, corner_turn) ? 1 : 0);
     }
   for (uint32_t e = 0; e < net.edge_slots(); ++e) {
     if (!c.edge_valid[e]) continue;

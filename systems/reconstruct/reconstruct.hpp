@@ -33,9 +33,10 @@ namespace fire::reconstruct {
 
 inline constexpr uint32_t kMaxCoonsSteps = 5;
 // fire: a border vertex of the network is a corner of the surface only where the border turns by more
-// than this many degrees, the turn measured between the directions in which its two border curves leave
-// it, each towards its point kTangentReach of the curve's length away. Elsewhere the border runs
-// smoothly through it (thesis: a vertex where a curve merely goes on is no corner).
+// than this many degrees plus the network's tangent_spread_deg (noise turns the curves' first stretches
+// too), the turn measured between the directions in which its two border curves leave it, each towards
+// its point kTangentReach of the curve's length away. Elsewhere the border runs smoothly through it
+// (thesis: a vertex where a curve merely goes on is no corner).
 inline constexpr double kBorderCornerTurnDegrees = 30.0;
 inline constexpr double kTangentReach = 0.15;
 // Surface levels the options allow (the Catmull-Clark library itself refines further).

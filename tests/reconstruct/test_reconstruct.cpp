@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "networks.hpp"
 #include "systems/reconstruct/fit.hpp"
@@ -134,6 +135,39 @@ TEST_CASE("FIRE: a border vertex is a corner only where the border turns", "[rec
   for (uint8_t flag : d.border_corners) CHECK(flag == 0);
   // The thesis pipeline keeps Catmull-Clark's own rule.
   CHECK(base_of(disk, {Method::thesis, 1, 2, Planarity::least_squares}).border_corners.empty());
+}
+
+TEST_CASE("FIRE: a border turn no larger than the noise's own turning is no corner", "[reconstruct][fire][noise]") {
+  // A 4 x 2 grid whose bottom border is bent at its middle vertex by 31 degrees, more than the 30 of an exact
+  // network, the top border straight.
+  const double dip = 2 * std::tan(15.5 * std::numbers::pi / 180);
+  Mesh net = grid_network(4, 2, 17, [](double x, double y) { return 0.05 * x * y; });
+  auto bend = [&](Vec3 p) {
+    p.y() -= dip * (1 - std::abs(p.x() - 2) / 2) * (1 - p.y() / 2);
+    return p;
+  };
+  for (uint32_t v = 0; v < net.vertex_slots(); ++v) net.vertices.position.set(v, bend(net.vertices.position[v]));
+  for (uint32_t i = 0; i < uint32_t(net.points.size()); ++i) net.points.set(i, bend(net.points[i]));
+  const Vec3 kink(2, -dip, 0);
+  auto kink_is_corner = [&](const Mesh& m) {
+    const BaseMesh b = base_of(m, {Method::fire, 1, 2, Planarity::least_squares});
+    for (uint32_t v = 0; v < b.vertex_count(); ++v)
+      if ((b.positions[v] - kink).norm() < 1e-9) return b.border_corners[v] != 0;
+    FAIL("no base vertex at the kink");
+    return false;
+  };
+  CHECK(tangent_spread_deg(net) < 0.5);
+  CHECK(kink_is_corner(net));
+  // Every curve bowed up by a smooth bump, as a tracked pen errs along a stroke: the curves now leave their
+  // vertices 4.4 degrees out of one plane (the median), and the kink, tilted up on both sides (a turn of
+  // about 32.4 degrees now), is within what that noise makes.
+  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+    const uint32_t first = net.edges.point_offset[e], count = net.edges.point_count[e];
+    for (uint32_t s = 1; s + 1 < count; ++s)
+      net.points.set(first + s, net.points[first + s] + Vec3(0, 0, 0.03 * std::sin(std::numbers::pi * s / (count - 1))));
+  }
+  CHECK(tangent_spread_deg(net) == Approx(4.4).margin(0.1));
+  CHECK_FALSE(kink_is_corner(net));
 }
 
 TEST_CASE("the worst base quad's aspect: 1 for a square, 1/w for a 1 x w rectangle", "[reconstruct]") {
