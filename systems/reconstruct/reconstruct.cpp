@@ -184,11 +184,12 @@ double tangent_spread_deg(const Mesh& net) {
   return *middle;
 }
 
-double fit_noise(const Mesh& net) {
-  const double noise = noise_estimate(net);
-  if (noise > kExactCurveNoise || !(tangent_spread_deg(net) > kDisagreeingTangentsDeg)) return noise;
+double fit_noise(double noise, double spread_deg) {
+  if (noise > kExactCurveNoise || !(spread_deg > kDisagreeingTangentsDeg)) return noise;
   return kExactCurveNoise * std::sqrt(kNoisyFairness / Options{}.fairness);
 }
+
+double fit_noise(const Mesh& net) { return fit_noise(noise_estimate(net), tangent_spread_deg(net)); }
 
 double fit_fairness(const Options& options, double noise) {
   if (!options.fairness_from_noise || !(noise > kExactCurveNoise)) return options.fairness;
@@ -287,12 +288,9 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
 }
 
 // Global numbering, in slot order: network vertices used by faces, then the split points of each edge,
-// then the vertices made inside each face.
-BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionCache& c) {
-  // Noise turns a curve's first stretch too: a border turn within the spread of the curves' directions
-  // where they meet is the noise's, not a corner (the pawn's border at 4 % correlated noise).
-  const double corner_turn =
-      kBorderCornerTurnDegrees + (options.method == Method::fire ? tangent_spread_deg(net) : 0.0);
+// then the vertices made inside each face. fire: border vertices turning by more than `corner_turn`
+// degrees are corners.
+BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionCache& c, double corner_turn) {
   BaseMesh base;
   const uint32_t pieces = 1u << options.coons_steps;
   base.pieces_per_edge = pieces;
@@ -445,10 +443,13 @@ Result<bool> run_refine(const Mesh& net, const Options& options, ReconstructionC
   c.options = options;
   c.run = {};  // a fit of the previous base mesh is abandoned; subdivide starts one from the new
   update_elements(net, options, c, everything);
-  c.base = assemble(net, options, c);
+  // Noise turns a curve's first stretch too: a border turn within the spread of the curves' directions
+  // where they meet is the noise's, not a corner (the pawn's border at 4 % correlated noise).
+  const double spread = options.method == Method::fire ? tangent_spread_deg(net) : 0.0;
+  c.base = assemble(net, options, c, kBorderCornerTurnDegrees + spread);
   c.rebuild_topology = c.rebuild_topology || everything || !same_topology(c, c.base);
   if (options.method == Method::fire) {
-    c.noise = options.fairness_from_noise ? fit_noise(net) : 0;
+    c.noise = options.fairness_from_noise ? fit_noise(noise_estimate(net), spread) : 0;
     c.mean_length = mean_curve_length(net);
     const FitWeights weights = fit_weights(options, c.noise, c.mean_length);
     if (c.fit_built && (weights.fairness != c.fit_fairness || shape_weights(c.base, weights) != c.fit_shape ||

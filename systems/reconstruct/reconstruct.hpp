@@ -118,6 +118,8 @@ inline constexpr double kDisagreeingTangentsDeg = 2.0;
 // disagree (tangent_spread_deg over kDisagreeingTangentsDeg), which count as noisy as the noise at which
 // the fairness reaches kNoisyFairness.
 double fit_noise(const Mesh& net);
+// The same from the two measures, where they are already known.
+double fit_noise(double noise, double spread_deg);
 // The fairness noisy curves reach, and keep up to kNoisierCurves: on pawn, rook and torus at 1 to 4 % noise
 // and on the simulated tracked drawing it gives fewer folds and a smaller rms and hausdorff than 1e-3 or
 // 1e-2 (perf/RESULTS.md).
