@@ -125,7 +125,10 @@ double quad_aspect(const BaseMesh& base, uint32_t face) {
   return area > 0 ? longest * longest / area : std::numeric_limits<double>::infinity();
 }
 
-double noise_estimate(const Mesh& net) {
+namespace {
+
+// noise_estimate for a network whose mean_curve_length is known.
+double noise_estimate(const Mesh& net, double mean_length) {
   std::vector<double> cubed;  // squared third differences of the samples
   for (uint32_t e = 0; e < net.edge_slots(); ++e) {
     if (!net.edge_alive(e) || !used_by_face(net, e)) continue;
@@ -135,14 +138,17 @@ double noise_estimate(const Mesh& net) {
     for (size_t i = 3; i < line.size(); ++i)
       cubed.push_back((line[i] - 3 * line[i - 1] + 3 * line[i - 2] - line[i - 3]).squaredNorm());
   }
-  const double length = mean_curve_length(net);
-  if (cubed.empty() || !(length > 0)) return 0;
+  if (cubed.empty() || !(mean_length > 0)) return 0;
   auto middle = cubed.begin() + std::ptrdiff_t(cubed.size() / 2);
   std::nth_element(cubed.begin(), middle, cubed.end());
   // Independent noise of deviation s per coordinate: a third difference's squared norm is 20 s^2 times a
   // chi-square of 3 degrees of freedom, whose median is 2.366.
-  return std::sqrt(*middle / (20 * 2.366)) / length;
+  return std::sqrt(*middle / (20 * 2.366)) / mean_length;
 }
+
+}  // namespace
+
+double noise_estimate(const Mesh& net) { return noise_estimate(net, mean_curve_length(net)); }
 
 double tangent_spread_deg(const Mesh& net) {
   // Per vertex: the sum of t t^T over the unit tangents of the curves leaving it, their count, and
@@ -449,8 +455,8 @@ Result<bool> run_refine(const Mesh& net, const Options& options, ReconstructionC
   c.base = assemble(net, options, c, kBorderCornerTurnDegrees + spread);
   c.rebuild_topology = c.rebuild_topology || everything || !same_topology(c, c.base);
   if (options.method == Method::fire) {
-    c.noise = options.fairness_from_noise ? fit_noise(noise_estimate(net), spread) : 0;
     c.mean_length = mean_curve_length(net);
+    c.noise = options.fairness_from_noise ? fit_noise(noise_estimate(net, c.mean_length), spread) : 0;
     const FitWeights weights = fit_weights(options, c.noise, c.mean_length);
     if (c.fit_built && (weights.fairness != c.fit_fairness || shape_weights(c.base, weights) != c.fit_shape ||
                         curve_weights(c.base, weights) != c.fit_curve_weights))

@@ -60,9 +60,10 @@ int run_reconstruct(const ReconstructArgs& a) {
   out["vertices"] = surface.positions.size();
   out["seconds"] = seconds;
   out["worst_quad_aspect"] = reconstruct::worst_quad_aspect(state.base());
-  out["noise_estimate"] = reconstruct::noise_estimate(*net);
-  out["tangent_spread_deg"] = reconstruct::tangent_spread_deg(*net);
-  out["fairness"] = reconstruct::fit_fairness(options, reconstruct::fit_noise(*net));
+  const double noise = reconstruct::noise_estimate(*net), spread = reconstruct::tangent_spread_deg(*net);
+  out["noise_estimate"] = noise;
+  out["tangent_spread_deg"] = spread;
+  out["fairness"] = reconstruct::fit_fairness(options, reconstruct::fit_noise(noise, spread));
   out["short_curves"] = state.short_curves();
   std::cout << out.dump() << "\n";
   return 0;
