@@ -214,22 +214,6 @@ std::vector<double> shape_weights(const BaseMesh& base, const FitWeights& settin
   return weight;
 }
 
-std::vector<double> curve_weights(const BaseMesh& base, const FitWeights& settings) {
-  std::vector<double> weight;
-  for (uint32_t first = 0; first < base.curve_count() && base.curve_drawn[first]; first += base.pieces_per_edge) {
-    weight.push_back(1.0);
-    if (!(settings.short_curve > 0)) continue;
-    // How far the curve reaches from its ends, which a loop's chord would not tell.
-    const Vec3 a = base.curve(first).front(), b = base.curve(first + base.pieces_per_edge - 1).back();
-    double extent = 0;
-    for (uint32_t c = first; c < first + base.pieces_per_edge; ++c)
-      for (const Vec3& q : base.curve(c)) extent = std::max({extent, (q - a).norm(), (q - b).norm()});
-    const double ratio = extent / settings.short_curve;
-    if (ratio < 1) weight.back() = ratio * ratio;
-  }
-  return weight;
-}
-
 LimitFit::LimitFit() = default;
 LimitFit::~LimitFit() = default;
 LimitFit::LimitFit(LimitFit&&) noexcept = default;
@@ -301,14 +285,6 @@ Result<LimitFit> LimitFit::build(const subdivide::Refinement& refinement, const 
 
   impl->data_normal = Sparse(impl->rows.transpose()) * impl->rows;
   const double data_scale = impl->data_normal.diagonal().mean();
-  // Short noisy curves: their inner rows weighted, the network vertices at their ends not. The fairness
-  // keeps the scale of the unweighted rows.
-  Eigen::VectorXd row_weight = Eigen::VectorXd::Ones(impl->rows.rows());
-  const std::vector<double> per_curve = curve_weights(base, settings);
-  for (size_t p = 0; p < impl->paths.size(); ++p)
-    for (size_t k = 1; k + 1 < impl->paths[p].size(); ++k) row_weight[impl->paths[p][k]] = per_curve[p];
-  if (std::any_of(per_curve.begin(), per_curve.end(), [](double w) { return w < 1; }))
-    impl->data_normal = Sparse(impl->rows.transpose()) * (row_weight.asDiagonal() * impl->rows);
   const Sparse laplacian = umbrella(base);
   impl->bilaplacian = laplacian * laplacian;
   const Sparse fairness = Sparse(impl->bilaplacian.transpose()) * impl->bilaplacian;
@@ -327,7 +303,7 @@ Result<LimitFit> LimitFit::build(const subdivide::Refinement& refinement, const 
   if (impl->solver.info() != Eigen::Success)
     return Result<LimitFit>::failure("the limit fit's normal matrix could not be factored");
   impl->inverse_diagonal = impl->solver.vectorD().cwiseInverse();
-  impl->rows_by_column = row_weight.asDiagonal() * impl->rows;
+  impl->rows_by_column = impl->rows;
   LimitFit fit;
   fit.impl_ = std::move(impl);
   return fit;

@@ -61,11 +61,6 @@ struct FitWeights {
   // the sweeps.
   double shape = 0.1;
   double shape_aspect = 3;
-  // A noisy curve that reaches less far from its ends than this (a length; 0: no curve is short) carries
-  // little shape but as many rows as a long one, and where it is as short as the noise its samples cross
-  // its neighbours' (the hole in the rook's bottom): its inner rows are weighted (reach / short_curve)^2.
-  // The reconstruction sets it from the noise (kShortCurveNoises), none for exact curves.
-  double short_curve = 0;
   uint32_t slide_iterations = 10;  // solves of phase 1
   uint32_t feet_iterations = 60;   // solves of phase 2
   // Phase 2: each target keeps at least this fraction of the equal arc-length step from its neighbours'
@@ -91,10 +86,6 @@ struct FitWeights {
 // Per base vertex, the weight of the shape term (FitWeights::shape); all zero where no quad is thin. The
 // fit's matrix depends on them as it does on topology, so a changed set needs a new factorization.
 std::vector<double> shape_weights(const BaseMesh& base, const FitWeights& weights);
-
-// Per drawn network edge of base (the order of its drawn curves), the weight of its inner rows
-// (FitWeights::short_curve); like shape_weights, a changed set needs a new factorization.
-std::vector<double> curve_weights(const BaseMesh& base, const FitWeights& weights);
 
 class LimitFit {
  public:

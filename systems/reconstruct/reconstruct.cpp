@@ -27,6 +27,8 @@ struct ReconstructionCache {
   // Per element slot of the network; valid[] says whether the entry holds the element's current result.
   std::vector<EdgeSplits> edges;
   std::vector<uint8_t> edge_valid;
+  std::vector<double> edge_scale;   // short_curve_scale each entry of `edges` was split with
+  std::vector<uint8_t> edge_redone;  // recomputed by the current update
   std::vector<FacePatch> faces;
   std::vector<uint8_t> face_valid;
   BaseMesh base;
@@ -45,8 +47,6 @@ struct ReconstructionCache {
   std::vector<double> fit_shape;
   double fit_fairness = 0;  // the fairness it was built with (fit_fairness of the network's noise)
   double noise = 0;         // noise_estimate of the network at the last refine (fire)
-  double mean_length = 0;   // mean_curve_length of the network at the last refine (fire)
-  std::vector<double> fit_curve_weights;  // curve_weights it was built with
   bool fit_waiting = false;
   // The fit of `base` in progress (fire), between the frame that took the base and the one it ends in.
   // Reset before `base` or `fit` is replaced; declared after `fit`, so destroyed before it.
@@ -63,8 +63,8 @@ const UpdateStats& ReconstructionState::last_update() const { return cache_->sta
 const BaseMesh& ReconstructionState::base() const { return cache_->base; }
 bool ReconstructionState::fitting() const { return cache_->fit_waiting || cache_->run.running(); }
 uint32_t ReconstructionState::short_curves() const {
-  const std::vector<double>& w = cache_->fit_curve_weights;
-  return static_cast<uint32_t>(std::count_if(w.begin(), w.end(), [](double x) { return x < 1; }));
+  const std::vector<double>& scale = cache_->edge_scale;
+  return static_cast<uint32_t>(std::count_if(scale.begin(), scale.end(), [](double s) { return s < 1; }));
 }
 
 namespace {
@@ -255,10 +255,37 @@ Status check_reconstruction_input(const Mesh& net, const Options& options) {
 
 namespace {
 
-// The per-edge and per-face stages, for the elements whose tags say they may have changed.
-void update_elements(const Mesh& net, const Options& options, ReconstructionCache& c, bool everything) {
+// How much of a curve's departure from its chord the surface takes, given the noise's deviation (a
+// length; 0: the curves are exact): none for a curve that reaches less than kChordCurveNoises deviations
+// from its ends, all of it from kShortCurveNoises on, linearly between.
+double short_curve_scale(std::span<const Vec3> line, double deviation) {
+  if (!(deviation > 0)) return 1;
+  double reach = 0;
+  for (const Vec3& q : line) reach = std::max({reach, (q - line.front()).norm(), (q - line.back()).norm()});
+  return std::clamp((reach / deviation - kChordCurveNoises) / (kShortCurveNoises - kChordCurveNoises), 0.0, 1.0);
+}
+
+// The polyline the surface takes for a curve of that scale: its chord, plus `scale` of the drawn
+// curve's departure from it.
+std::vector<Vec3> scaled_polyline(std::span<const Vec3> line, double scale) {
+  std::vector<Vec3> out(line.begin(), line.end());
+  if (scale >= 1) return out;
+  const std::vector<double> t = arc_parameters(line);
+  for (size_t i = 1; i + 1 < out.size(); ++i) {
+    const Vec3 chord = line.front() + (line.back() - line.front()) * t[i];
+    out[i] = chord + scale * (line[i] - chord);
+  }
+  return out;
+}
+
+// The per-edge and per-face stages, for the elements whose tags say they may have changed, or (edges)
+// whose short-curve scale did.
+void update_elements(const Mesh& net, const Options& options, ReconstructionCache& c, bool everything,
+                     double deviation) {
   c.edges.resize(net.edge_slots());
   c.edge_valid.resize(net.edge_slots(), 0);
+  c.edge_scale.resize(net.edge_slots(), 1.0);
+  c.edge_redone.assign(net.edge_slots(), 0);
   c.faces.resize(net.face_slots());
   c.face_valid.resize(net.face_slots(), 0);
   c.stats = {};
@@ -266,11 +293,19 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
     if (!net.edge_alive(e) || !used_by_face(net, e)) {
       c.edges[e] = {};
       c.edge_valid[e] = 0;
+      c.edge_scale[e] = 1;
       continue;
     }
-    if (!everything && c.edge_valid[e] && !net.edges.changes.changed_since(e, c.seen)) continue;
-    c.edges[e] = split_network_edge(net.polyline(e), options.coons_steps);
+    const auto line = net.polyline(e);
+    const double scale = short_curve_scale(line, deviation);
+    if (!everything && c.edge_valid[e] && !net.edges.changes.changed_since(e, c.seen) && scale == c.edge_scale[e])
+      continue;
+    if (!everything && c.edge_valid[e] && !net.edges.changes.changed_since(e, c.seen)) ++c.stats.edges_rescaled;
+    c.edges[e] = scale < 1 ? split_network_edge(scaled_polyline(line, scale), options.coons_steps)
+                           : split_network_edge(line, options.coons_steps);
     c.edge_valid[e] = 1;
+    c.edge_scale[e] = scale;
+    c.edge_redone[e] = 1;
     ++c.stats.edges_recomputed;
   }
   const FaceSettings settings{options.method, options.coons_steps, options.planarity};
@@ -283,7 +318,7 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
     }
     auto loop = net.face_loop(f);
     bool stale = everything || !c.face_valid[f] || net.faces.changes.changed_since(f, c.seen);
-    for (uint32_t oe : loop) stale = stale || net.edges.changes.changed_since(edge_of(oe), c.seen);
+    for (uint32_t oe : loop) stale = stale || c.edge_redone[edge_of(oe)];
     if (!stale) continue;
     splits.clear();
     for (uint32_t oe : loop) splits.push_back(&c.edges[edge_of(oe)]);
@@ -409,27 +444,34 @@ Status rebuild_topology(const Options& options, ReconstructionCache& c) {
   return Status::success();
 }
 
+// The deviation of the curves' noise that short_curve_scale measures reaches in, a length: the larger of
+// the fit's noise and the sideways step of a curve turned by the tangent spread over kTangentReach of its
+// length (what correlated noise shows, whose deviation fit_noise does not measure). 0 for exact curves and
+// an explicit fairness: no curve is short.
+double curve_noise_deviation(const Options& options, double noise, double spread_deg, double mean_length) {
+  if (!options.fairness_from_noise || !(noise > kExactCurveNoise)) return 0;
+  const double turned = std::sin(spread_deg * std::numbers::pi / 180) * kTangentReach;
+  return std::max(noise, turned) * mean_length;
+}
+
 // The shape term comes with the noise too: exact curves are followed as drawn (it would cost the rook's
-// exact network its rms goal), noisy hand-drawn ones keep their thin quads' transfinite shape. So does the
-// lighter weight of curves as short as a few times the noise (`noise` is relative to `mean_length`).
-FitWeights fit_weights(const Options& options, double noise, double mean_length) {
+// exact network its rms goal), noisy hand-drawn ones keep their thin quads' transfinite shape.
+FitWeights fit_weights(const Options& options, double noise) {
   FitWeights weights;
   weights.fairness = fit_fairness(options, noise);
   const double noisy = (weights.fairness - options.fairness) / (kNoisyFairness - options.fairness);
   weights.shape = kNoisyFairness > options.fairness ? weights.shape * std::clamp(noisy, 0.0, 1.0) : 0;
-  if (options.fairness_from_noise && noise > kExactCurveNoise) weights.short_curve = kShortCurveNoises * noise * mean_length;
   return weights;
 }
 
 Status build_fit(const Options& options, ReconstructionCache& c) {
-  const FitWeights weights = fit_weights(options, c.noise, c.mean_length);
+  const FitWeights weights = fit_weights(options, c.noise);
   auto fit = LimitFit::build(c.refinement, c.limit, c.base, weights);
   if (!fit) return Status::failure(fit.error());
   c.run = {};
   c.fit = std::move(*fit);
   c.fit_built = true;
   c.fit_shape = shape_weights(c.base, weights);
-  c.fit_curve_weights = curve_weights(c.base, weights);
   c.fit_fairness = weights.fairness;
   return Status::success();
 }
@@ -448,20 +490,23 @@ Result<bool> run_refine(const Mesh& net, const Options& options, ReconstructionC
   c.built = false;
   c.options = options;
   c.run = {};  // a fit of the previous base mesh is abandoned; subdivide starts one from the new
-  update_elements(net, options, c, everything);
   // Noise turns a curve's first stretch too: a border turn within the spread of the curves' directions
   // where they meet is the noise's, not a corner (the pawn's border at 4 % correlated noise).
   const double spread = options.method == Method::fire ? tangent_spread_deg(net) : 0.0;
+  FitWeights weights;
+  double deviation = 0;
+  if (options.method == Method::fire) {
+    const double mean_length = mean_curve_length(net);
+    c.noise = options.fairness_from_noise ? fit_noise(noise_estimate(net, mean_length), spread) : 0;
+    weights = fit_weights(options, c.noise);
+    deviation = curve_noise_deviation(options, c.noise, spread, mean_length);
+  }
+  update_elements(net, options, c, everything, deviation);
   c.base = assemble(net, options, c, kBorderCornerTurnDegrees + spread);
   c.rebuild_topology = c.rebuild_topology || everything || !same_topology(c, c.base);
-  if (options.method == Method::fire) {
-    c.mean_length = mean_curve_length(net);
-    c.noise = options.fairness_from_noise ? fit_noise(noise_estimate(net, c.mean_length), spread) : 0;
-    const FitWeights weights = fit_weights(options, c.noise, c.mean_length);
-    if (c.fit_built && (weights.fairness != c.fit_fairness || shape_weights(c.base, weights) != c.fit_shape ||
-                        curve_weights(c.base, weights) != c.fit_curve_weights))
-      c.fit_built = false;
-  }
+  if (options.method == Method::fire && c.fit_built &&
+      (weights.fairness != c.fit_fairness || shape_weights(c.base, weights) != c.fit_shape))
+    c.fit_built = false;
   c.pending_subdivide = true;
   c.seen = net.frame();
   c.compactions_seen = net.last_compaction().count;

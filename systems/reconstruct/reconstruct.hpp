@@ -134,16 +134,25 @@ inline constexpr double kNoisiestFairness = 1.0;  // the top of --fairness's ran
 // curves, growing with the square of the noise above kExactCurveNoise up to kNoisyFairness, and again
 // above kNoisierCurves up to kNoisiestFairness.
 double fit_fairness(const Options& options, double noise);
-// A noisy curve reaching less far than this many noise deviations (fit_noise times the mean polyline
-// length) from its ends weighs less in the fit (FitWeights::short_curve): the rook's noisy folds were
-// nearly all at its 1.3 mm hole, whose curves are as short as 1 to 4 % noise (perf/RESULTS.md).
-inline constexpr double kShortCurveNoises = 16;
+// A noisy curve reaching less far than kShortCurveNoises noise deviations from its ends is short: its shape
+// is mostly the noise's. The deviation is the larger of fit_noise and the sideways step of a curve turned
+// by tangent_spread_deg over kTangentReach of its length (correlated noise, which fit_noise does not
+// measure), times the mean polyline length; none for exact curves or an explicit --fairness. The surface takes it as its chord plus a part of its departure from the chord,
+// none below kChordCurveNoises deviations, growing linearly to all of it. The rook's noisy folds were
+// nearly all at its 1.3 mm hole, whose curves reach 1 to 3 deviations at 1 to 4 % noise and whose
+// scribbles crossed their neighbours; the torus's shortest curves reach 9 (perf/RESULTS.md). The drawn
+// curves stay as drawn: only the surface's polylines (the refine stage's edge splits) change.
+inline constexpr double kChordCurveNoises = 3;
+inline constexpr double kShortCurveNoises = 6;
 // The same measure for one base face, which must be a quad.
 double quad_aspect(const BaseMesh& base, uint32_t face);
 
 // What the last reconstruct_update() did.
 struct UpdateStats {
   size_t edges_recomputed = 0;
+  // Of those, unchanged edges redone because how much of their shape the surface takes changed with the
+  // network's noise (short noisy curves, kShortCurveNoises): their faces are redone too, wherever the edit was.
+  size_t edges_rescaled = 0;
   size_t faces_recomputed = 0;
   bool topology_rebuilt = false;  // subdivision topology and (fire) the fit's factorization were rebuilt
   uint32_t fit_iterations = 0;    // solves of the fit (fire), each a back-substitution
@@ -162,7 +171,7 @@ class ReconstructionState {
   const UpdateStats& last_update() const;
   const BaseMesh& base() const;  // the base mesh of the last successful update
   bool fitting() const;          // a fit runs over the next subdivide_update calls
-  // fire: how many curves the current fit weighs less as short noisy ones (FitWeights::short_curve).
+  // fire: how many curves the last update took nearer their chords as short noisy ones (kShortCurveNoises).
   uint32_t short_curves() const;
   ReconstructionCache& cache() { return *cache_; }
 

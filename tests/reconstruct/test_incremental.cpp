@@ -6,6 +6,8 @@
 #include <cstring>
 #include <numbers>
 
+#include <Eigen/Geometry>
+
 #include "networks.hpp"
 #include "systems/reconstruct/fit.hpp"
 #include "systems/reconstruct/reconstruct.hpp"
@@ -150,58 +152,84 @@ TEST_CASE("a noisy network's fit follows its noise, and a move that changes the 
   check_equals_full_rebuild(net, options, surface);
 }
 
-TEST_CASE("a noisy curve as short as its noise weighs less, and a change of that weight refactorizes, equal to a rebuild",
+namespace {
+
+// Per drawn network edge of `base` (its drawn curves in order, pieces_per_edge each), how far its points
+// lie from the chord between its ends at most.
+std::vector<double> departures(const BaseMesh& base) {
+  std::vector<double> out;
+  for (uint32_t first = 0; first < base.curve_count() && base.curve_drawn[first]; first += base.pieces_per_edge) {
+    const Vec3 a = base.curve(first).front(), b = base.curve(first + base.pieces_per_edge - 1).back();
+    double farthest = 0;
+    for (uint32_t c = first; c < first + base.pieces_per_edge; ++c)
+      for (const Vec3& q : base.curve(c)) farthest = std::max(farthest, (q - a).cross(b - a).norm() / (b - a).norm());
+    out.push_back(farthest);
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("a noisy curve as short as its noise is taken nearer its chord, and a change of that redoes its faces, "
+          "equal to a rebuild",
           "[reconstruct][incremental][noise]") {
   auto noisy = [](double x, double y) { return height(x, y) + 0.03 * std::sin(97 * x + 53 * y); };
-  // The grid's fourth column of faces squeezed to 1/20 of its width: its 5 horizontal curves are 0.05 wide,
-  // and 2 of them also end level (the other 3 climb 0.09 to 0.12, more than 16 noise deviations).
+  // The grid's fourth column of faces squeezed to 0.3 of its width: 2 of its 5 horizontal curves also end
+  // level and reach less than kShortCurveNoises deviations of the noise from their ends; the others climb
+  // farther.
   auto squeeze = [](Vec3 p) {
-    p.x() = p.x() <= 3 ? p.x() * 3.95 / 3 : p.x() <= 4 ? 3.95 + (p.x() - 3) * 0.05 : p.x();
+    p.x() = p.x() <= 3 ? p.x() * 3.7 / 3 : p.x() <= 4 ? 3.7 + (p.x() - 3) * 0.3 : p.x();
     return p;
   };
-  Mesh net = grid_network(6, 4, 20, noisy);
-  for (uint32_t v = 0; v < net.vertex_slots(); ++v) net.vertices.position.set(v, squeeze(net.vertices.position[v]));
-  for (uint32_t i = 0; i < uint32_t(net.points.size()); ++i) net.points.set(i, squeeze(net.points[i]));
-  const Options options;
-  const double noise = fit_noise(net);
-  REQUIRE(noise > kExactCurveNoise);
-  REQUIRE(fit_fairness(options, noise) == kNoisyFairness);
-  auto weights_of = [&](const Mesh& m, const BaseMesh& base) {
-    double length = 0;
-    uint32_t lines = 0;
-    for (uint32_t e = 0; e < m.edge_slots(); ++e) {
-      if (!m.edge_alive(e)) continue;
-      for (size_t i = 1; i < m.polyline(e).size(); ++i) length += (m.polyline(e)[i] - m.polyline(e)[i - 1]).norm();
-      ++lines;
-    }
-    FitWeights w;
-    w.short_curve = kShortCurveNoises * fit_noise(m) * length / lines;
-    return curve_weights(base, w);
+  auto squeezed = [&](const Height& h) {
+    Mesh net = grid_network(6, 4, 20, h);
+    for (uint32_t v = 0; v < net.vertex_slots(); ++v) net.vertices.position.set(v, squeeze(net.vertices.position[v]));
+    for (uint32_t i = 0; i < uint32_t(net.points.size()); ++i) net.points.set(i, squeeze(net.points[i]));
+    return net;
   };
-
-  ReconstructionState state;
+  const Options options;
   SurfaceMesh surface;
+
+  // Exact curves, however short, are followed as drawn.
+  Mesh exact = squeezed(height);
+  ReconstructionState exact_state;
+  update(exact, options, exact_state, surface);
+  CHECK(exact_state.short_curves() == 0);
+
+  Mesh net = squeezed(noisy);
+  REQUIRE(fit_noise(net) > kExactCurveNoise);
+  ReconstructionState state;
   update(net, options, state, surface);
   check_equals_full_rebuild(net, options, surface);
-  // Exact curves (no short_curve) all weigh 1; here the short curves alone weigh less.
-  const std::vector<double> plain = curve_weights(state.base(), FitWeights{});
-  CHECK(plain.size() == net.edge_count());
-  CHECK(std::all_of(plain.begin(), plain.end(), [](double w) { return w == 1; }));
-  const std::vector<double> before = weights_of(net, state.base());
-  REQUIRE(before.size() == plain.size());
-  CHECK(std::count_if(before.begin(), before.end(), [](double w) { return w < 1; }) == 2);
-  CHECK(*std::min_element(before.begin(), before.end()) > 0);
+  CHECK(state.short_curves() == 2);
+  // The surface's polylines of the short curves lie nearer their chords than the drawn ones, the others
+  // are the drawn ones. The base's drawn curves come in edge order; every edge of the grid is drawn.
+  const std::vector<double> before = departures(state.base());
+  REQUIRE(before.size() == net.edge_count());
+  uint32_t nearer = 0, partly = 0;
+  for (uint32_t e = 0; e < net.edge_count(); ++e) {
+    const auto line = net.polyline(e);
+    double drawn = 0;
+    for (const Vec3& q : line)
+      drawn = std::max(drawn, (q - line.front()).cross(line.back() - line.front()).norm() /
+                                  (line.back() - line.front()).norm());
+    CHECK(before[e] <= drawn);
+    if (before[e] < drawn) ++nearer;
+    if (before[e] > 0 && before[e] < drawn) ++partly;
+  }
+  CHECK(nearer == 2);
+  REQUIRE(partly >= 1);  // a short curve keeps part of its shape, so the move below changes it
 
-  // A vertex far from it raised: the curves' mean length, and with it the short curve's weight, change;
-  // the fairness (on its plateau) and the thin quads' shape weights do not. The fit is factorized again.
+  // A vertex far from them raised: the curves' mean length, and with it how much of the short curves'
+  // shape the surface takes, change; so their faces are redone too.
   const uint32_t far = 3 * 7 + 5;
-  const std::vector<double> shape = shape_weights(state.base(), FitWeights{});
+  const uint32_t far_edges = static_cast<uint32_t>(net.vertex_edges(far).size());
   net.move_vertex(far, net.vertices.position[far] + Vec3(0, 0, 0.3));
   update(net, options, state, surface);
   CHECK_FALSE(state.last_update().topology_rebuilt);
-  REQUIRE(fit_fairness(options, fit_noise(net)) == kNoisyFairness);
-  REQUIRE(shape_weights(state.base(), FitWeights{}) == shape);
-  REQUIRE(weights_of(net, state.base()) != before);
+  CHECK(state.last_update().edges_recomputed > far_edges);
+  CHECK(state.last_update().edges_rescaled == 2);
+  CHECK(departures(state.base()) != before);
   check_equals_full_rebuild(net, options, surface);
 }
 

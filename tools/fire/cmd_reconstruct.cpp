@@ -86,7 +86,8 @@ void add_reconstruct_commands(CLI::App& app, Registry& registry) {
       "over 2, curves with a noise estimate under 3e-4 count as noisy as 3e-3) and fairness (the fit's weight: "
       "--fairness if given, else the default for exact curves raised with the noise estimate: 0.1 from 3e-3 to "
       "1.3e-2, beyond with its square, up to 1) and short_curves (without --fairness, noisy curves that reach "
-      "less than 16 noise deviations from their ends weigh less in the fit: how many did).");
+      "less than 6 noise deviations from their ends, which the surface takes nearer their chords, as a chord "
+      "below 3: how many there were).");
   cmd->add_option("NET", a->network_path, "curve network file (format: engine/NETWORK_FORMAT.md)")->required();
   cmd->add_option("-o,--output", a->out_path, "surface file to write: .obj, .ply, .stl or .glb")->required();
   cmd->add_option("--method", a->method, "thesis or fire")->capture_default_str();
