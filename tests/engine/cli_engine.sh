@@ -26,8 +26,9 @@ check "replay hash matches the recorded one ($golden)" "[ '$h1' = '$golden' ]"
 check "replay writes the network" "'$fire' replay '$src/tools/demo/sketch.log' -o '$tmp/demo.fnet' 2>/dev/null && [ -s '$tmp/demo.fnet' ]"
 # The surface the frame's refine and subdivide systems left equals a reconstruction from scratch of the
 # same network, byte for byte.
-check "replay writes the surface" "'$fire' replay '$src/tools/demo/sketch.log' -o '$tmp/s.fnet' --surface '$tmp/live.obj' 2>/dev/null && [ -s '$tmp/live.obj' ]"
+check "replay writes the surface, to each --surface" "'$fire' replay '$src/tools/demo/sketch.log' -o '$tmp/s.fnet' --surface '$tmp/live.obj' --surface '$tmp/live.glb' 2>/dev/null && [ -s '$tmp/live.obj' ]"
 check "the live surface equals a full rebuild" "'$fire' reconstruct '$tmp/s.fnet' -o '$tmp/full.obj' && cmp -s '$tmp/live.obj' '$tmp/full.obj'"
+check "so does its second file" "'$fire' reconstruct '$tmp/s.fnet' -o '$tmp/full.glb' && cmp -s '$tmp/live.glb' '$tmp/full.glb'"
 check "--no-surface skips refine and subdivide" "'$fire' replay '$src/tools/demo/sketch.log' --no-surface --timings 2>/dev/null | grep -q 'surface: level 0, 0 quads'"
 expect_error "--surface with an unknown extension" "unknown surface format" "$fire" replay "$src/tools/demo/sketch.log" --surface "$tmp/x.xyz"
 check "export-network writes one l per edge" "'$fire' export-network '$tmp/demo.fnet' -o '$tmp/demo.obj' && [ \$(grep -c '^l ' '$tmp/demo.obj') -eq 32 ]"

@@ -18,7 +18,8 @@ namespace fire::cli {
 namespace {
 
 struct ReplayOptions {
-  std::string log_path, out_path, obj_path, surface_path, session_dir, rig_path;
+  std::string log_path, out_path, obj_path, session_dir, rig_path;
+  std::vector<std::string> surface_paths;
   uint64_t snapshot_every = 0;
   bool hash = false, timings = false, no_surface = false;
   bool settings_given = false;  // --snap, --levels, --fairness or --no-surface on the command line
@@ -65,16 +66,15 @@ int run_replay(const ReplayOptions& o) {
     std::cerr << "fire replay: --snap must be a positive distance\n";
     return 1;
   }
-  if (o.no_surface && !o.surface_path.empty()) {
+  if (o.no_surface && !o.surface_paths.empty()) {
     std::cerr << "fire replay: --surface needs the surface that --no-surface turns off\n";
     return 1;
   }
-  if (!o.surface_path.empty()) {
-    if (auto format = surface_format_of(o.surface_path); !format) {
+  for (const std::string& path : o.surface_paths)
+    if (auto format = surface_format_of(path); !format) {
       std::cerr << "fire replay: " << format.error() << "\n";
       return 1;
     }
-  }
   std::unique_ptr<World> world;
   std::unique_ptr<Scheduler> scheduler_owner;
   // Where rejections' lines are: the log read, or the log of the session written or reopened.
@@ -168,16 +168,18 @@ int run_replay(const ReplayOptions& o) {
                 surface.vertex_count(), world->surface_build.updates);
   }
   if (o.hash) std::printf("%016" PRIx64 "\n", world_hash(*world));
-  if (!o.surface_path.empty()) {
+  if (!o.surface_paths.empty()) {
     if (surface.empty()) {
-      std::cerr << "fire replay: " << o.log_path << " ends with no surface to write to " << o.surface_path
+      std::cerr << "fire replay: " << o.log_path << " ends with no surface to write to " << o.surface_paths.front()
                 << (m.face_count() == 0 ? " (the network has no faces)\n" : "\n");
       return 1;
     }
-    if (auto s = write_surface(to_surface_mesh(surface), o.surface_path); !s) {
-      std::cerr << "fire replay: " << s.error << "\n";
-      return 1;
-    }
+    const SurfaceMesh mesh = to_surface_mesh(surface);
+    for (const std::string& path : o.surface_paths)
+      if (auto s = write_surface(mesh, path); !s) {
+        std::cerr << "fire replay: " << s.error << "\n";
+        return 1;
+      }
   }
   if (!o.out_path.empty()) {
     if (auto s = save_network(m, o.out_path); !s) {
@@ -217,8 +219,10 @@ void add_network_commands(CLI::App& app, Registry& registry) {
                      "written from the log keeps a copy (rig.json), so reopening it needs no --rig");
   replay->add_option("-o,--output", o->out_path, "write the final curve network here (format: engine/NETWORK_FORMAT.md)");
   replay->add_option("--export-obj", o->obj_path, "also write the network's polylines as OBJ lines");
-  replay->add_option("--surface", o->surface_path,
-                     "write the final surface here (.obj, .ply, .stl or .glb), as the frame's subdivide system left it");
+  replay->add_option("--surface", o->surface_paths,
+                     "write the final surface here (.obj, .ply, .stl or .glb), as the frame's subdivide system left it; "
+                     "repeat it for more than one file")
+      ->allow_extra_args(false);
   replay->add_flag("--no-surface", o->no_surface, "run only input, sketch and split (no refine and subdivide)");
   replay->add_option("--levels", o->surface.levels, "subdivision levels of the surface")
       ->capture_default_str()
