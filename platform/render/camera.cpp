@@ -10,7 +10,8 @@ Result<View> parse_view(const std::string& name) {
   if (name == "front") return View::front;
   if (name == "top") return View::top;
   if (name == "side") return View::side;
-  return Result<View>::failure("--view must be iso, front, top or side, not '" + name + "'");
+  if (name == "bottom") return View::bottom;
+  return Result<View>::failure("--view must be iso, front, top, side or bottom, not '" + name + "'");
 }
 
 Camera frame_box(const Box& box, View view, uint32_t width, uint32_t height) {
@@ -23,6 +24,7 @@ Camera frame_box(const Box& box, View view, uint32_t width, uint32_t height) {
     case View::front: break;
     case View::side: back = {1.0f, 0.0f, 0.0f}; break;
     case View::top: back = {0.0f, 0.0f, 1.0f}, up = {0.0f, 1.0f, 0.0f}; break;
+    case View::bottom: back = {0.0f, 0.0f, -1.0f}, up = {0.0f, 1.0f, 0.0f}; break;
   }
   const glm::vec3 right = glm::normalize(glm::cross(up, back));
   const glm::vec3 true_up = glm::cross(back, right);

@@ -8,9 +8,9 @@
 
 namespace fire::render {
 
-enum class View { iso, front, top, side };
+enum class View { iso, front, top, side, bottom };
 
-// "iso", "front", "top", "side"; nullopt-like failure otherwise.
+// "iso", "front", "top", "side", "bottom" (from below: what rests on the table); a failure otherwise.
 Result<View> parse_view(const std::string& name);
 
 struct Box {

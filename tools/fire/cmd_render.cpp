@@ -232,7 +232,7 @@ void add_render_commands(CLI::App& app, Registry& registry) {
                   "(frame, png, edges, surface_quads, bytes_uploaded, edges_uploaded, surface_vertices_uploaded)");
   cmd->add_option("--png-dir", a->png_dir, "directory for --every's frame_NNNNNN.png pictures");
   cmd->add_option("--size", a->size, "WIDTHxHEIGHT in pixels")->capture_default_str();
-  cmd->add_option("--view", a->view, "iso, front, top or side (Z up)")->capture_default_str();
+  cmd->add_option("--view", a->view, "iso, front, top, side or bottom (Z up)")->capture_default_str();
   cmd->add_option("--reference", a->reference_path, "OBJ mesh drawn see-through over the scene");
   cmd->add_option("--levels", a->levels, "Catmull-Clark levels of the surface (1 to 6)")->capture_default_str();
   cmd->add_option("--rig", a->rig_path,

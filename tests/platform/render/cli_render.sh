@@ -58,7 +58,7 @@ expect_error "a missing reference mesh" "--reference: .*missing.obj" "$tmp/missi
 expect_error "a PNG path that cannot be written" "$tmp/no/such/dir/x.png: cannot write" "$tmp/no/such/dir/x.png" \
   "$fire" render "$here/data/sketch.fnet" -o "$tmp/no/such/dir/x.png" --size 64x64
 expect_error "an output that is not a PNG" "must be a .png" "$tmp/x.jpg" "$fire" render "$here/data/sketch.fnet" -o "$tmp/x.jpg"
-expect_error "an unknown view" "--view must be iso, front, top or side" "$tmp/v.png" \
+expect_error "an unknown view" "--view must be iso, front, top, side or bottom" "$tmp/v.png" \
   "$fire" render "$here/data/sketch.fnet" -o "$tmp/v.png" --view diagonal
 expect_error "a bad size" "--size must be WIDTHxHEIGHT" "$tmp/s.png" "$fire" render "$here/data/sketch.fnet" -o "$tmp/s.png" --size 0x10
 expect_error "a network that does not load" "missing.fnet" "$tmp/n.png" "$fire" render "$tmp/missing.fnet" -o "$tmp/n.png"

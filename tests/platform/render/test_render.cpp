@@ -435,13 +435,14 @@ TEST_CASE("Vulkan failures name the call") {
         "vkCreateDevice failed: VK_ERROR_DEVICE_LOST (-4)");
   CHECK_FALSE(parse_view("diagonal"));
   CHECK(parse_view("side"));
+  CHECK(parse_view("bottom"));
 }
 
 TEST_CASE("framing keeps every corner of the box inside the image") {
   Box box;
   box.add(Vec3(-1, -2, 0));
   box.add(Vec3(3, 1, 0.5));
-  for (View view : {View::iso, View::front, View::top, View::side}) {
+  for (View view : {View::iso, View::front, View::top, View::side, View::bottom}) {
     const Camera camera = frame_box(box, view, 640, 360);
     for (int c = 0; c < 8; ++c) {
       const Vec3 p((c & 1) ? 3 : -1, (c & 2) ? 1 : -2, (c & 4) ? 0.5 : 0);
@@ -452,6 +453,9 @@ TEST_CASE("framing keeps every corner of the box inside the image") {
       CHECK(q.y <= 360);
     }
   }
+  // Top and bottom look from above and from below.
+  CHECK(frame_box(box, View::top, 640, 360).eye.z > 0.5f);
+  CHECK(frame_box(box, View::bottom, 640, 360).eye.z < 0.0f);
 }
 
 TEST_CASE("the app's orbit camera: a ray through a pixel lands on it, pixel sizes, pan, zoom and pitch") {
