@@ -269,7 +269,6 @@ double short_curve_scale(std::span<const Vec3> line, double deviation) {
 // curve's departure from it.
 std::vector<Vec3> scaled_polyline(std::span<const Vec3> line, double scale) {
   std::vector<Vec3> out(line.begin(), line.end());
-  if (scale >= 1) return out;
   const std::vector<double> t = arc_parameters(line);
   for (size_t i = 1; i + 1 < out.size(); ++i) {
     const Vec3 chord = line.front() + (line.back() - line.front()) * t[i];
@@ -298,9 +297,9 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
     }
     const auto line = net.polyline(e);
     const double scale = short_curve_scale(line, deviation);
-    if (!everything && c.edge_valid[e] && !net.edges.changes.changed_since(e, c.seen) && scale == c.edge_scale[e])
-      continue;
-    if (!everything && c.edge_valid[e] && !net.edges.changes.changed_since(e, c.seen)) ++c.stats.edges_rescaled;
+    const bool unchanged = !everything && c.edge_valid[e] && !net.edges.changes.changed_since(e, c.seen);
+    if (unchanged && scale == c.edge_scale[e]) continue;
+    if (unchanged) ++c.stats.edges_rescaled;
     c.edges[e] = scale < 1 ? split_network_edge(scaled_polyline(line, scale), options.coons_steps)
                            : split_network_edge(line, options.coons_steps);
     c.edge_valid[e] = 1;

@@ -137,8 +137,9 @@ double fit_fairness(const Options& options, double noise);
 // A noisy curve reaching less far than kShortCurveNoises noise deviations from its ends is short: its shape
 // is mostly the noise's. The deviation is the larger of fit_noise and the sideways step of a curve turned
 // by tangent_spread_deg over kTangentReach of its length (correlated noise, which fit_noise does not
-// measure), times the mean polyline length; none for exact curves or an explicit --fairness. The surface takes it as its chord plus a part of its departure from the chord,
-// none below kChordCurveNoises deviations, growing linearly to all of it. The rook's noisy folds were
+// measure), times the mean polyline length; none for exact curves or an explicit --fairness. The surface
+// takes a short curve as its chord plus a part of its departure from the chord, none below
+// kChordCurveNoises deviations, growing linearly to all of it. The rook's noisy folds were
 // nearly all at its 1.3 mm hole, whose curves reach 1 to 3 deviations at 1 to 4 % noise and whose
 // scribbles crossed their neighbours; the torus's shortest curves reach 9 (perf/RESULTS.md). The drawn
 // curves stay as drawn: only the surface's polylines (the refine stage's edge splits) change.

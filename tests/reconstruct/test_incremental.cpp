@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <span>
 
 #include <Eigen/Geometry>
 
@@ -154,6 +155,13 @@ TEST_CASE("a noisy network's fit follows its noise, and a move that changes the 
 
 namespace {
 
+// How far the farthest of `points` lies from the line through a and b.
+double farthest_from_chord(std::span<const Vec3> points, const Vec3& a, const Vec3& b) {
+  double farthest = 0;
+  for (const Vec3& q : points) farthest = std::max(farthest, (q - a).cross(b - a).norm() / (b - a).norm());
+  return farthest;
+}
+
 // Per drawn network edge of `base` (its drawn curves in order, pieces_per_edge each), how far its points
 // lie from the chord between its ends at most.
 std::vector<double> departures(const BaseMesh& base) {
@@ -162,7 +170,7 @@ std::vector<double> departures(const BaseMesh& base) {
     const Vec3 a = base.curve(first).front(), b = base.curve(first + base.pieces_per_edge - 1).back();
     double farthest = 0;
     for (uint32_t c = first; c < first + base.pieces_per_edge; ++c)
-      for (const Vec3& q : base.curve(c)) farthest = std::max(farthest, (q - a).cross(b - a).norm() / (b - a).norm());
+      farthest = std::max(farthest, farthest_from_chord(base.curve(c), a, b));
     out.push_back(farthest);
   }
   return out;
@@ -209,10 +217,7 @@ TEST_CASE("a noisy curve as short as its noise is taken nearer its chord, and a 
   uint32_t nearer = 0, partly = 0;
   for (uint32_t e = 0; e < net.edge_count(); ++e) {
     const auto line = net.polyline(e);
-    double drawn = 0;
-    for (const Vec3& q : line)
-      drawn = std::max(drawn, (q - line.front()).cross(line.back() - line.front()).norm() /
-                                  (line.back() - line.front()).norm());
+    const double drawn = farthest_from_chord(line, line.front(), line.back());
     CHECK(before[e] <= drawn);
     if (before[e] < drawn) ++nearer;
     if (before[e] > 0 && before[e] < drawn) ++partly;
