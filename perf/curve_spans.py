@@ -196,7 +196,7 @@ def fit_curve(points, spans, start=None, iterations=500):
     # On noisy points a smaller sum of squares can come with a larger largest distance (the parameters let
     # the curve loop): the curve with the smaller largest distance is the one reported.
     best = None
-    for candidate in (first_guess, controls):
+    for candidate in (first_guess,) if controls is first_guess else (first_guess, controls):
         samples = [(i / (200 * spans), evaluate(i / (200 * spans), knots, spans, candidate)) for i in range(200 * spans + 1)]
         feet = [foot(p, knots, spans, candidate, samples) for p in points[1:-1]]
         farthest = max((f[1] for f in feet), default=0.0)
