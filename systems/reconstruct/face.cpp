@@ -19,12 +19,6 @@ EdgeSplits split_network_edge(std::span<const Vec3> line, uint32_t depth) {
 
 namespace {
 
-double polyline_length(std::span<const Vec3> line) {
-  double length = 0;
-  for (size_t i = 1; i < line.size(); ++i) length += (line[i] - line[i - 1]).norm();
-  return length;
-}
-
 struct LocalEdge {
   VertexRef from, to;
   std::vector<Vec3> own;               // the polyline of an edge made inside the face
@@ -223,23 +217,32 @@ struct Refiner {
 
 FacePatch build_face_patch(const Mesh& net, uint32_t face, std::span<const EdgeSplits* const> splits,
                            const FaceSettings& settings) {
-  LocalMesh mesh;
   const auto network_loop = net.face_loop(face);
-  const uint32_t n = static_cast<uint32_t>(network_loop.size());
+  std::vector<FaceSide> sides(network_loop.size());
+  for (size_t k = 0; k < sides.size(); ++k) {
+    const uint32_t e = edge_of(network_loop[k]);
+    sides[k] = {splits[k], e, net.edges.vertex[e][0], net.edges.vertex[e][1], is_reversed(network_loop[k]),
+                polyline_length(net.polyline(e)), size_t(net.edges.point_count[e] - 1)};
+  }
+  return build_face_patch(sides, settings);
+}
+
+FacePatch build_face_patch(std::span<const FaceSide> sides, const FaceSettings& settings) {
+  LocalMesh mesh;
+  const uint32_t n = static_cast<uint32_t>(sides.size());
   std::vector<uint32_t> loop(n);
   double total_length = 0;
   size_t total_segments = 0;
   for (uint32_t k = 0; k < n; ++k) {
-    const uint32_t e = edge_of(network_loop[k]);
     LocalEdge edge;
-    edge.from = {RefKind::network_vertex, net.edges.vertex[e][0], 0};
-    edge.to = {RefKind::network_vertex, net.edges.vertex[e][1], 0};
-    edge.splits = splits[k];
-    edge.network_edge = e;
+    edge.from = {RefKind::network_vertex, sides[k].from, 0};
+    edge.to = {RefKind::network_vertex, sides[k].to, 0};
+    edge.splits = sides[k].splits;
+    edge.network_edge = sides[k].network_edge;
     edge.node = 1;
-    loop[k] = mesh.add_edge(std::move(edge)) << 1 | (is_reversed(network_loop[k]) ? 1u : 0u);
-    total_length += polyline_length(net.polyline(e));
-    total_segments += net.edges.point_count[e] - 1;
+    loop[k] = mesh.add_edge(std::move(edge)) << 1 | (sides[k].reversed ? 1u : 0u);
+    total_length += sides[k].length;
+    total_segments += sides[k].segments;
   }
   Refiner refiner{mesh, total_segments ? total_length / double(total_segments) : 0.0};
 

@@ -62,10 +62,23 @@ struct FacePatch {
   std::vector<uint32_t> first_stage_sizes;
 };
 
-// `splits[k]` is the split of the edge at loop position k (depth = coons_steps). A face with 2 edges is
-// the degenerate quad whose other two sides are its corners: 2 quads around the centre of the ruled
-// surface between its two curves (FIRE's rule; the thesis has none, and check_reconstruction_input
-// rejects such faces for it).
+// One side of a face: a network edge, or a chain of them joined through network vertices the surface
+// leaves out (reconstruct.cpp), from network vertex `from` to `to` in its stored direction.
+struct FaceSide {
+  const EdgeSplits* splits = nullptr;  // depth = coons_steps
+  uint32_t network_edge = 0;           // the edge slot its split points are named by (VertexRef::index)
+  uint32_t from = 0, to = 0;
+  bool reversed = false;  // the face's loop walks it from `to` to `from`
+  double length = 0;      // its drawn polyline's length and segments: the face's sample spacing
+  size_t segments = 0;
+};
+
+// The face's sides in loop order. A face with 2 sides is the degenerate quad whose other two sides are
+// its corners: 2 quads around the centre of the ruled surface between its two curves (FIRE's rule; the
+// thesis has none, and check_reconstruction_input rejects such faces for it).
+FacePatch build_face_patch(std::span<const FaceSide> sides, const FaceSettings& settings);
+// The same for network face `face` whose every edge is a side: `splits[k]` is the split of the edge at
+// loop position k.
 FacePatch build_face_patch(const Mesh& net, uint32_t face, std::span<const EdgeSplits* const> splits,
                            const FaceSettings& settings);
 

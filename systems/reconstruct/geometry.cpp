@@ -9,6 +9,12 @@
 
 namespace fire::reconstruct {
 
+double polyline_length(std::span<const Vec3> line) {
+  double length = 0;
+  for (size_t i = 1; i < line.size(); ++i) length += (line[i] - line[i - 1]).norm();
+  return length;
+}
+
 std::vector<double> arc_parameters(std::span<const Vec3> line) {
   std::vector<double> t(line.size(), 0.0);
   double length = 0;

@@ -14,6 +14,7 @@ namespace fire::reconstruct {
 // Arc-length parameter of each point: 0 at the first, 1 at the last (thesis 6.2). A zero-length line
 // gets 0 everywhere but the last point.
 std::vector<double> arc_parameters(std::span<const Vec3> line);
+double polyline_length(std::span<const Vec3> line);
 
 // How a polyline is read between its samples: `nearest` is the thesis's rule (the sample whose
 // parameter is closest, ties to the lower index), `linear` interpolates along the arc.

@@ -9,10 +9,23 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
+#include "engine/assert.hpp"
 #include "systems/reconstruct/fit.hpp"
 #include "systems/subdivide/subdivide.hpp"
 
 namespace fire::reconstruct {
+
+// The sides of the network's faces as the surface sees them: a network edge, or a chain of edges joined
+// through `joined` vertices (joined_vertices), named by its lead, the lowest edge slot in it, and
+// running in the lead's stored direction from network vertex `from` to `to`.
+struct Sides {
+  std::vector<uint8_t> joined;    // per vertex slot
+  std::vector<uint32_t> lead;     // per edge slot: the lead of its side (kNone: no face uses it)
+  // Per lead slot: the members in order from `from` (edge slot << 1 | 1 where the member runs against
+  // the side), and the side's ends.
+  std::vector<std::vector<uint32_t>> members;
+  std::vector<uint32_t> from, to;
+};
 
 struct ReconstructionCache {
   bool built = false;
@@ -25,10 +38,15 @@ struct ReconstructionCache {
   bool pending_subdivide = false;
   bool rebuild_topology = false;
   // Per element slot of the network; valid[] says whether the entry holds the element's current result.
+  // An entry of `edges` is the split of a side: the chain of network edges led by that slot (sides).
   std::vector<EdgeSplits> edges;
   std::vector<uint8_t> edge_valid;
-  std::vector<double> edge_scale;   // short_curve_scale each entry of `edges` was split with
+  std::vector<double> edge_scale;   // short_curve_scale each entry of `edges` was split with (1: none)
   std::vector<uint8_t> edge_redone;  // recomputed by the current update
+  // The chain each valid entry of `edges` was split from (oriented members, Sides::members), and the
+  // current sides, rebuilt by every update.
+  std::vector<std::vector<uint32_t>> edge_members;
+  Sides sides;
   std::vector<FacePatch> faces;
   std::vector<uint8_t> face_valid;
   BaseMesh base;
@@ -65,6 +83,11 @@ bool ReconstructionState::fitting() const { return cache_->fit_waiting || cache_
 uint32_t ReconstructionState::short_curves() const {
   const std::vector<double>& scale = cache_->edge_scale;
   return static_cast<uint32_t>(std::count_if(scale.begin(), scale.end(), [](double s) { return s < 1; }));
+}
+
+uint32_t ReconstructionState::joined_vertices() const {
+  const std::vector<uint8_t>& joined = cache_->sides.joined;
+  return static_cast<uint32_t>(std::count(joined.begin(), joined.end(), uint8_t(1)));
 }
 
 namespace {
@@ -277,6 +300,93 @@ std::vector<Vec3> scaled_polyline(std::span<const Vec3> line, double scale) {
   return out;
 }
 
+// With noisy curves, an interior network vertex where just two curves meet is left out of the base mesh:
+// its two edges become one side of both its faces. Kept, it would be a base vertex of valence 2, and a
+// fit stiff enough for the noise pins that degenerate Catmull-Clark vertex to the turn the curve takes
+// there and pleats the two quads at it (the rook's battlement notches, perf/RESULTS.md). Exact curves
+// keep it: the fit follows them closely, and a turn inside one side would fold it instead. Never where
+// a face would keep fewer than two corners, nor between edges of different sharpness.
+std::vector<uint8_t> joined_vertices(const Mesh& net, bool noisy) {
+  std::vector<uint8_t> joined(net.vertex_slots(), 0);
+  if (!noisy) return joined;
+  std::vector<uint32_t> used(net.vertex_slots(), 0), first(net.vertex_slots(), kNone);
+  std::vector<uint8_t> candidate(net.vertex_slots(), 1);
+  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+    if (!net.edge_alive(e) || !used_by_face(net, e)) continue;
+    const uint32_t a = net.edges.vertex[e][0], b = net.edges.vertex[e][1];
+    const bool interior = !net.is_border_edge(e) && net.edges.face[e][0] != net.edges.face[e][1] && a != b;
+    for (uint32_t v : {a, b}) {
+      ++used[v];
+      if (!interior) candidate[v] = 0;
+      if (first[v] == kNone) {
+        first[v] = e;
+      } else if (used[v] == 2) {
+        const uint32_t g = first[v];
+        const uint32_t far_e = a == v ? b : a;
+        const uint32_t far_g = net.edges.vertex[g][0] == v ? net.edges.vertex[g][1] : net.edges.vertex[g][0];
+        const bool same_sharpness = ((net.edges.flags[e] ^ net.edges.flags[g]) & kSharpEdge) == 0;
+        if (g == e || far_e == far_g || !same_sharpness) candidate[v] = 0;
+      }
+    }
+  }
+  for (uint32_t v = 0; v < net.vertex_slots(); ++v) joined[v] = net.vertex_alive(v) && used[v] == 2 && candidate[v];
+  for (uint32_t f = 0; f < net.face_slots(); ++f) {
+    if (!net.face_alive(f)) continue;
+    const auto loop = net.face_loop(f);
+    const auto kept = std::count_if(loop.begin(), loop.end(), [&](uint32_t oe) { return !joined[net.tail(oe)]; });
+    if (kept < 2)
+      for (uint32_t oe : loop) joined[net.tail(oe)] = 0;
+  }
+  return joined;
+}
+
+// The sides of the faces, from the joined vertices: each edge a face uses walked forwards and back
+// through joined vertices to the ends of its chain.
+void build_sides(const Mesh& net, bool noisy, Sides& sides) {
+  sides.joined = joined_vertices(net, noisy);
+  sides.lead.assign(net.edge_slots(), kNone);
+  sides.members.resize(net.edge_slots());
+  sides.from.assign(net.edge_slots(), kNone);
+  sides.to.assign(net.edge_slots(), kNone);
+  // The other edge at a joined vertex.
+  std::vector<uint32_t> pair(2 * size_t(net.vertex_slots()), kNone);
+  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+    if (!net.edge_alive(e) || !used_by_face(net, e)) continue;
+    for (uint32_t v : net.edges.vertex[e])
+      if (sides.joined[v]) pair[2 * size_t(v) + (pair[2 * size_t(v)] == kNone ? 0 : 1)] = e;
+  }
+  auto across = [&](uint32_t v, uint32_t e) { return pair[2 * size_t(v)] == e ? pair[2 * size_t(v) + 1] : pair[2 * size_t(v)]; };
+  auto far_end = [&](uint32_t e, uint32_t v) { return net.edges.vertex[e][0] == v ? net.edges.vertex[e][1] : net.edges.vertex[e][0]; };
+  std::vector<uint32_t> back;
+  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+    std::vector<uint32_t>& members = sides.members[e];
+    members.clear();
+    if (!net.edge_alive(e) || !used_by_face(net, e) || sides.lead[e] != kNone) continue;
+    // Backwards from the lead's first vertex, then forwards from its second; joined_vertices leaves no
+    // chain closed on itself (its faces would keep no corner).
+    back.clear();
+    uint32_t v = net.edges.vertex[e][0];
+    for (uint32_t g = e; sides.joined[v];) {
+      g = across(v, g);
+      FIRE_ASSERT(g != e, "a chain of joined vertices closed on itself");
+      const uint32_t next = far_end(g, v);
+      back.push_back(g << 1 | (net.edges.vertex[g][1] == v ? 0u : 1u));
+      v = next;
+    }
+    sides.from[e] = v;
+    members.assign(back.rbegin(), back.rend());
+    members.push_back(e << 1);
+    v = net.edges.vertex[e][1];
+    for (uint32_t g = e; sides.joined[v];) {
+      g = across(v, g);
+      members.push_back(g << 1 | (net.edges.vertex[g][0] == v ? 0u : 1u));
+      v = far_end(g, v);
+    }
+    sides.to[e] = v;
+    for (uint32_t m : members) sides.lead[m >> 1] = e;
+  }
+}
+
 // The per-edge and per-face stages, for the elements whose tags say they may have changed, or (edges)
 // whose short-curve scale did.
 void update_elements(const Mesh& net, const Options& options, ReconstructionCache& c, bool everything,
@@ -284,31 +394,49 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
   c.edges.resize(net.edge_slots());
   c.edge_valid.resize(net.edge_slots(), 0);
   c.edge_scale.resize(net.edge_slots(), 1.0);
+  c.edge_members.resize(net.edge_slots());
   c.edge_redone.assign(net.edge_slots(), 0);
   c.faces.resize(net.face_slots());
   c.face_valid.resize(net.face_slots(), 0);
   c.stats = {};
+  build_sides(net, options.method == Method::fire && deviation > 0, c.sides);
+  const Sides& sides = c.sides;
+  std::vector<Vec3> line;
   for (uint32_t e = 0; e < net.edge_slots(); ++e) {
-    if (!net.edge_alive(e) || !used_by_face(net, e)) {
+    const std::vector<uint32_t>& members = sides.members[e];
+    if (members.empty()) {
       c.edges[e] = {};
       c.edge_valid[e] = 0;
       c.edge_scale[e] = 1;
+      c.edge_members[e].clear();
       continue;
     }
-    const auto line = net.polyline(e);
+    // The side as drawn; a short noisy side is taken nearer its chord as a whole.
+    line.clear();
+    for (uint32_t m : members) {
+      const auto drawn = net.polyline(m >> 1);
+      const size_t at = line.size();
+      line.insert(line.end(), drawn.begin(), drawn.end());
+      if (m & 1) std::reverse(line.begin() + std::ptrdiff_t(at), line.end());
+      if (at > 0) line.erase(line.begin() + std::ptrdiff_t(at));  // the joined vertex, once
+    }
     const double scale = short_curve_scale(line, deviation);
-    const bool unchanged = !everything && c.edge_valid[e] && !net.edges.changes.changed_since(e, c.seen);
-    if (unchanged && scale == c.edge_scale[e]) continue;
-    if (unchanged) ++c.stats.edges_rescaled;
-    c.edges[e] = scale < 1 ? split_network_edge(scaled_polyline(line, scale), options.coons_steps)
-                           : split_network_edge(line, options.coons_steps);
+    const bool fresh = everything || !c.edge_valid[e];
+    const bool rejoined = !fresh && c.edge_members[e] != members;
+    bool stamped = false;
+    for (uint32_t m : members) stamped = stamped || net.edges.changes.changed_since(m >> 1, c.seen);
+    const bool rescaled = scale != c.edge_scale[e];
+    if (!fresh && !stamped && !rejoined && !rescaled) continue;
+    if (!fresh && !stamped) ++(rejoined ? c.stats.edges_rejoined : c.stats.edges_rescaled);
+    c.edges[e] = split_network_edge(scale < 1 ? scaled_polyline(line, scale) : line, options.coons_steps);
     c.edge_valid[e] = 1;
     c.edge_scale[e] = scale;
-    c.edge_redone[e] = 1;
+    c.edge_members[e] = members;
+    for (uint32_t m : members) c.edge_redone[m >> 1] = 1;
     ++c.stats.edges_recomputed;
   }
   const FaceSettings settings{options.method, options.coons_steps, options.planarity};
-  std::vector<const EdgeSplits*> splits;
+  std::vector<FaceSide> face_sides;
   for (uint32_t f = 0; f < net.face_slots(); ++f) {
     if (!net.face_alive(f)) {
       c.faces[f] = {};
@@ -319,9 +447,25 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
     bool stale = everything || !c.face_valid[f] || net.faces.changes.changed_since(f, c.seen);
     for (uint32_t oe : loop) stale = stale || c.edge_redone[edge_of(oe)];
     if (!stale) continue;
-    splits.clear();
-    for (uint32_t oe : loop) splits.push_back(&c.edges[edge_of(oe)]);
-    c.faces[f] = build_face_patch(net, f, splits, settings);
+    // One side per run of the loop from a corner that is not joined to the next.
+    const size_t n = loop.size();
+    size_t start = 0;
+    while (sides.joined[net.tail(loop[start])]) ++start;
+    face_sides.clear();
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t oe = loop[(start + i) % n];
+      if (sides.joined[net.tail(oe)]) continue;
+      const uint32_t lead = sides.lead[edge_of(oe)];
+      const std::vector<uint32_t>& members = sides.members[lead];
+      const auto member = std::find_if(members.begin(), members.end(), [&](uint32_t m) { return (m >> 1) == edge_of(oe); });
+      FaceSide side{&c.edges[lead], lead, sides.from[lead], sides.to[lead], is_reversed(oe) != ((*member & 1) != 0), 0, 0};
+      for (uint32_t m : members) {
+        side.length += polyline_length(net.polyline(m >> 1));
+        side.segments += net.edges.point_count[m >> 1] - 1;
+      }
+      face_sides.push_back(side);
+    }
+    c.faces[f] = build_face_patch(face_sides, settings);
     c.face_valid[f] = 1;
     ++c.stats.faces_recomputed;
   }
@@ -336,9 +480,11 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
   base.pieces_per_edge = pieces;
   std::vector<uint32_t> vertex_id(net.vertex_slots(), kNone), edge_first(net.edge_slots(), kNone),
       face_first(net.face_slots(), kNone);
+  const Sides& sides = c.sides;
   for (uint32_t f = 0; f < net.face_slots(); ++f)
     if (net.face_alive(f))
-      for (uint32_t oe : net.face_loop(f)) vertex_id[net.tail(oe)] = 0;
+      for (uint32_t oe : net.face_loop(f))
+        if (!sides.joined[net.tail(oe)]) vertex_id[net.tail(oe)] = 0;
   for (uint32_t v = 0; v < net.vertex_slots(); ++v)
     if (vertex_id[v] != kNone) {
       vertex_id[v] = base.vertex_count();
@@ -378,13 +524,13 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
       }
     }
   }
-  // Drawn curves: the pieces of each network edge, between its vertices and split points.
+  // Drawn curves: the pieces of each side, between its ends and split points.
   for (uint32_t e = 0; e < net.edge_slots(); ++e) {
     if (!c.edge_valid[e]) continue;
     const bool sharp = (net.edges.flags[e] & kSharpEdge) != 0;
     for (uint32_t i = 0; i < pieces; ++i) {
-      const uint32_t a = i == 0 ? vertex_id[net.edges.vertex[e][0]] : edge_first[e] + i - 1;
-      const uint32_t b = i + 1 == pieces ? vertex_id[net.edges.vertex[e][1]] : edge_first[e] + i;
+      const uint32_t a = i == 0 ? vertex_id[sides.from[e]] : edge_first[e] + i - 1;
+      const uint32_t b = i + 1 == pieces ? vertex_id[sides.to[e]] : edge_first[e] + i;
       base.curve_ends.push_back(a);
       base.curve_ends.push_back(b);
       auto leaf = c.edges[e].leaf(i);

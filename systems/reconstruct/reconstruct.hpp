@@ -9,7 +9,9 @@
 //     sampled from an n-sided transfinite patch over the face's polylines (systems/reconstruct/
 //     geometry.hpp); N-1 further Coons steps (linear sampling); a 2-sided face gives 2 quads; then the
 //     base points are fitted so that the Catmull-Clark limit surface passes through the drawn
-//     polylines (least squares with a fairness term, systems/reconstruct/fit.hpp).
+//     polylines (least squares with a fairness term, systems/reconstruct/fit.hpp). A side is a network
+//     edge, or, for noisy curves, the two edges at an inner vertex where only they meet, joined
+//     (UpdateStats::edges_rejoined, ReconstructionState::joined_vertices).
 //
 // Both write a SurfaceMesh: the level-L quads with their vertices' limit positions and limit normals.
 // The network is read, never written. Incremental use: reconstruct_update() keeps the per-edge and
@@ -82,8 +84,8 @@ struct BaseMesh {
   std::vector<Vec3> curve_points;
   std::vector<uint8_t> curve_drawn;
   std::vector<uint8_t> vertex_drawn;  // the vertex is a network vertex or a sample of a network polyline
-  // The drawn curves come first, `pieces_per_edge` consecutive ones per network edge, from its first
-  // vertex to its last.
+  // The drawn curves come first, `pieces_per_edge` consecutive ones per side (a network edge, or edges
+  // joined at vertices the base mesh leaves out), from its first vertex to its last.
   uint32_t pieces_per_edge = 1;
   uint32_t vertex_count() const { return static_cast<uint32_t>(positions.size()); }
   uint32_t face_count() const { return static_cast<uint32_t>(face_offsets.size() - 1); }
@@ -154,6 +156,10 @@ struct UpdateStats {
   // Of those, unchanged edges redone because how much of their shape the surface takes changed with the
   // network's noise (short noisy curves, kShortCurveNoises): their faces are redone too, wherever the edit was.
   size_t edges_rescaled = 0;
+  // Of those, unchanged sides redone because the vertices joined into them changed (joined_vertices in
+  // reconstruct.cpp: an edit at the vertex, or the network's noise crossing kExactCurveNoise): their two
+  // faces are redone too.
+  size_t edges_rejoined = 0;
   size_t faces_recomputed = 0;
   bool topology_rebuilt = false;  // subdivision topology and (fire) the fit's factorization were rebuilt
   uint32_t fit_iterations = 0;    // solves of the fit (fire), each a back-substitution
@@ -174,6 +180,9 @@ class ReconstructionState {
   bool fitting() const;          // a fit runs over the next subdivide_update calls
   // fire: how many curves the last update took nearer their chords as short noisy ones (kShortCurveNoises).
   uint32_t short_curves() const;
+  // fire: how many network vertices the last update joined the two curves at (noisy curves meeting at an
+  // inner vertex of valence 2, which the base mesh leaves out: reconstruct.cpp, joined_vertices).
+  uint32_t joined_vertices() const;
   ReconstructionCache& cache() { return *cache_; }
 
  private:

@@ -25,7 +25,7 @@ network square "$(v 0,0,0),$(v 1,0,0),$(v 1,1,0),$(v 0,1,0)" \
   "$(e 0,1 '[0,0,0],[0.25,0,0.1],[0.5,0,0.15],[0.75,0,0.1],[1,0,0]'),$(e 1,2 '[1,0,0],[1,0.5,0.2],[1,1,0]'),$(e 3,2 '[0,1,0],[0.5,1,0.3],[1,1,0]'),$(e 0,3 '[0,0,0],[0,0.5,0.1],[0,1,0]')" \
   '{"edges":[0,1,2,3],"reversed":[false,false,true,true]}'
 out=$("$fire" reconstruct "$tmp/square.fnet" -o "$tmp/square.obj")
-check "prints one JSON line with the counts" "echo '$out' | grep -q '^{\"method\":\"fire\",\"coons_steps\":1,\"levels\":3,\"base_faces\":4,\"faces\":256,\"vertices\":289,\"seconds\":[0-9.e-]*,\"worst_quad_aspect\":[0-9.e+-]*,\"noise_estimate\":[0-9.e+-]*,\"tangent_spread_deg\":[0-9.e+-]*,\"fairness\":0.001,\"short_curves\":0}$'"
+check "prints one JSON line with the counts" "echo '$out' | grep -q '^{\"method\":\"fire\",\"coons_steps\":1,\"levels\":3,\"base_faces\":4,\"faces\":256,\"vertices\":289,\"seconds\":[0-9.e-]*,\"worst_quad_aspect\":[0-9.e+-]*,\"noise_estimate\":[0-9.e+-]*,\"tangent_spread_deg\":[0-9.e+-]*,\"fairness\":0.001,\"short_curves\":0,\"joined_vertices\":0}$'"
 check "writes the OBJ: 289 vertices with normals, 256 faces" "[ \$(grep -c '^v ' '$tmp/square.obj') -eq 289 ] && [ \$(grep -c '^vn ' '$tmp/square.obj') -eq 289 ] && [ \$(grep -c '^f ' '$tmp/square.obj') -eq 256 ]"
 out=$("$fire" reconstruct "$tmp/square.fnet" -o "$tmp/square.glb" --method thesis --coons-steps 2 --levels 1 --planarity hough)
 check "thesis, 2 Coons steps, level 1" "echo '$out' | grep -q '\"method\":\"thesis\",\"coons_steps\":2,\"levels\":1,\"base_faces\":16,\"faces\":64,\"vertices\":81'"

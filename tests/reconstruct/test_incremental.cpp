@@ -254,3 +254,75 @@ TEST_CASE("smooth curves whose tangents disagree where they meet are fitted as n
   CHECK(tangent_spread_deg(net) == Approx(4.4).margin(0.1));
   CHECK(fit_fairness(Options{}, fit_noise(net)) == Approx(kNoisyFairness));
 }
+
+TEST_CASE("noisy curves meeting at an inner vertex of valence 2 are one side of its faces, exact ones keep it, "
+          "and a change of that equals a rebuild",
+          "[reconstruct][incremental][noise]") {
+  auto noisy = [](double x, double y) { return height(x, y) + 0.03 * std::sin(97 * x + 53 * y); };
+  const Options options;
+  // An inner horizontal curve of a 6 x 4 grid split at its 6th of 20 samples: a vertex of valence 2 between
+  // two faces, which become pentagons.
+  const uint32_t edge = 2 * 6 + 2;
+  auto with_vertex = [&](const Height& h, uint32_t& v) {
+    Mesh net = grid_network(6, 4, 20, h);
+    REQUIRE_FALSE(net.is_border_edge(edge));
+    v = split_edge(net, edge, 5);
+    REQUIRE(net.valence(v) == 2);
+    net.begin_frame(net.frame() + 1);
+    return net;
+  };
+  auto has_vertex_at = [](const BaseMesh& b, const Vec3& p) {
+    return std::any_of(b.positions.begin(), b.positions.end(), [&](const Vec3& q) { return q == p; });
+  };
+  SurfaceMesh surface;
+  uint32_t v = kNone;
+
+  // Exact: the vertex is a base vertex and each pentagon gives 5 quads.
+  Mesh exact = with_vertex(height, v);
+  ReconstructionState exact_state;
+  update(exact, options, exact_state, surface);
+  CHECK(exact_state.joined_vertices() == 0);
+  CHECK(has_vertex_at(exact_state.base(), exact.vertices.position[v]));
+  CHECK(exact_state.base().face_count() == 4 * 24 + 2);
+
+  // Noisy: the two curves are one side, split as the curve they were; the base mesh is the unsplit grid's.
+  Mesh plain = grid_network(6, 4, 20, noisy);
+  REQUIRE(fit_noise(plain) > kExactCurveNoise);
+  const BaseMesh unsplit = [&] {
+    ReconstructionState s;
+    SurfaceMesh out;
+    update(plain, options, s, out);
+    return s.base();
+  }();
+  Mesh net = with_vertex(noisy, v);
+  ReconstructionState state;
+  update(net, options, state, surface);
+  check_equals_full_rebuild(net, options, surface);
+  CHECK(state.joined_vertices() == 1);
+  const BaseMesh joined = state.base();
+  CHECK_FALSE(has_vertex_at(joined, net.vertices.position[v]));
+  CHECK(joined.face_count() == unsplit.face_count());
+  CHECK(joined.vertex_count() == unsplit.vertex_count());
+  std::vector<Vec3> a = joined.curve_points, b = unsplit.curve_points;
+  auto lexical = [](const Vec3& p, const Vec3& q) { return std::lexicographical_compare(p.data(), p.data() + 3, q.data(), q.data() + 3); };
+  std::sort(a.begin(), a.end(), lexical);
+  std::sort(b.begin(), b.end(), lexical);
+  CHECK(a == b);  // the same polylines, split at the same samples
+
+  // One of the two curves made a crease: the vertex is kept again, then joined again once it is smooth.
+  // Only the two faces of the side are redone each time.
+  const std::vector<uint32_t> edges = net.vertex_edges(v);
+  REQUIRE(edges.size() == 2);
+  net.set_edge_flag(edges[0], kSharpEdge, true);
+  update(net, options, state, surface);
+  check_equals_full_rebuild(net, options, surface);
+  CHECK(state.joined_vertices() == 0);
+  CHECK(has_vertex_at(state.base(), net.vertices.position[v]));
+  CHECK(state.last_update().faces_recomputed == 2);
+  net.set_edge_flag(edges[0], kSharpEdge, false);
+  update(net, options, state, surface);
+  check_equals_full_rebuild(net, options, surface);
+  CHECK(state.joined_vertices() == 1);
+  CHECK(state.last_update().faces_recomputed == 2);
+  CHECK(same_bytes(state.base().curve_points, joined.curve_points));
+}

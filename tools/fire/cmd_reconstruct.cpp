@@ -65,6 +65,7 @@ int run_reconstruct(const ReconstructArgs& a) {
   out["tangent_spread_deg"] = spread;
   out["fairness"] = reconstruct::fit_fairness(options, reconstruct::fit_noise(noise, spread));
   out["short_curves"] = state.short_curves();
+  out["joined_vertices"] = state.joined_vertices();
   std::cout << out.dump() << "\n";
   return 0;
 }
@@ -85,9 +86,11 @@ void add_reconstruct_commands(CLI::App& app, Registry& registry) {
       "length), tangent_spread_deg (the median angle by which the curves leaving a vertex lie out of one plane: "
       "over 2, curves with a noise estimate under 3e-4 count as noisy as 3e-3) and fairness (the fit's weight: "
       "--fairness if given, else the default for exact curves raised with the noise estimate: 0.1 from 3e-3 to "
-      "1.3e-2, beyond with its square, up to 1) and short_curves (without --fairness, noisy curves that reach "
+      "1.3e-2, beyond with its square, up to 1), short_curves (without --fairness, noisy curves that reach "
       "less than 6 noise deviations from their ends, which the surface takes nearer their chords, as a chord "
-      "below 3: how many there were).");
+      "below 3: how many there were) and joined_vertices (without --fairness, for noisy curves: inner network "
+      "vertices where just two curves meet, which the surface runs through as through any curve sample "
+      "instead of making them vertices of its base mesh).");
   cmd->add_option("NET", a->network_path, "curve network file (format: engine/NETWORK_FORMAT.md)")->required();
   cmd->add_option("-o,--output", a->out_path, "surface file to write: .obj, .ply, .stl or .glb")->required();
   cmd->add_option("--method", a->method, "thesis or fire")->capture_default_str();
