@@ -148,7 +148,8 @@ TEST_CASE("random edits through the frame: shown in the commit frame, settled wi
     if (rebuilt_from_scratch) {
       rebuilt_from_scratch = false;
     } else if (r.ok) {
-      // Faces near the edit, and those of short noisy curves the edit's change of the noise rescaled.
+      // Faces near the edit, and those of short noisy curves the edit's change of the noise rescaled or of
+      // sides whose joined vertices it changed.
       const size_t bound = local_bound(net, edit_frame) + 2 * (stats.edges_rescaled + stats.edges_rejoined);
       CHECK(stats.faces_recomputed <= bound);
       faces_recomputed += stats.faces_recomputed;
