@@ -411,16 +411,21 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
       c.edge_members[e].clear();
       continue;
     }
-    // The side as drawn; a short noisy side is taken nearer its chord as a whole.
-    line.clear();
-    for (uint32_t m : members) {
-      const auto drawn = net.polyline(m >> 1);
-      const size_t at = line.size();
-      line.insert(line.end(), drawn.begin(), drawn.end());
-      if (m & 1) std::reverse(line.begin() + std::ptrdiff_t(at), line.end());
-      if (at > 0) line.erase(line.begin() + std::ptrdiff_t(at));  // the joined vertex, once
+    // The side as drawn (a lone edge, the common case, read in place); a short noisy side is taken nearer
+    // its chord as a whole.
+    std::span<const Vec3> side = net.polyline(e);
+    if (members.size() > 1) {
+      line.clear();
+      for (uint32_t m : members) {
+        const auto drawn = net.polyline(m >> 1);
+        const size_t at = line.size();
+        line.insert(line.end(), drawn.begin(), drawn.end());
+        if (m & 1) std::reverse(line.begin() + std::ptrdiff_t(at), line.end());
+        if (at > 0) line.erase(line.begin() + std::ptrdiff_t(at));  // the joined vertex, once
+      }
+      side = line;
     }
-    const double scale = short_curve_scale(line, deviation);
+    const double scale = short_curve_scale(side, deviation);
     const bool fresh = everything || !c.edge_valid[e];
     const bool rejoined = !fresh && c.edge_members[e] != members;
     bool stamped = false;
@@ -428,7 +433,8 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
     const bool rescaled = scale != c.edge_scale[e];
     if (!fresh && !stamped && !rejoined && !rescaled) continue;
     if (!fresh && !stamped) ++(rejoined ? c.stats.edges_rejoined : c.stats.edges_rescaled);
-    c.edges[e] = split_network_edge(scale < 1 ? scaled_polyline(line, scale) : line, options.coons_steps);
+    c.edges[e] = scale < 1 ? split_network_edge(scaled_polyline(side, scale), options.coons_steps)
+                           : split_network_edge(side, options.coons_steps);
     c.edge_valid[e] = 1;
     c.edge_scale[e] = scale;
     c.edge_members[e] = members;
