@@ -56,7 +56,8 @@ struct FitWeights {
   // umbrella of the change from the initial base points (the transfinite patches, which do not fold)
   // costs too, with this weight (same scale as `fairness`) times min((aspect / shape_aspect - 1)^2, 1)
   // per vertex of a quad whose aspect (quad_aspect) exceeds `shape_aspect`. The reconstruction scales
-  // it with the curves' noise, as the fairness: none for exact curves, this at kNoisyFairness.
+  // it with the curves' noise, as the fairness: the exact curves' fairness for exact curves, this at
+  // kNoisyFairness (fit_weights in reconstruct.cpp).
   // perf/RESULTS.md, "Thin quads keep their transfinite shape; the fairness follows the noise", has
   // the sweeps.
   double shape = 0.1;

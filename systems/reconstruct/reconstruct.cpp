@@ -605,13 +605,19 @@ double curve_noise_deviation(const Options& options, double noise, double spread
   return std::max(noise, turned) * mean_length;
 }
 
-// The shape term comes with the noise too: exact curves are followed as drawn (it would cost the rook's
-// exact network its rms goal), noisy hand-drawn ones keep their thin quads' transfinite shape.
+// The shape term comes with the noise too: noisy hand-drawn curves keep their thin quads' transfinite
+// shape. Exact curves are followed as drawn, so for them it weighs only as much as their fairness: the
+// full weight would cost the rook's exact network its rms goal, none lets a sliver's quads fold (the
+// rook K = 2 network's face 186; perf/RESULTS.md). An explicit --fairness has none.
 FitWeights fit_weights(const Options& options, double noise) {
   FitWeights weights;
   weights.fairness = fit_fairness(options, noise);
+  if (!options.fairness_from_noise || !(kNoisyFairness > options.fairness)) {
+    weights.shape = 0;
+    return weights;
+  }
   const double noisy = (weights.fairness - options.fairness) / (kNoisyFairness - options.fairness);
-  weights.shape = kNoisyFairness > options.fairness ? weights.shape * std::clamp(noisy, 0.0, 1.0) : 0;
+  weights.shape = std::max(weights.shape * std::clamp(noisy, 0.0, 1.0), options.fairness);
   return weights;
 }
 

@@ -2,7 +2,8 @@
 # `fire reconstruct` without folds (perf/folds.py counts face pairs over 60 degrees):
 # - the rook's K = 2 network without noise (perf/quality.sh's row): the curve along the foot's widest ring
 #   bends faster than the surface can follow, and when the fit's targets could gather there the surface
-#   folded across it (338 pairs);
+#   folded across it (338 pairs); its last 2 pairs were in one sliver triangle (face 186, a corner of 148
+#   degrees), which went when exact curves kept their thin quads' shape term at the fairness's weight;
 # - the rook's K = 2 network at 2 % noise: the 24 curves 0.0013 long around the hole in its bottom become
 #   scribbles as long as the noise, which crossed their neighbours' and folded the surface there (31 pairs;
 #   10 while such curves only weighed less in the fit), until the surface took such short curves nearer
@@ -22,11 +23,10 @@ status=0
 "$fire" reconstruct "$tmp/rook.fnet" -o "$tmp/rook.obj" >/dev/null || exit 1
 python3 "$folds" "$tmp/rook.obj" >"$tmp/rook.json" || exit 1
 pairs=$(count pairs_over_60_deg "$tmp/rook.json")
-# 7 measured on 2026-12-02; a few more would be a changed sum order, hundreds the gathering again.
-if [ -n "$pairs" ] && [ "$pairs" -le 10 ]; then
-  echo "ok: rook K=2, $pairs face pairs over 60 degrees"
+if [ "$pairs" = 0 ]; then
+  echo "ok: rook K=2, no face pair over 60 degrees"
 else
-  echo "FAILED: rook K=2, ${pairs:-?} face pairs over 60 degrees (at most 10)"; status=1
+  echo "FAILED: rook K=2, ${pairs:-?} face pairs over 60 degrees (0)"; status=1
 fi
 
 "$fire" network-from-mesh "$meshes/rook.obj" --unrefine 2 --noise 2 --seed 1 --limit -o "$tmp/rook2.fnet" >/dev/null || exit 1
