@@ -236,7 +236,7 @@ double worst_quad_aspect(const BaseMesh& base) {
   return worst;
 }
 
-Status check_reconstruction_input(const Mesh& net, const Options& options) {
+Status check_options(const Options& options) {
   if (options.coons_steps < 1 || options.coons_steps > kMaxCoonsSteps)
     return Status::failure("the number of Coons steps must be 1 to " + std::to_string(kMaxCoonsSteps) + ", not " +
                            std::to_string(options.coons_steps));
@@ -247,6 +247,11 @@ Status check_reconstruction_input(const Mesh& net, const Options& options) {
     return Status::failure("the fairness weight must be 0 to 1, not " + std::to_string(options.fairness));
   if (options.fit_solves_per_frame < 1)
     return Status::failure("the fit's back-substitutions per frame must be at least 1");
+  return Status::success();
+}
+
+Status check_reconstruction_input(const Mesh& net, const Options& options) {
+  if (Status s = check_options(options); !s) return s;
   if (std::string problem = net.validate(); !problem.empty()) return Status::failure("invalid network: " + problem);
   if (net.face_count() == 0) return Status::failure("the network has no faces");
   for (uint32_t e = 0; e < net.edge_slots(); ++e) {

@@ -198,7 +198,9 @@ struct SurfaceBuild {
   uint64_t updates = 0;        // refine updates that produced a new base mesh
 };
 
-// Rejects, with the element and the problem named: options out of range, a network that breaks its
+// Rejects options out of range, with the option and its range named.
+Status check_options(const Options& options);
+// Rejects, with the element and the problem named: options out of range (check_options), a network that breaks its
 // invariants (non-finite coordinates included), no faces, a face with fewer than 3 edges (thesis), a
 // polyline of zero length, two consecutive polyline points that coincide, two corners of a face that
 // coincide.

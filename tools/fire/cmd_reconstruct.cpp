@@ -8,16 +8,15 @@
 #include "platform/surface_io.hpp"
 #include "systems/reconstruct/reconstruct.hpp"
 #include "tools/fire/commands.hpp"
+#include "tools/fire/surface_args.hpp"
 
 namespace fire::cli {
 
 namespace {
 
 struct ReconstructArgs {
-  std::string network_path, out_path, method = "fire", planarity = "least-squares";
-  uint32_t coons_steps = 1, levels = 3;
-  double fairness = reconstruct::Options{}.fairness;
-  bool fairness_given = false;
+  std::string network_path, out_path;
+  SurfaceArgs surface;
 };
 
 int fail(const std::string& message) {
@@ -25,19 +24,10 @@ int fail(const std::string& message) {
   return 1;
 }
 
-int run_reconstruct(const ReconstructArgs& a) {
-  reconstruct::Options options;
-  if (a.method == "fire") options.method = reconstruct::Method::fire;
-  else if (a.method == "thesis") options.method = reconstruct::Method::thesis;
-  else return fail("--method must be thesis or fire, not '" + a.method + "'");
-  if (a.planarity == "least-squares") options.planarity = reconstruct::Planarity::least_squares;
-  else if (a.planarity == "mean-normal") options.planarity = reconstruct::Planarity::mean_normal;
-  else if (a.planarity == "hough") options.planarity = reconstruct::Planarity::hough;
-  else return fail("--planarity must be least-squares, mean-normal or hough, not '" + a.planarity + "'");
-  options.coons_steps = a.coons_steps;
-  options.levels = a.levels;
-  options.fairness = a.fairness;
-  options.fairness_from_noise = !a.fairness_given;
+int run_reconstruct(const ReconstructArgs& a, const CLI::App& cmd) {
+  auto parsed = surface_options(a.surface, cmd);
+  if (!parsed) return fail(parsed.error());
+  const reconstruct::Options& options = *parsed;
   // The output's format is checked first, so a wrong extension costs no reconstruction.
   if (auto format = surface_format_of(a.out_path); !format) return fail(format.error());
   auto net = load_network(a.network_path);
@@ -52,7 +42,7 @@ int run_reconstruct(const ReconstructArgs& a) {
   if (auto written = write_surface(surface, a.out_path); !written) return fail(written.error);
 
   nlohmann::ordered_json out;
-  out["method"] = a.method;
+  out["method"] = a.surface.method;
   out["coons_steps"] = options.coons_steps;
   out["levels"] = options.levels;
   out["base_faces"] = state.base().face_count();
@@ -93,22 +83,8 @@ void add_reconstruct_commands(CLI::App& app, Registry& registry) {
       "instead of making them vertices of its base mesh).");
   cmd->add_option("NET", a->network_path, "curve network file (format: engine/NETWORK_FORMAT.md)")->required();
   cmd->add_option("-o,--output", a->out_path, "surface file to write: .obj, .ply, .stl or .glb")->required();
-  cmd->add_option("--method", a->method, "thesis or fire")->capture_default_str();
-  cmd->add_option("--coons-steps", a->coons_steps, "N: Coons refinement steps (1 to 5)")->capture_default_str();
-  cmd->add_option("--levels", a->levels, "L: Catmull-Clark levels (1 to 6)")->capture_default_str();
-  cmd->add_option("--fairness", a->fairness,
-                  "fire: weight of the fit's smoothness term, 0 to 1 (smaller follows the curves more closely, larger "
-                  "keeps face interiors smoother). Default: this for exact curves, raised with the noise the "
-                  "polylines show (0.1 for a noise estimate of 3e-3 to 1.3e-2, beyond with its square, up to 1); given, it "
-                  "is used as is")
-      ->capture_default_str();
-  cmd->add_option("--planarity", a->planarity,
-                  "the thesis triquadrification's measure: least-squares, mean-normal or hough")
-      ->capture_default_str();
-  cmd->callback([a, cmd, &registry] {
-    a->fairness_given = cmd->count("--fairness") > 0;
-    registry.exit_code = run_reconstruct(*a);
-  });
+  add_surface_options(*cmd, a->surface);
+  cmd->callback([a, cmd, &registry] { registry.exit_code = run_reconstruct(*a, *cmd); });
 }
 
 }  // namespace fire::cli

@@ -14,6 +14,7 @@
 #include "platform/render/renderer.hpp"
 #include "systems/reconstruct/reconstruct.hpp"
 #include "tools/fire/commands.hpp"
+#include "tools/fire/surface_args.hpp"
 #include "tools/fire/session.hpp"
 #include "tools/fire/session_rig.hpp"
 
@@ -23,7 +24,8 @@ namespace {
 
 struct RenderArgs {
   std::string input_path, out_path, size = "1280x720", view = "iso", reference_path, png_dir, rig_path;
-  uint32_t levels = 3, every = 0;
+  uint32_t every = 0;
+  SurfaceArgs surface;
 };
 
 int fail(const std::string& message) {
@@ -72,14 +74,15 @@ Result<Mesh> load_input(const std::string& path, const std::string& rig_path) {
 // frames after the previous picture whose network changed is reconstructed incrementally, uploaded by
 // changed range and written to DIR/frame_NNNNNN.png; one JSON line per picture says what was uploaded.
 // The camera frames the final network, so the pictures line up.
-int render_sequence(const RenderArgs& a, const Mesh& final_network, render::Renderer& renderer, const render::Camera& camera) {
+int render_sequence(const RenderArgs& a, const reconstruct::Options& options, const Mesh& final_network,
+                    render::Renderer& renderer, const render::Camera& camera) {
   std::error_code error;
   std::filesystem::create_directories(a.png_dir, error);
   if (error) return fail(a.png_dir + ": cannot create the directory (" + error.message() + ")");
   auto loaded = world_for_log(a.input_path, a.rig_path);
   if (!loaded) return fail(loaded.error());
   std::unique_ptr<World> world = std::move(*loaded);
-  world->surface_options.levels = a.levels;
+  world->surface_options = options;
 
   Status status;
   uint64_t last_picture = 0;
@@ -123,7 +126,7 @@ int render_sequence(const RenderArgs& a, const Mesh& final_network, render::Rend
   return 0;
 }
 
-int run_render(const RenderArgs& a) {
+int run_render(const RenderArgs& a, const CLI::App& cmd) {
   uint32_t width = 0, height = 0;
   char tail = 0;
   if (std::sscanf(a.size.c_str(), "%ux%u%c", &width, &height, &tail) != 2 || width == 0 || height == 0 ||
@@ -135,8 +138,8 @@ int run_render(const RenderArgs& a) {
   if (a.every && (a.png_dir.empty() || ends_with(a.input_path, ".fnet")))
     return fail("--every needs an input log and --png-dir DIR");
   if (!a.every && !ends_with(a.out_path, ".png")) return fail(a.out_path + ": the output must be a .png file");
-  if (a.levels < 1 || a.levels > reconstruct::kMaxSurfaceLevels)
-    return fail("--levels must be 1 to " + std::to_string(reconstruct::kMaxSurfaceLevels));
+  auto options = surface_options(a.surface, cmd);
+  if (!options) return fail(options.error());
 
   // The reference's triangles (faces as fans), read before anything expensive.
   std::vector<Vec3> reference_positions;
@@ -155,13 +158,11 @@ int run_render(const RenderArgs& a) {
   if (!a.rig_path.empty() && ends_with(a.input_path, ".fnet")) return fail("--rig is for an input log, not a network");
   auto network = load_input(a.input_path, a.rig_path);
   if (!network) return fail(network.error());
-  reconstruct::Options options;
-  options.levels = a.levels;
   SurfaceLevels surface;
-  auto built = reconstruct::reconstruct_surface(*network, options);
+  auto built = reconstruct::reconstruct_surface(*network, *options);
   if (!built) std::cerr << "fire render: no surface, drawing the curves only: " << built.error() << "\n";
   else if (!assign_quads(*built, 1, surface)) return fail("internal error: the reconstructed surface is not all quads");
-  surface.level = a.levels;
+  surface.level = options->levels;
 
   render::Box box;
   for (uint32_t e = 0; e < network->edge_slots(); ++e)
@@ -177,7 +178,7 @@ int run_render(const RenderArgs& a) {
   if (!renderer) return fail(renderer.error());
   Status drawn = (*renderer)->set_reference(reference_positions, reference_triangles);
   if (drawn && a.every) {
-    const int code = render_sequence(a, *network, **renderer, render::frame_box(box, *view, width, height));
+    const int code = render_sequence(a, *options, *network, **renderer, render::frame_box(box, *view, width, height));
     const size_t messages = (*context)->validation_message_count();
     renderer->reset();
     context->reset();
@@ -218,7 +219,7 @@ void add_render_commands(CLI::App& app, Registry& registry) {
   CLI::App* cmd = app.add_subcommand("render", "Render a curve network and its surface to a PNG, headless");
   cmd->footer(
       "NET is a curve network (.fnet, engine/NETWORK_FORMAT.md); any other file is read as an input log and "
-      "replayed headless first. The network is reconstructed (the fire method) and drawn with Vulkan, offscreen: "
+      "replayed headless first. The network is reconstructed as `fire reconstruct` does with the same options and drawn with Vulkan, offscreen: "
       "the lit surface, the curves over it, the vertices as markers, the reference mesh see-through. Without a "
       "GPU, Vulkan runs on lavapipe (Debian package mesa-vulkan-drivers). FIRE_VK_VALIDATION=1 turns the "
       "validation layer on; any message then fails the command. Prints one JSON line: output, width, height, "
@@ -234,11 +235,11 @@ void add_render_commands(CLI::App& app, Registry& registry) {
   cmd->add_option("--size", a->size, "WIDTHxHEIGHT in pixels")->capture_default_str();
   cmd->add_option("--view", a->view, "iso, front, top, side or bottom (Z up)")->capture_default_str();
   cmd->add_option("--reference", a->reference_path, "OBJ mesh drawn see-through over the scene");
-  cmd->add_option("--levels", a->levels, "Catmull-Clark levels of the surface (1 to 6)")->capture_default_str();
+  add_surface_options(*cmd, a->surface);
   cmd->add_option("--rig", a->rig_path,
                   "rig file from fire calibrate, for an input log of Wii Remote reports (fire simulate drawing, a "
                   "session's input.log): its reports go through the triangulation system as in fire replay --rig");
-  cmd->callback([a, &registry] { registry.exit_code = run_render(*a); });
+  cmd->callback([a, cmd, &registry] { registry.exit_code = run_render(*a, *cmd); });
 }
 
 }  // namespace fire::cli

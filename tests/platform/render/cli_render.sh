@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # `fire render` as a user runs it, on lavapipe or a GPU with the validation layer on (FIRE_VK_VALIDATION=1
-# from ctest): a network and an input log become PNGs of the asked size; bad input (no Vulkan device, a
+# from ctest): a network and an input log become PNGs of the asked size, with `fire reconstruct`'s surface
+# options; bad input (no Vulkan device, a
 # reference mesh that does not load, a PNG that cannot be written, a bad view or size, a log of Wii Remote
 # reports without its --rig) exits 1 with a message saying what is wrong, and writes nothing.
 set -u
@@ -28,6 +29,24 @@ check "a network renders (exit 0, nothing on stderr)" "[ $rc -eq 0 ] && [ ! -s '
 check "prints one JSON line with the device and the counts" \
   "echo '$out' | grep -q '^{\"output\":\"$tmp/net.png\",\"width\":400,\"height\":300,\"view\":\"front\",\"device\":\"[^\"]*\",\"edges\":32,\"surface_quads\":3264,\"bytes_uploaded\":[1-9][0-9]*,\"validation\":true}$'"
 check "writes a 400x300 PNG" "is_png '$tmp/net.png' && [ \"\$(png_size '$tmp/net.png')\" = '400 300' ]"
+
+# The surface options are `fire reconstruct`'s: the picture shows the surface that command exports.
+out=$("$fire" render "$here/data/sketch.fnet" -o "$tmp/steps.png" --size 400x300 --view front --coons-steps 2 --levels 2 --fairness 0.05 2>"$tmp/err"); rc=$?
+check "--coons-steps, --levels and --fairness reach the reconstruction (2 steps at level 2: 3264 quads again)" \
+  "[ $rc -eq 0 ] && echo '$out' | grep -q '\"surface_quads\":3264,'"
+"$fire" reconstruct "$here/data/sketch.fnet" -o "$tmp/steps.obj" --coons-steps 2 --levels 2 --fairness 0.05 >/dev/null
+"$fire" reconstruct "$here/data/sketch.fnet" -o "$tmp/default.obj" >/dev/null
+"$fire" render "$here/data/sketch.fnet" -o "$tmp/steps-noise.png" --size 400x300 --view front --coons-steps 2 --levels 2 >/dev/null
+check "that surface is not the default one, nor the one with the fairness from the noise" \
+  "! cmp -s '$tmp/steps.png' '$tmp/net.png' && ! cmp -s '$tmp/steps.png' '$tmp/steps-noise.png' && ! cmp -s '$tmp/steps.obj' '$tmp/default.obj'"
+out=$("$fire" render "$here/data/sketch.fnet" -o "$tmp/thesis.png" --size 400x300 --method thesis --levels 2 2>"$tmp/err"); rc=$?
+check "--method thesis renders the thesis's surface" "[ $rc -eq 0 ] && echo '$out' | grep -q '\"surface_quads\":[1-9]'"
+expect_error "Coons steps out of range" "fire render: the number of Coons steps must be 1 to 5, not 9" "$tmp/c9.png" \
+  "$fire" render "$here/data/sketch.fnet" -o "$tmp/c9.png" --coons-steps 9
+expect_error "an unknown method" "fire render: --method must be thesis or fire" "$tmp/m.png" \
+  "$fire" render "$here/data/sketch.fnet" -o "$tmp/m.png" --method magic
+expect_error "a fairness out of range" "fire render: the fairness weight must be 0 to 1" "$tmp/f.png" \
+  "$fire" render "$here/data/sketch.fnet" -o "$tmp/f.png" --fairness 2
 
 "$fire" render "$log" -o "$tmp/log.png" --size 320x180 --view top >"$tmp/stdout" 2>"$tmp/err"; rc=$?
 check "an input log is replayed and rendered" "[ $rc -eq 0 ] && is_png '$tmp/log.png' && [ \"\$(png_size '$tmp/log.png')\" = '320 180' ]"

@@ -1,0 +1,41 @@
+#include "tools/fire/surface_args.hpp"
+
+namespace fire::cli {
+
+void add_surface_options(CLI::App& cmd, SurfaceArgs& a) {
+  cmd.add_option("--method", a.method, "thesis or fire")->capture_default_str();
+  cmd.add_option("--coons-steps", a.coons_steps,
+                 "N: Coons refinement steps (1 to " + std::to_string(reconstruct::kMaxCoonsSteps) + ")")
+      ->capture_default_str();
+  cmd.add_option("--levels", a.levels,
+                 "L: Catmull-Clark levels (1 to " + std::to_string(reconstruct::kMaxSurfaceLevels) + ")")
+      ->capture_default_str();
+  cmd.add_option("--fairness", a.fairness,
+                 "fire: weight of the fit's smoothness term, 0 to 1 (smaller follows the curves more closely, larger "
+                 "keeps face interiors smoother). Default: this for exact curves, raised with the noise the "
+                 "polylines show (0.1 for a noise estimate of 3e-3 to 1.3e-2, beyond with its square, up to 1); given, it "
+                 "is used as is")
+      ->capture_default_str();
+  cmd.add_option("--planarity", a.planarity, "the thesis triquadrification's measure: least-squares, mean-normal or hough")
+      ->capture_default_str();
+}
+
+Result<reconstruct::Options> surface_options(const SurfaceArgs& a, const CLI::App& cmd) {
+  using R = Result<reconstruct::Options>;
+  reconstruct::Options options;
+  if (a.method == "fire") options.method = reconstruct::Method::fire;
+  else if (a.method == "thesis") options.method = reconstruct::Method::thesis;
+  else return R::failure("--method must be thesis or fire, not '" + a.method + "'");
+  if (a.planarity == "least-squares") options.planarity = reconstruct::Planarity::least_squares;
+  else if (a.planarity == "mean-normal") options.planarity = reconstruct::Planarity::mean_normal;
+  else if (a.planarity == "hough") options.planarity = reconstruct::Planarity::hough;
+  else return R::failure("--planarity must be least-squares, mean-normal or hough, not '" + a.planarity + "'");
+  options.coons_steps = a.coons_steps;
+  options.levels = a.levels;
+  options.fairness = a.fairness;
+  options.fairness_from_noise = cmd.count("--fairness") == 0;
+  if (Status s = reconstruct::check_options(options); !s) return R::failure(s.error);
+  return options;
+}
+
+}  // namespace fire::cli

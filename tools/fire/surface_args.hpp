@@ -1,0 +1,25 @@
+#pragma once
+// The surface options of the commands that reconstruct a network once (reconstruct, render), written once so
+// that a picture can show exactly the surface an export holds.
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "engine/common.hpp"
+#include "systems/reconstruct/reconstruct.hpp"
+
+namespace fire::cli {
+
+struct SurfaceArgs {
+  std::string method = "fire", planarity = "least-squares";
+  uint32_t coons_steps = reconstruct::Options{}.coons_steps;
+  uint32_t levels = reconstruct::Options{}.levels;
+  double fairness = reconstruct::Options{}.fairness;
+};
+
+// --method, --coons-steps, --levels, --fairness and --planarity on `cmd`.
+void add_surface_options(CLI::App& cmd, SurfaceArgs& args);
+// The options they give (an explicit --fairness is used as is), or what is wrong with them. Call after
+// parsing: it asks `cmd` whether --fairness was given.
+Result<reconstruct::Options> surface_options(const SurfaceArgs& args, const CLI::App& cmd);
+
+}  // namespace fire::cli
