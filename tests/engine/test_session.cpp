@@ -260,6 +260,37 @@ void report(const char* what, int runs, size_t lost, const std::string& covered,
 
 }  // namespace
 
+TEST_CASE("a session's settings keep every surface option, and one out of range is refused by name", "[session]") {
+  World w;
+  w.surface_options.method = reconstruct::Method::thesis;
+  w.surface_options.coons_steps = 3;
+  w.surface_options.levels = 2;
+  w.surface_options.planarity = reconstruct::Planarity::hough;
+  w.surface_options.fairness = 0.25;
+  w.surface_options.fairness_from_noise = false;
+  const std::string text = settings_json(w);
+  World back;
+  REQUIRE(apply_settings_json(text, "settings.json", back).ok());
+  CHECK(back.surface_options == w.surface_options);
+
+  auto refused = [&](const std::string& key, const std::string& value) {
+    std::string bad = text;
+    const size_t at = bad.find("\"" + key + "\":");
+    REQUIRE(at != std::string::npos);
+    const size_t from = at + key.size() + 3, to = bad.find_first_of(",}", from);
+    bad.replace(from, to - from, value);
+    World other;
+    const Status s = apply_settings_json(bad, "settings.json", other);
+    CHECK(!s.ok());
+    return s.error;
+  };
+  CHECK(refused("coons_steps", "9") == "settings.json: the number of Coons steps must be 1 to 5, not 9");
+  CHECK(refused("levels", "0") == "settings.json: the subdivision level must be 1 to 6, not 0");
+  CHECK(refused("fairness", "2") == "settings.json: the fairness weight must be 0 to 1, not 2.000000");
+  CHECK(refused("planarity", "3") == "settings.json: a setting is out of range");
+  CHECK(refused("coons_steps", "4294967297") == "settings.json: a setting is out of range");
+}
+
 TEST_CASE("a session log's torn last record is dropped and counted, corruption before it refused", "[session]") {
   std::string log = "FIRE-LOG 1\n0 down\n";
   log += format_durable(0, log.size());

@@ -97,19 +97,21 @@ Status apply_settings_json(std::string_view text, const std::string& source, Wor
   const double snap = j["snap_distance"], fairness = j["fairness"];
   const uint64_t close = j["close_samples"], coons = j["coons_steps"], levels = j["levels"], planarity = j["planarity"];
   const std::string method = j["method"];
-  if (!(snap > 0) || close < 2 || close > 1'000'000 || (method != "fire" && method != "thesis") || coons < 1 ||
-      coons > reconstruct::kMaxCoonsSteps || levels < 1 || levels > reconstruct::kMaxSurfaceLevels ||
-      planarity > static_cast<uint64_t>(reconstruct::Planarity::least_squares) || !(fairness >= 0 && fairness <= 1))
+  if (!(snap > 0) || close < 2 || close > 1'000'000 || (method != "fire" && method != "thesis") ||
+      coons > UINT32_MAX || levels > UINT32_MAX || planarity > static_cast<uint64_t>(reconstruct::Planarity::hough))
     return fail("a setting is out of range");
+  reconstruct::Options surface = w.surface_options;
+  surface.method = method == "fire" ? reconstruct::Method::fire : reconstruct::Method::thesis;
+  surface.coons_steps = static_cast<uint32_t>(coons);
+  surface.levels = static_cast<uint32_t>(levels);
+  surface.planarity = static_cast<reconstruct::Planarity>(planarity);
+  surface.fairness = fairness;
+  surface.fairness_from_noise = from_noise;
+  if (Status s = reconstruct::check_options(surface); !s) return fail(s.error);
   w.sketch_settings.snap_distance = snap;
   w.sketch_settings.close_samples = static_cast<uint32_t>(close);
   w.build_surface = j["surface"];
-  w.surface_options.method = method == "fire" ? reconstruct::Method::fire : reconstruct::Method::thesis;
-  w.surface_options.coons_steps = static_cast<uint32_t>(coons);
-  w.surface_options.levels = static_cast<uint32_t>(levels);
-  w.surface_options.planarity = static_cast<reconstruct::Planarity>(planarity);
-  w.surface_options.fairness = fairness;
-  w.surface_options.fairness_from_noise = from_noise;
+  w.surface_options = surface;
   return Status::success();
 }
 
