@@ -100,6 +100,15 @@ class LocalMesh {
     const uint32_t c = static_cast<uint32_t>(edges[oe >> 1].first_child);
     return (oe & 1) ? (c << 1 | 1u) : ((c + 1) << 1);
   }
+  // The split points of a network edge's piece below the face's own steps, in walk order.
+  void append_finer_points(uint32_t oe, std::vector<VertexRef>& out) const {
+    const LocalEdge& edge = edges[oe >> 1];
+    if (!edge.splits || edge.node >= edge.splits->leaf_count()) return;
+    const uint32_t level = static_cast<uint32_t>(std::bit_width(edge.node)) - 1;
+    const uint32_t span = 1u << (edge.splits->depth - level), first = (edge.node - (1u << level)) * span;
+    for (uint32_t i = 1; i < span; ++i)
+      out.push_back({RefKind::edge_point, edge.network_edge, (oe & 1) ? first + span - i : first + i});
+  }
   VertexRef mid(uint32_t oe) const { return edges[edges[oe >> 1].first_child].to; }
   Vec3 mid_position(uint32_t oe) const { return edges[edges[oe >> 1].first_child].line().back(); }
   double mid_walk_param(uint32_t oe) const {
@@ -303,8 +312,13 @@ FacePatch build_face_patch(std::span<const FaceSide> sides, const FaceSettings& 
   }
 
   patch.interior = mesh.interior;
-  for (const auto& f : faces)
-    for (uint32_t oe : f) patch.quads.push_back(mesh.tail(oe));
+  for (const auto& f : faces) {
+    for (uint32_t oe : f) {
+      patch.corners.push_back(mesh.tail(oe));
+      mesh.append_finer_points(oe, patch.corners);
+    }
+    patch.face_offsets.push_back(static_cast<uint32_t>(patch.corners.size()));
+  }
   for (const LocalEdge& e : mesh.edges) {
     if (e.splits || e.first_child >= 0) continue;
     patch.curve_ends.push_back(e.from);

@@ -63,9 +63,9 @@ struct LimitFit::Impl {
   uint32_t base_vertices = 0;
   SparseRows rows;  // limit positions of the selected level-L vertices, from base points
   Sparse rows_by_column;  // the same by column: rows^T times the targets as one gather per base point
-  // Per network edge, its rows in order along it (ends included) and its curves (pieces).
+  // Per side, its rows in order along it (ends included), its first curve and how many pieces it has.
   std::vector<std::vector<Eigen::Index>> paths;
-  std::vector<uint32_t> path_first_curve;
+  std::vector<uint32_t> path_first_curve, path_pieces;
   std::vector<Eigen::Index> vertex_row;  // row of each drawn base vertex (-1 for the others)
   double ridge = 0;
   Sparse shape;  // the shape term's matrix (empty when no base quad is thin): its pull is shape * initial
@@ -233,8 +233,7 @@ Result<LimitFit> LimitFit::build(const subdivide::Refinement& refinement, const 
     const uint32_t a = level0.edge_vertices[2 * e], b = level0.edge_vertices[2 * e + 1];
     edge_of_pair[uint64_t(std::min(a, b)) << 32 | std::max(a, b)] = e;
   }
-  // Rows: the drawn base vertices, then the inner level-L vertices of
-  // every drawn curve, network edge by network edge.
+  // Rows: the drawn base vertices, then the inner level-L vertices of every drawn curve, side by side.
   std::vector<uint32_t> selected;
   impl->vertex_row.assign(nb, -1);
   for (uint32_t v = 0; v < nb; ++v)
@@ -243,22 +242,24 @@ Result<LimitFit> LimitFit::build(const subdivide::Refinement& refinement, const 
       selected.push_back(subdivide::last_level_vertex(refinement, v));
     }
   std::vector<uint32_t> chain;
-  for (uint32_t c = 0; c < base.curve_count() && base.curve_drawn[c]; ++c) {
-    const uint32_t a = base.curve_ends[2 * c], b = base.curve_ends[2 * c + 1];
-    if (c % base.pieces_per_edge == 0) {
-      impl->paths.push_back({impl->vertex_row[a]});
-      impl->path_first_curve.push_back(c);
+  for (uint32_t s = 0; s < base.side_count(); ++s) {
+    const uint32_t first = base.side_curve_offsets[s], end = base.side_curve_offsets[s + 1];
+    impl->paths.push_back({impl->vertex_row[base.curve_ends[2 * first]]});
+    impl->path_first_curve.push_back(first);
+    impl->path_pieces.push_back(end - first);
+    for (uint32_t c = first; c < end; ++c) {
+      const uint32_t a = base.curve_ends[2 * c], b = base.curve_ends[2 * c + 1];
+      auto it = edge_of_pair.find(uint64_t(std::min(a, b)) << 32 | std::max(a, b));
+      if (it == edge_of_pair.end())
+        return Result<LimitFit>::failure("internal error: curve " + std::to_string(c) + " is not a base edge");
+      chain.clear();
+      subdivide::vertices_along_edge(refinement, 0, it->second, a, chain);
+      for (size_t k = 1; k < chain.size(); ++k) {
+        impl->paths.back().push_back(Eigen::Index(selected.size()));
+        selected.push_back(chain[k]);
+      }
+      impl->paths.back().push_back(impl->vertex_row[b]);
     }
-    auto it = edge_of_pair.find(uint64_t(std::min(a, b)) << 32 | std::max(a, b));
-    if (it == edge_of_pair.end())
-      return Result<LimitFit>::failure("internal error: curve " + std::to_string(c) + " is not a base edge");
-    chain.clear();
-    subdivide::vertices_along_edge(refinement, 0, it->second, a, chain);
-    for (size_t k = 1; k < chain.size(); ++k) {
-      impl->paths.back().push_back(Eigen::Index(selected.size()));
-      selected.push_back(chain[k]);
-    }
-    impl->paths.back().push_back(impl->vertex_row[b]);
   }
 
   subdivide::StencilTable table;
@@ -467,7 +468,7 @@ bool FitRun::advance(uint32_t solves) {
 // resume runs exactly one (and the target updates up to the next); the body starts eagerly (steps.hpp),
 // so the setup above the first one runs in FitRun's constructor, the only place `base` is read.
 Steps<FitRun::Fitted> FitRun::fit_steps(const LimitFit::Impl& m, const BaseMesh& base) {
-  const uint32_t nb = m.base_vertices, pieces = base.pieces_per_edge;
+  const uint32_t nb = m.base_vertices;
   Eigen::MatrixX3d targets(m.rows.rows(), 3), initial(nb, 3);
   for (uint32_t v = 0; v < nb; ++v) {
     initial.row(v) = base.positions[v].transpose();
@@ -478,6 +479,7 @@ Steps<FitRun::Fitted> FitRun::fit_steps(const LimitFit::Impl& m, const BaseMesh&
   std::vector<Vec3> line;
   for (size_t p = 0; p < m.paths.size(); ++p) {
     const std::vector<Eigen::Index>& rows = m.paths[p];
+    const uint32_t pieces = m.path_pieces[p];
     const size_t steps = (rows.size() - 1) / pieces;
     line.clear();
     for (uint32_t i = 0; i < pieces; ++i) {
@@ -639,15 +641,12 @@ Steps<FitRun::Fitted> FitRun::fit_steps(const LimitFit::Impl& m, const BaseMesh&
   const double feet_distance = distance_to_curves();
   // Phase 3: the split points settle on polyline samples, and each piece is fitted between them.
   std::vector<Span> split;
-  if (pieces > 1) {
-    for (const Span& span : whole) snap_split_points(span, pieces, targets, split);
-    co_yield Step{};
-    solve_once();
-  }
-  const std::vector<Span>& sliding = pieces > 1 ? split : whole;
+  for (size_t p = 0; p < whole.size(); ++p) snap_split_points(whole[p], m.path_pieces[p], targets, split);
+  co_yield Step{};
+  solve_once();
   while (report.iterations < m.settings.max_iterations) {
     double move = 0;
-    for (const Span& span : sliding) move = std::max(move, slide(span, fitted, targets, scratch));
+    for (const Span& span : split) move = std::max(move, slide(span, fitted, targets, scratch));
     if (move <= tolerance) break;
     co_yield Step{};
     solve_once();

@@ -4,8 +4,9 @@
 //
 // The limit position of every level-L vertex is a fixed linear combination of the base points (each
 // level's subdivision stencils composed with the last level's limit masks, all from fire_subdivide).
-// Along every network edge lie 2^(N+L) + 1 level-L vertices (N Coons steps, L levels); the fit asks
-// their limit positions to meet the edge's polyline, in the least-squares sense. Curves alone leave
+// Along every side lie 2^(D+L) + 1 level-L vertices (D its EdgeSplits::depth: N Coons steps, more for a
+// long side; L levels); the fit asks their limit positions to meet the side's polyline, in the
+// least-squares sense. Curves alone leave
 // each face's interior free (on a regular grid about one bulge mode per face: moving a face's centre
 // and its edge midpoints in a way no limit curve along the edges sees), so a small fairness term, the
 // squared bi-Laplacian (umbrella operator applied twice) of the base points, picks the smoothest

@@ -392,6 +392,35 @@ void build_sides(const Mesh& net, bool noisy, Sides& sides) {
   }
 }
 
+// How many times each side is split (EdgeSplits::depth), by its lead edge: the Coons steps, and for FIRE
+// one more for each doubling a side needs to come within kLongSideRatio of the mean side of every face
+// it borders (at most kMaxSideDoublings).
+std::vector<uint32_t> side_depths(const Mesh& net, const Options& options, const Sides& sides) {
+  std::vector<uint32_t> depth(net.edge_slots(), options.coons_steps);
+  if (options.method != Method::fire) return depth;
+  std::vector<double> length(net.edge_slots(), 0.0);
+  for (uint32_t e = 0; e < net.edge_slots(); ++e)
+    for (uint32_t m : sides.members[e]) length[e] += polyline_length(net.polyline(m >> 1));
+  std::vector<uint32_t> leads;
+  for (uint32_t f = 0; f < net.face_slots(); ++f) {
+    if (!net.face_alive(f)) continue;
+    leads.clear();
+    double total = 0;
+    for (uint32_t oe : net.face_loop(f)) {
+      if (sides.joined[net.tail(oe)]) continue;
+      leads.push_back(sides.lead[edge_of(oe)]);
+      total += length[leads.back()];
+    }
+    const double mean = total / double(leads.size());
+    for (uint32_t e : leads) {
+      uint32_t doublings = 0;
+      while (doublings < kMaxSideDoublings && length[e] > kLongSideRatio * double(1u << doublings) * mean) ++doublings;
+      depth[e] = std::max(depth[e], options.coons_steps + doublings);
+    }
+  }
+  return depth;
+}
+
 // The per-edge and per-face stages, for the elements whose tags say they may have changed, or (edges)
 // whose short-curve scale did.
 void update_elements(const Mesh& net, const Options& options, ReconstructionCache& c, bool everything,
@@ -406,6 +435,7 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
   c.stats = {};
   build_sides(net, options.method == Method::fire && deviation > 0, c.sides);
   const Sides& sides = c.sides;
+  const std::vector<uint32_t> depth = side_depths(net, options, sides);
   std::vector<Vec3> line;
   for (uint32_t e = 0; e < net.edge_slots(); ++e) {
     const std::vector<uint32_t>& members = sides.members[e];
@@ -436,10 +466,11 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
     bool stamped = false;
     for (uint32_t m : members) stamped = stamped || net.edges.changes.changed_since(m >> 1, c.seen);
     const bool rescaled = scale != c.edge_scale[e];
-    if (!fresh && !stamped && !rejoined && !rescaled) continue;
-    if (!fresh && !stamped) ++(rejoined ? c.stats.edges_rejoined : c.stats.edges_rescaled);
-    c.edges[e] = scale < 1 ? split_network_edge(scaled_polyline(side, scale), options.coons_steps)
-                           : split_network_edge(side, options.coons_steps);
+    const bool resplit = !fresh && depth[e] != c.edges[e].depth;
+    if (!fresh && !stamped && !rejoined && !rescaled && !resplit) continue;
+    if (!fresh && !stamped) ++(rejoined ? c.stats.edges_rejoined : rescaled ? c.stats.edges_rescaled : c.stats.edges_resplit);
+    c.edges[e] = scale < 1 ? split_network_edge(scaled_polyline(side, scale), depth[e])
+                           : split_network_edge(side, depth[e]);
     c.edge_valid[e] = 1;
     c.edge_scale[e] = scale;
     c.edge_members[e] = members;
@@ -487,8 +518,6 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
 // degrees are corners.
 BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionCache& c, double corner_turn) {
   BaseMesh base;
-  const uint32_t pieces = 1u << options.coons_steps;
-  base.pieces_per_edge = pieces;
   std::vector<uint32_t> vertex_id(net.vertex_slots(), kNone), edge_first(net.edge_slots(), kNone),
       face_first(net.face_slots(), kNone);
   const Sides& sides = c.sides;
@@ -506,7 +535,7 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
   for (uint32_t e = 0; e < net.edge_slots(); ++e) {
     if (!c.edge_valid[e]) continue;
     edge_first[e] = base.vertex_count();
-    for (uint32_t i = 1; i < pieces; ++i) {
+    for (uint32_t i = 1; i < c.edges[e].leaf_count(); ++i) {
       base.positions.push_back(c.edges[e].leaf(i).front());
       base.vertex_drawn.push_back(1);
     }
@@ -527,18 +556,18 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
   };
   for (uint32_t f = 0; f < net.face_slots(); ++f) {
     if (!net.face_alive(f)) continue;
-    for (const VertexRef& r : c.faces[f].quads) {
-      base.face_vertices.push_back(id(r, f));
-      if (base.face_vertices.size() % 4 == 0) {
-        base.face_offsets.push_back(static_cast<uint32_t>(base.face_vertices.size()));
-        base.face_source.push_back(f);
-      }
+    const FacePatch& p = c.faces[f];
+    for (uint32_t k = 0; k < p.face_count(); ++k) {
+      for (uint32_t i = p.face_offsets[k]; i < p.face_offsets[k + 1]; ++i) base.face_vertices.push_back(id(p.corners[i], f));
+      base.face_offsets.push_back(static_cast<uint32_t>(base.face_vertices.size()));
+      base.face_source.push_back(f);
     }
   }
   // Drawn curves: the pieces of each side, between its ends and split points.
   for (uint32_t e = 0; e < net.edge_slots(); ++e) {
     if (!c.edge_valid[e]) continue;
     const bool sharp = (net.edges.flags[e] & kSharpEdge) != 0;
+    const uint32_t pieces = c.edges[e].leaf_count();
     for (uint32_t i = 0; i < pieces; ++i) {
       const uint32_t a = i == 0 ? vertex_id[sides.from[e]] : edge_first[e] + i - 1;
       const uint32_t b = i + 1 == pieces ? vertex_id[sides.to[e]] : edge_first[e] + i;
@@ -553,6 +582,7 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
         base.sharp_edges.push_back(b);
       }
     }
+    base.side_curve_offsets.push_back(base.curve_count());
   }
   for (uint32_t f = 0; f < net.face_slots(); ++f) {
     if (!net.face_alive(f)) continue;

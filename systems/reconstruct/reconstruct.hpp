@@ -41,6 +41,13 @@ inline constexpr uint32_t kMaxCoonsSteps = 5;
 // (thesis: a vertex where a curve merely goes on is no corner).
 inline constexpr double kBorderCornerTurnDegrees = 30.0;
 inline constexpr double kTangentReach = 0.15;
+// fire: a side more than this many times as long as the mean side of a face it borders is split into
+// twice the pieces, again while it is still so much longer, at most kMaxSideDoublings times: the face's
+// quads along it are then not stretched along the curve, and the fit has the base points to follow it
+// (the demo dome's longest curve; perf/RESULTS.md, "Long sides get more pieces"). The faces on either
+// side then have polygons with the finer split points between their corners.
+inline constexpr double kLongSideRatio = 2.0;
+inline constexpr uint32_t kMaxSideDoublings = 2;
 // Surface levels the options allow (the Catmull-Clark library itself refines further).
 inline constexpr uint32_t kMaxSurfaceLevels = 6;
 // Options::fit_solves_per_frame that runs a fit to its end in one call, as a rebuild does.
@@ -65,7 +72,8 @@ struct Options {
   friend bool operator==(const Options&, const Options&) = default;
 };
 
-// The quad base mesh handed to subdivision, and the polylines the fit follows along its edges.
+// The base mesh handed to subdivision, and the polylines the fit follows along its edges: quads, and
+// (FIRE) polygons beside sides split more finely than the Coons steps (kLongSideRatio).
 struct BaseMesh {
   std::vector<Vec3> positions;
   std::vector<uint32_t> face_offsets{0};
@@ -84,12 +92,14 @@ struct BaseMesh {
   std::vector<Vec3> curve_points;
   std::vector<uint8_t> curve_drawn;
   std::vector<uint8_t> vertex_drawn;  // the vertex is a network vertex or a sample of a network polyline
-  // The drawn curves come first, `pieces_per_edge` consecutive ones per side (a network edge, or edges
-  // joined at vertices the base mesh leaves out), from its first vertex to its last.
-  uint32_t pieces_per_edge = 1;
+  // The drawn curves come first, side by side (a side is a network edge, or edges joined at vertices the
+  // base mesh leaves out), each side's pieces from its first vertex to its last: side s has the curves
+  // side_curve_offsets[s] to side_curve_offsets[s + 1] - 1.
+  std::vector<uint32_t> side_curve_offsets{0};
   uint32_t vertex_count() const { return static_cast<uint32_t>(positions.size()); }
   uint32_t face_count() const { return static_cast<uint32_t>(face_offsets.size() - 1); }
   uint32_t curve_count() const { return static_cast<uint32_t>(curve_offsets.size() - 1); }
+  uint32_t side_count() const { return static_cast<uint32_t>(side_curve_offsets.size() - 1); }
   std::span<const Vec3> curve(uint32_t c) const {
     return std::span<const Vec3>(curve_points).subspan(curve_offsets[c], curve_offsets[c + 1] - curve_offsets[c]);
   }
@@ -160,6 +170,9 @@ struct UpdateStats {
   // reconstruct.cpp: an edit at the vertex, or the network's noise crossing kExactCurveNoise): their two
   // faces are redone too.
   size_t edges_rejoined = 0;
+  // Of those, unchanged sides redone because the pieces they are split into changed (kLongSideRatio: a face
+  // they border changed its mean side): their faces are redone too.
+  size_t edges_resplit = 0;
   size_t faces_recomputed = 0;
   bool topology_rebuilt = false;  // subdivision topology and (fire) the fit's factorization were rebuilt
   uint32_t fit_iterations = 0;    // solves of the fit (fire), each a back-substitution

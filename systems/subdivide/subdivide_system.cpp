@@ -28,17 +28,18 @@ void subdivide_system(const reconstruct::Options& options, const FrameTime& fram
   }
   surface.level = options.levels;
   surface.settled = *wrote == reconstruct::SurfaceWrite::settled;
-  // Each base quad's descendants are 4^L consecutive last-level quads, in base face order, so a network
-  // face's quads are one range: its patch.
-  const std::vector<uint32_t>& source = build.state.base().face_source;
-  FIRE_ASSERT(!source.empty() && surface.quad_count() == source.size() << (2 * options.levels),
-              "the last level has 4^L quads per base face");
-  const uint32_t per_base_face = 1u << (2 * options.levels);
+  // Each base face of n corners has n * 4^(L-1) consecutive last-level quads, in base face order, so a
+  // network face's quads are one range: its patch.
+  const reconstruct::BaseMesh& base = build.state.base();
+  const std::vector<uint32_t>& source = base.face_source;
+  const uint32_t per_corner = 1u << (2 * (options.levels - 1));
+  FIRE_ASSERT(!source.empty() && surface.quad_count() == size_t{base.face_offsets.back()} * per_corner,
+              "the last level has 4^(L-1) quads per base face corner");
   surface.patch_offsets.clear();
   surface.patch_keys.clear();
   for (uint32_t f = 0; f < source.size(); ++f)
     if (f == 0 || source[f] != source[f - 1]) {
-      surface.patch_offsets.push_back(f * per_base_face);
+      surface.patch_offsets.push_back(base.face_offsets[f] * per_corner);
       surface.patch_keys.push_back(source[f]);
     }
   surface.patch_offsets.push_back(surface.quad_count());

@@ -21,15 +21,22 @@ void add_face(Mesh& m, std::initializer_list<std::pair<uint32_t, bool>> loop) {
 }  // namespace
 
 Mesh polygon_network(uint32_t n, uint32_t samples) {
+  std::vector<double> angles;
+  for (uint32_t k = 0; k < n; ++k) angles.push_back(2 * std::numbers::pi * k / n);
+  return polygon_network(angles, samples);
+}
+
+Mesh polygon_network(const std::vector<double>& angles, uint32_t samples) {
   Mesh m;
   auto point = [](double angle) { return Vec3(std::cos(angle), std::sin(angle), 0.2 * std::cos(2 * angle)); };
+  const size_t n = angles.size();
   std::vector<uint32_t> corners;
-  for (uint32_t k = 0; k < n; ++k) corners.push_back(m.add_vertex(point(2 * std::numbers::pi * k / n)));
+  for (double a : angles) corners.push_back(m.add_vertex(point(a)));
   std::vector<uint32_t> oriented;
-  for (uint32_t k = 0; k < n; ++k) {
+  for (size_t k = 0; k < n; ++k) {
+    const double from = angles[k], to = k + 1 < n ? angles[k + 1] : angles[0] + 2 * std::numbers::pi;
     std::vector<Vec3> line;
-    for (uint32_t i = 0; i < samples; ++i)
-      line.push_back(point(2 * std::numbers::pi * (k + double(i) / (samples - 1)) / n));
+    for (uint32_t i = 0; i < samples; ++i) line.push_back(point(from + (to - from) * i / (samples - 1)));
     oriented.push_back(make_oriented(m.add_edge(corners[k], corners[(k + 1) % n], line), false));
   }
   REQUIRE(m.add_face(oriented) != kNone);

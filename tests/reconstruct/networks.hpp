@@ -15,6 +15,9 @@ using Height = std::function<double(double, double)>;
 // One face with n sides (n >= 2): corners on the unit circle at angles 2 pi k / n, each side the arc
 // of the circle between its corners lifted to z = 0.2 cos(2 angle), with `samples` points.
 Mesh polygon_network(uint32_t n, uint32_t samples = 9);
+// The same with corners at the given increasing angles (radians, from [0, 2 pi)): side k runs from
+// corner k to corner k + 1 counter-clockwise, the last one back to corner 0.
+Mesh polygon_network(const std::vector<double>& angles, uint32_t samples = 9);
 
 // A grid of nx by ny square faces over [0, nx] x [0, ny], every curve on the surface z = height(x, y)
 // with `samples` points; faces counter-clockwise seen from +z, numbered row by row (face j*nx + i).

@@ -82,7 +82,7 @@ TEST_CASE("random edits through the frame: shown in the commit frame, settled wi
   // Which edits wait for their fit to end: a separate generator, so that the edits are the same.
   std::mt19937_64 pace(7);
   size_t applied = 0, refused = 0, faces_recomputed = 0, faces_bound = 0, topology_rebuilds = 0, limit_vertices = 0,
-         interrupted = 0, joined_faces = 0;
+         interrupted = 0, joined_faces = 0, finer_faces = 0;
   int most_frames_to_settle = 0;
   bool rebuilt_from_scratch = false;  // after a refused network the next update starts over
   for (int op = 0; op < operations; ++op) {
@@ -148,9 +148,10 @@ TEST_CASE("random edits through the frame: shown in the commit frame, settled wi
     if (rebuilt_from_scratch) {
       rebuilt_from_scratch = false;
     } else if (r.ok) {
-      // Faces near the edit, and those of short noisy curves the edit's change of the noise rescaled or of
-      // sides whose joined vertices it changed.
-      const size_t bound = local_bound(net, edit_frame) + 2 * (stats.edges_rescaled + stats.edges_rejoined);
+      // Faces near the edit, and those of short noisy curves the edit's change of the noise rescaled, of
+      // sides whose joined vertices it changed, or of long sides split anew.
+      const size_t bound =
+          local_bound(net, edit_frame) + 2 * (stats.edges_rescaled + stats.edges_rejoined + stats.edges_resplit);
       CHECK(stats.faces_recomputed <= bound);
       faces_recomputed += stats.faces_recomputed;
       faces_bound += bound;
@@ -163,14 +164,21 @@ TEST_CASE("random edits through the frame: shown in the commit frame, settled wi
     REQUIRE(same_bytes(surface.normals, full->normals));
     REQUIRE(same_bytes(surface.quads, full->face_vertices));
     // The quads grouped by network face (what the renderer keeps blocks by): one patch per live face, in
-    // slot order, a face's base quads with 4^L quads each: one per side, n for an n-sided face, fewer
-    // where noisy curves join at a vertex of valence 2.
+    // slot order, a face's base faces with 4^(L-1) quads per corner: one base face per side, n for an
+    // n-sided face, fewer where noisy curves join at a vertex of valence 2; quads, or polygons where a
+    // long side has more pieces (kLongSideRatio).
     REQUIRE(surface.patch_keys.size() == net.face_count());
     REQUIRE(surface.patch_offsets.size() == net.face_count() + 1);
     CHECK(surface.patch_offsets.front() == 0);
     CHECK(surface.patch_offsets.back() == surface.quad_count());
-    std::vector<uint32_t> base_quads(net.face_slots(), 0);
-    for (uint32_t source : build.state.base().face_source) ++base_quads[source];
+    const BaseMesh& base = build.state.base();
+    std::vector<uint32_t> base_quads(net.face_slots(), 0), base_corners(net.face_slots(), 0);
+    for (uint32_t b = 0; b < base.face_count(); ++b) {
+      const uint32_t corners = base.face_offsets[b + 1] - base.face_offsets[b];
+      ++base_quads[base.face_source[b]];
+      base_corners[base.face_source[b]] += corners;
+      finer_faces += corners > 4;
+    }
     for (uint32_t p = 0; p < surface.patch_count(); ++p) {
       const uint32_t f = surface.patch_keys[p];
       REQUIRE(net.face_alive(f));
@@ -182,19 +190,21 @@ TEST_CASE("random edits through the frame: shown in the commit frame, settled wi
         ++joined_faces;
         CHECK(fit_noise(net) > kExactCurveNoise);
       }
-      CHECK(surface.patch_end(p) - surface.patch_begin(p) == 16 * base_quads[f]);
+      CHECK(surface.patch_end(p) - surface.patch_begin(p) == 4 * base_corners[f]);
     }
   }
   INFO("applied " << applied << ", refused " << refused << ", faces recomputed " << faces_recomputed << " of a local bound " << faces_bound
                   << ", topology rebuilds " << topology_rebuilds << ", limit vertices evaluated " << limit_vertices
                   << ", fits interrupted by the next edit " << interrupted << ", most frames to settle "
-                  << most_frames_to_settle << ", faces with joined corners " << joined_faces);
+                  << most_frames_to_settle << ", faces with joined corners " << joined_faces
+                  << ", base polygons beside long sides " << finer_faces);
   CHECK(applied > size_t(operations) / 2);
   CHECK(interrupted > size_t(operations) / 50);
   CHECK(most_frames_to_settle > 1);  // the fit did spread over frames
   CHECK(refused < size_t(operations) / 20);
   CHECK(faces_recomputed > 0);
   CHECK(joined_faces > 0);  // noisy edits joined curves at vertices of valence 2, and stayed equal to a rebuild
+  CHECK(finer_faces > 0);   // long sides got more pieces, and stayed equal to a rebuild
   WARN("per-stage work over " << operations << " operations: " << faces_recomputed << " face patches recomputed (bound "
                               << faces_bound << "), " << topology_rebuilds << " topology rebuilds, " << limit_vertices
                               << " limit vertices evaluated, " << joined_faces << " faces with joined corners");

@@ -162,15 +162,15 @@ double farthest_from_chord(std::span<const Vec3> points, const Vec3& a, const Ve
   return farthest;
 }
 
-// Per drawn network edge of `base` (its drawn curves in order, pieces_per_edge each), how far its points
-// lie from the chord between its ends at most.
+// Per side of `base` (its drawn curves in order), how far its points lie from the chord between its ends
+// at most.
 std::vector<double> departures(const BaseMesh& base) {
   std::vector<double> out;
-  for (uint32_t first = 0; first < base.curve_count() && base.curve_drawn[first]; first += base.pieces_per_edge) {
-    const Vec3 a = base.curve(first).front(), b = base.curve(first + base.pieces_per_edge - 1).back();
+  for (uint32_t s = 0; s < base.side_count(); ++s) {
+    const uint32_t first = base.side_curve_offsets[s], end = base.side_curve_offsets[s + 1];
+    const Vec3 a = base.curve(first).front(), b = base.curve(end - 1).back();
     double farthest = 0;
-    for (uint32_t c = first; c < first + base.pieces_per_edge; ++c)
-      farthest = std::max(farthest, farthest_from_chord(base.curve(c), a, b));
+    for (uint32_t c = first; c < end; ++c) farthest = std::max(farthest, farthest_from_chord(base.curve(c), a, b));
     out.push_back(farthest);
   }
   return out;

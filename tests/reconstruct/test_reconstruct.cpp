@@ -52,7 +52,7 @@ TEST_CASE("thesis: a pentagon triquadrifies into a quad and a triangle, then 7 q
   std::vector<EdgeSplits> splits;
   const FacePatch p = patch_of(net, 0, {Method::thesis, 1, Planarity::least_squares}, splits);
   CHECK(p.first_stage_sizes == std::vector<uint32_t>{4, 3});
-  CHECK(p.quad_count() == 7);
+  CHECK(p.face_count() == 7);
   CHECK(p.interior.size() == 3);  // the cut's midpoint and the two centres
   const BaseMesh b = base_of(net, {Method::thesis, 1, 2, Planarity::least_squares});
   CHECK(b.vertex_count() == 13);  // 5 corners, 5 edge midpoints, 3 inside
@@ -111,6 +111,38 @@ TEST_CASE("FIRE: an n-sided face becomes n quads around its centre", "[reconstru
     CHECK(s->face_count() == 16 * n);
     CHECK(s->normals.size() == s->positions.size());
   }
+}
+
+TEST_CASE("FIRE: a side much longer than its face's mean side gets more pieces, and the faces beside it polygons",
+          "[reconstruct][fire]") {
+  // Four sides of 45 degrees and one of 180 along the circle: the long one is 2.5 times the mean side.
+  const double d = std::numbers::pi / 4;
+  const Mesh net = polygon_network({0, d, 2 * d, 3 * d, 4 * d}, 17);
+  for (uint32_t steps : {1u, 2u}) {
+    INFO(steps << " Coons steps");
+    const BaseMesh b = base_of(net, {Method::fire, steps, 2, Planarity::least_squares});
+    const uint32_t pieces = 1u << steps;
+    REQUIRE(b.side_count() == 5);
+    for (uint32_t s = 0; s < 5; ++s)
+      CHECK(b.side_curve_offsets[s + 1] - b.side_curve_offsets[s] == (s == 4 ? 2 * pieces : pieces));
+    // Every base face beside the long side has one finer split point between its corners on it.
+    uint32_t pentagons = 0, corners = 0;
+    for (uint32_t f = 0; f < b.face_count(); ++f) {
+      const uint32_t size = b.face_offsets[f + 1] - b.face_offsets[f];
+      CHECK((size == 4 || size == 5));
+      pentagons += size == 5;
+      corners += size;
+    }
+    CHECK(pentagons == pieces);
+    // Still a disk with every base edge carrying one curve.
+    CHECK(int64_t(b.vertex_count()) - int64_t(b.curve_count()) + int64_t(b.face_count()) == 1);
+    auto surface = reconstruct_surface(net, {Method::fire, steps, 2, Planarity::least_squares});
+    REQUIRE(surface.ok());
+    CHECK(surface->face_count() == 4 * corners);
+  }
+  // The thesis's Coons steps split every side alike.
+  const BaseMesh thesis = base_of(net, {Method::thesis, 1, 2, Planarity::least_squares});
+  for (uint32_t s = 0; s < thesis.side_count(); ++s) CHECK(thesis.side_curve_offsets[s + 1] - thesis.side_curve_offsets[s] == 2);
 }
 
 TEST_CASE("FIRE: a border vertex is a corner only where the border turns", "[reconstruct][fire]") {
