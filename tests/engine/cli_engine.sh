@@ -57,6 +57,17 @@ expect_error "a session is written into a new folder" "not empty" "$fire" replay
 expect_error "--snapshot-every needs --session" "needs --session" "$fire" replay "$src/tools/demo/sketch.log" --snapshot-every 5
 expect_error "session settings are not overridden" "settings.json" "$fire" replay "$tmp/s" --levels 2
 expect_error "missing session folder" "nope: no such session folder" "$fire" open "$tmp/nope"
+# fire replay takes fire reconstruct's surface options; a session keeps them all and reopens with them.
+h2=$("$fire" replay "$src/tools/demo/sketch.log" --coons-steps 2 --hash 2>/dev/null)
+check "replay --coons-steps 2 builds another surface ($h2)" "[ -n '$h2' ] && [ '$h2' != '$golden' ]"
+expect_error "replay refuses Coons steps out of range" "fire replay: the number of Coons steps must be 1 to 5, not 9" \
+  "$fire" replay "$src/tools/demo/sketch.log" --coons-steps 9 --hash
+expect_error "replay refuses an unknown planarity" "fire replay: --planarity must be" \
+  "$fire" replay "$src/tools/demo/sketch.log" --planarity flat --hash
+ht=$("$fire" replay "$src/tools/demo/sketch.log" --method thesis --planarity hough --session "$tmp/thesis" --hash 2>/dev/null)
+check "a session with the thesis's method and the Hough measure reopens to its hash" \
+  "[ -n '$ht' ] && [ '$ht' != '$golden' ] && [ \"\$('$fire' open '$tmp/thesis' 2>/dev/null)\" = '$ht' ]"
+expect_error "session settings are not overridden, whichever surface option" "settings.json" "$fire" replay "$tmp/thesis" --method fire
 cp -r "$tmp/s" "$tmp/bad"; newest=$(ls "$tmp/bad"/snapshot-* | tail -1)
 printf 'XXXX' | dd of="$newest" bs=1 seek=200 conv=notrunc 2>/dev/null
 "$fire" open "$tmp/bad" >"$tmp/out" 2>"$tmp/err"

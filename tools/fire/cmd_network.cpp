@@ -12,6 +12,7 @@
 #include "tools/fire/session.hpp"
 #include "tools/fire/session_rig.hpp"
 #include "tools/fire/session_store.hpp"
+#include "tools/fire/surface_args.hpp"
 
 namespace fire::cli {
 
@@ -22,8 +23,9 @@ struct ReplayOptions {
   std::vector<std::string> surface_paths;
   uint64_t snapshot_every = 0;
   bool hash = false, timings = false, no_surface = false;
-  bool settings_given = false;  // --snap, --levels, --fairness or --no-surface on the command line
+  bool settings_given = false;  // --snap, a surface option or --no-surface on the command line
   double snap = SketchSettings{}.snap_distance;
+  SurfaceArgs surface_args;
   reconstruct::Options surface;
 };
 
@@ -46,8 +48,8 @@ Result<ReopenedSession> reopen(const std::string& command, const std::string& di
 int run_replay(const ReplayOptions& o) {
   const bool session_in = is_directory(o.log_path);
   if (session_in && o.settings_given) {
-    std::cerr << "fire replay: " << o.log_path << " is a session folder: its settings.json sets --snap, --levels, "
-              << "--fairness and --no-surface\n";
+    std::cerr << "fire replay: " << o.log_path << " is a session folder: its settings.json sets --snap, the surface "
+              << "options (--method, --coons-steps, --levels, --fairness, --planarity) and --no-surface\n";
     return 1;
   }
   if (session_in && !o.session_dir.empty()) {
@@ -205,7 +207,7 @@ void add_network_commands(CLI::App& app, Registry& registry) {
   replay->add_option("LOG", o->log_path,
                      "input log (format: engine/INPUT_LOG.md), or a session folder (engine/SESSION.md) to reopen: its "
                      "last good snapshot, then its log's tail, a torn last record dropped; a folder's settings.json "
-                     "fixes --snap, --levels, --fairness and --no-surface")
+                     "fixes --snap, the surface options and --no-surface")
       ->required();
   replay->add_option("--session", o->session_dir,
                      "write a session folder while replaying LOG: the input log, fsynced with a durability record at "
@@ -224,15 +226,7 @@ void add_network_commands(CLI::App& app, Registry& registry) {
                      "repeat it for more than one file")
       ->allow_extra_args(false);
   replay->add_flag("--no-surface", o->no_surface, "run only input, sketch and split (no refine and subdivide)");
-  replay->add_option("--levels", o->surface.levels, "subdivision levels of the surface")
-      ->capture_default_str()
-      ->check(CLI::Range(1u, reconstruct::kMaxSurfaceLevels));
-  replay->add_option("--fairness", o->surface.fairness,
-                     "fairness weight of the surface fit, 0 to 1, used as is (default: this for exact curves, raised "
-                     "with the noise the polylines show: 0.1 for a noise estimate of 3e-3 to 1.3e-2, beyond with its square, "
-                     "up to 1)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
+  add_surface_options(*replay, o->surface_args);
   replay->add_flag("--hash", o->hash,
                    "print a 64-bit hash of the final pools and surface (identical on every run and machine)");
   replay->add_flag("--timings", o->timings, "print per-system timings (mean, p99, max per frame) and final counts");
@@ -242,9 +236,17 @@ void add_network_commands(CLI::App& app, Registry& registry) {
       ->capture_default_str();
   replay->footer("Pictures of the replay's frames: fire render LOG --every N --png-dir DIR.");
   replay->callback([o, replay, &registry] {
-    o->settings_given = replay->count("--snap") + replay->count("--levels") + replay->count("--fairness") +
-                            replay->count("--no-surface") > 0;
-    if (replay->count("--fairness") > 0) o->surface.fairness_from_noise = false;
+    size_t given = replay->count("--snap") + replay->count("--no-surface");
+    for (const char* option : {"--method", "--coons-steps", "--levels", "--fairness", "--planarity"})
+      given += replay->count(option);
+    o->settings_given = given > 0;
+    auto surface = surface_options(o->surface_args, *replay);
+    if (!surface) {
+      std::cerr << "fire replay: " << surface.error() << "\n";
+      registry.exit_code = 1;
+      return;
+    }
+    o->surface = *surface;
     registry.exit_code = run_replay(*o);
   });
 
