@@ -58,7 +58,7 @@ Result<std::unique_ptr<AppLive>> AppLive::open(const AppLiveOptions& o) {
     app->marks_ = std::move(*marks);
   }
   World& w = app->world_;
-  w.surface_options.levels = o.levels;
+  w.surface_options = o.surface;
   auto rig = tracking_rig_from_json(rig_json, rig_source, InputLog{}, o.session_dir);
   if (!rig) return R::failure(rig.error());
   set_rig(w, *rig);

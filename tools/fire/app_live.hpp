@@ -22,7 +22,7 @@ struct AppLiveOptions {
   std::string rig_path;     // the rig file (fire calibrate): cameras and the remotes' roles
   std::string marks_path;   // the object's marks (fire-marks JSON), for registering it; optional
   std::string session_dir;  // a new session folder, written as the frames run
-  uint32_t levels = 3;      // Catmull-Clark levels of the surface
+  reconstruct::Options surface;  // the surface options (fire app's, as fire reconstruct's)
   int ir_sensitivity = 3;
   SessionWriteOptions write;  // snapshots
   // Test and simulation hook: no hardware; three fake remotes show `fire simulate drawing` with this

@@ -28,6 +28,7 @@
 #include "tools/fire/app_window.hpp"
 #include "tools/fire/commands.hpp"
 #include "tools/fire/session.hpp"
+#include "tools/fire/surface_args.hpp"
 
 namespace fire::cli {
 
@@ -37,7 +38,9 @@ struct AppArgs {
   std::string input_path, reference_path, out_path, export_path, record_path, script_path, screenshot_path,
       session_dir, size = "1280x720";
   uint64_t snapshot_every = 3000;
-  uint32_t levels = 3;
+  SurfaceArgs surface_args;
+  reconstruct::Options surface;  // from surface_args
+  bool surface_given = false;    // a surface option on the command line
   int reference_levels = 3;
   double snap_pixels = 12;
   bool live = false;
@@ -206,8 +209,6 @@ int run_app(const AppArgs& a) {
   if (std::sscanf(a.size.c_str(), "%ux%u%c", &width, &height, &tail) != 2 || width < 64 || height < 64 ||
       width > 8192 || height > 8192)
     return fail("--size must be WIDTHxHEIGHT, 64 to 8192 pixels a side, not '" + a.size + "'");
-  if (a.levels < 1 || a.levels > reconstruct::kMaxSurfaceLevels)
-    return fail("--levels must be 1 to " + std::to_string(reconstruct::kMaxSurfaceLevels));
   if (!a.screenshot_path.empty() && !ends_with(a.screenshot_path, ".png"))
     return fail(a.screenshot_path + ": --screenshot must be a .png file");
   if (a.live) {
@@ -240,6 +241,9 @@ int run_app(const AppArgs& a) {
   if (session_in && !a.session_dir.empty())
     return fail("--session writes a new session folder; " + a.input_path +
                 " is a session already, and it goes on being written");
+  if (session_in && a.surface_given)
+    return fail(a.input_path + " is a session folder: its settings.json sets the surface options (--method, "
+                "--coons-steps, --levels, --fairness, --planarity)");
   if (recording && !a.record_path.empty())
     return fail("--record: the session folder's input.log is the record already");
   if (a.snapshot_every == 0) return fail("--snapshot-every must be at least 1 frame");
@@ -280,7 +284,7 @@ int run_app(const AppArgs& a) {
   if (a.live) {
     AppLiveOptions options = a.live_options;
     options.session_dir = live_dir;
-    options.levels = a.levels;
+    options.surface = a.surface;
     options.write = write_options;
     auto opened = AppLive::open(options);
     if (!opened) return fail(opened.error());
@@ -302,7 +306,7 @@ int run_app(const AppArgs& a) {
               << ", then " << reopened->events_replayed << " event(s) of its log); new strokes are added to it\n";
   } else {
     world = std::make_unique<World>();
-    world->surface_options.levels = a.levels;
+    world->surface_options = a.surface;
     if (from_network) {
       auto network = load_network(a.input_path);
       if (!network) return fail(network.error());
@@ -640,7 +644,7 @@ void add_app_commands(CLI::App& app, Registry& registry) {
       "\n\nKeys:\n" + keys + "\nWith --live:\n" + live_keys);
   cmd->add_option("INPUT", a->input_path,
                   "a session folder to go on with (engine/SESSION.md: its last good snapshot, then its log's tail; "
-                  "new strokes are written to it; its settings.json fixes --levels), a curve network (.fnet) to "
+                  "new strokes are written to it; its settings.json fixes the surface options), a curve network (.fnet) to "
                   "continue from, or an input log replayed first");
   cmd->add_option("--session", a->session_dir,
                   "write the session to this new folder as it goes (engine/SESSION.md): every event on disk as it is "
@@ -668,7 +672,7 @@ void add_app_commands(CLI::App& app, Registry& registry) {
   cmd->add_option("--record", a->record_path, "write the session's input log here on exit (not with a .fnet input, nor with a session folder, whose "
                   "input.log is the record)");
   cmd->add_option("--size", a->size, "window size WIDTHxHEIGHT in pixels")->capture_default_str();
-  cmd->add_option("--levels", a->levels, "Catmull-Clark levels of the surface (1 to 6)")->capture_default_str();
+  add_surface_options(*cmd, a->surface_args);
   cmd->add_option("--script", a->script_path,
                   "test hook: input events delivered through the window's GLFW callbacks, one a line: "
                   "'FRAME move X Y', 'FRAME press|release left|right|middle', 'FRAME scroll DY', "
@@ -697,7 +701,17 @@ void add_app_commands(CLI::App& app, Registry& registry) {
                   "--fake-rig: seconds of the drawing per 60 displayed frames, whatever they cost (the fake clock is "
                   "the frames', not the wall's)")
       ->capture_default_str();
-  cmd->callback([a, &registry] { registry.exit_code = run_app(*a); });
+  cmd->callback([a, cmd, &registry] {
+    auto surface = surface_options(a->surface_args, *cmd);
+    if (!surface) {
+      registry.exit_code = fail(surface.error());
+      return;
+    }
+    a->surface = *surface;
+    for (const char* option : {"--method", "--coons-steps", "--levels", "--fairness", "--planarity"})
+      a->surface_given = a->surface_given || cmd->count(option) > 0;
+    registry.exit_code = run_app(*a);
+  });
 }
 
 }  // namespace fire::cli

@@ -580,6 +580,33 @@ TEST_CASE("fire app: no Vulkan device, a reference that does not load: a clear m
   fs::remove_all(dir);
 }
 
+TEST_CASE("fire app: the surface options are fire reconstruct's and its session keeps them", "[app][window][session]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("surface_options");
+  const std::string session = (dir / "steps").string();
+  const Run app = run_app(177,
+                          "--coons-steps 2 --reference " + quote(FIRE_PAWN) + " --size 960x720 --script " +
+                              quote(FIRE_WINDOW_TEST_DIR "/draw_on_pawn.script") + " --session " + quote(session),
+                          dir);
+  INFO("xvfb-run exit: " << app.runner_exit << "\nstdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  const std::string hash = nlohmann::json::parse(app.out)["hash"].get<std::string>() + "\n";
+  // The folder's settings.json holds the two Coons steps; its log alone replays to them only when told.
+  const std::string log = quote(session + "/input.log");
+  CHECK(run(quote(FIRE_BINARY) + " replay " + quote(session) + " --hash", dir).out == hash);
+  CHECK(run(quote(FIRE_BINARY) + " replay " + log + " --coons-steps 2 --hash", dir).out == hash);
+  CHECK(run(quote(FIRE_BINARY) + " replay " + log + " --hash", dir).out != hash);
+  // Reopened, the folder's settings decide: a surface option beside it is refused in words.
+  const Run again = run_app(178, quote(session) + " --levels 2", dir);
+  CHECK(again.exit_code == 1);
+  CHECK(again.err.find("is a session folder: its settings.json sets the surface options") != std::string::npos);
+  // Out of range: refused before a window opens, so without a display too.
+  const Run wrong = run("env -u DISPLAY -u WAYLAND_DISPLAY " + quote(FIRE_BINARY) + " app --coons-steps 9", dir);
+  CHECK(wrong.exit_code == 1);
+  CHECK(wrong.err.find("fire app: the number of Coons steps must be 1 to 5, not 9") != std::string::npos);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("fire app: a script that does not parse is refused before a window opens", "[app][window]") {
   const fs::path dir = scratch("bad_script");
   const std::string script = (dir / "bad.script").string();
