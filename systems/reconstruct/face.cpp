@@ -68,9 +68,7 @@ class LocalMesh {
     VertexRef mid;
     if (const EdgeSplits* s = edges[e].splits) {
       const uint32_t k = edges[e].node;
-      const uint32_t level = static_cast<uint32_t>(std::bit_width(k)) - 1;
-      const uint32_t span = 1u << (s->depth - level);
-      mid = {RefKind::edge_point, edges[e].network_edge, (k - (1u << level)) * span + span / 2};
+      mid = {RefKind::edge_point, edges[e].network_edge, s->first_leaf(k) + s->leaves_below(k) / 2};
       first.splits = second.splits = s;
       first.network_edge = second.network_edge = edges[e].network_edge;
       first.node = 2 * k;
@@ -104,8 +102,7 @@ class LocalMesh {
   void append_finer_points(uint32_t oe, std::vector<VertexRef>& out) const {
     const LocalEdge& edge = edges[oe >> 1];
     if (!edge.splits || edge.node >= edge.splits->leaf_count()) return;
-    const uint32_t level = static_cast<uint32_t>(std::bit_width(edge.node)) - 1;
-    const uint32_t span = 1u << (edge.splits->depth - level), first = (edge.node - (1u << level)) * span;
+    const uint32_t first = edge.splits->first_leaf(edge.node), span = edge.splits->leaves_below(edge.node);
     for (uint32_t i = 1; i < span; ++i)
       out.push_back({RefKind::edge_point, edge.network_edge, (oe & 1) ? first + span - i : first + i});
   }

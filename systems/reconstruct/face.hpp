@@ -3,6 +3,7 @@
 // one network face (its loop and its edges' polylines), which is what lets an edit recompute only the
 // faces it touched: both faces of an edge split it identically because the split is computed on the
 // edge's stored polyline, never on a face's view of it.
+#include <bit>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -34,6 +35,10 @@ struct EdgeSplits {
   std::span<const Vec3> node(uint32_t k) const { return nodes[k]; }
   uint32_t leaf_count() const { return 1u << depth; }
   std::span<const Vec3> leaf(uint32_t i) const { return nodes[leaf_count() + i]; }
+  // The leaves below node k: the first one's index and how many.
+  uint32_t first_leaf(uint32_t k) const { return (k << (depth - level(k))) - leaf_count(); }
+  uint32_t leaves_below(uint32_t k) const { return 1u << (depth - level(k)); }
+  static uint32_t level(uint32_t k) { return static_cast<uint32_t>(std::bit_width(k)) - 1; }
 };
 EdgeSplits split_network_edge(std::span<const Vec3> line, uint32_t depth);
 

@@ -708,8 +708,7 @@ void add_app_commands(CLI::App& app, Registry& registry) {
       return;
     }
     a->surface = *surface;
-    for (const char* option : {"--method", "--coons-steps", "--levels", "--fairness", "--planarity"})
-      a->surface_given = a->surface_given || cmd->count(option) > 0;
+    a->surface_given = surface_options_given(*cmd);
     registry.exit_code = run_app(*a);
   });
 }

@@ -236,10 +236,8 @@ void add_network_commands(CLI::App& app, Registry& registry) {
       ->capture_default_str();
   replay->footer("Pictures of the replay's frames: fire render LOG --every N --png-dir DIR.");
   replay->callback([o, replay, &registry] {
-    size_t given = replay->count("--snap") + replay->count("--no-surface");
-    for (const char* option : {"--method", "--coons-steps", "--levels", "--fairness", "--planarity"})
-      given += replay->count(option);
-    o->settings_given = given > 0;
+    o->settings_given =
+        replay->count("--snap") + replay->count("--no-surface") > 0 || surface_options_given(*replay);
     auto surface = surface_options(o->surface_args, *replay);
     if (!surface) {
       std::cerr << "fire replay: " << surface.error() << "\n";

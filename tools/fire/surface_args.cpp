@@ -20,6 +20,12 @@ void add_surface_options(CLI::App& cmd, SurfaceArgs& a) {
       ->capture_default_str();
 }
 
+bool surface_options_given(const CLI::App& cmd) {
+  for (const char* option : {"--method", "--coons-steps", "--levels", "--fairness", "--planarity"})
+    if (cmd.count(option) > 0) return true;
+  return false;
+}
+
 Result<reconstruct::Options> surface_options(const SurfaceArgs& a, const CLI::App& cmd) {
   using R = Result<reconstruct::Options>;
   reconstruct::Options options;

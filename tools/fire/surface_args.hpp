@@ -18,6 +18,8 @@ struct SurfaceArgs {
 
 // --method, --coons-steps, --levels, --fairness and --planarity on `cmd`.
 void add_surface_options(CLI::App& cmd, SurfaceArgs& args);
+// Whether any of them is on `cmd`'s command line (a session folder's settings.json decides them instead).
+bool surface_options_given(const CLI::App& cmd);
 // The options they give (an explicit --fairness is used as is), or what is wrong with them. Call after
 // parsing: it asks `cmd` whether --fairness was given.
 Result<reconstruct::Options> surface_options(const SurfaceArgs& args, const CLI::App& cmd);
