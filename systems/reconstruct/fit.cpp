@@ -329,8 +329,9 @@ Span make_span(std::span<const Vec3> line, std::vector<Eigen::Index> rows) {
 }
 
 // Re-places the inner targets of a span at the arc-length fractions its fitted limit points have along
-// it; returns the largest move.
-double slide(const Span& span, const Eigen::MatrixX3d& fitted, Eigen::MatrixX3d& targets, std::vector<double>& length) {
+// it, reading its polyline as `reading` says; returns the largest move.
+double slide(const Span& span, Sampling reading, const Eigen::MatrixX3d& fitted, Eigen::MatrixX3d& targets,
+             std::vector<double>& length) {
   const std::vector<Eigen::Index>& rows = span.rows;
   length.assign(rows.size(), 0.0);
   for (size_t k = 1; k < rows.size(); ++k) length[k] = length[k - 1] + (fitted.row(rows[k]) - fitted.row(rows[k - 1])).norm();
@@ -338,7 +339,7 @@ double slide(const Span& span, const Eigen::MatrixX3d& fitted, Eigen::MatrixX3d&
   double largest = 0;
   if (!(total > 0)) return largest;
   for (size_t k = 1; k + 1 < rows.size(); ++k) {
-    const Vec3 target = sample_polyline(span.line, span.params, length[k] / total, Sampling::linear);
+    const Vec3 target = sample_polyline(span.line, span.params, length[k] / total, reading);
     largest = std::max(largest, (target - Vec3(targets.row(rows[k]).transpose())).norm());
     targets.row(rows[k]) = target.transpose();
   }
@@ -487,7 +488,7 @@ Steps<FitRun::Fitted> FitRun::fit_steps(const LimitFit::Impl& m, const BaseMesh&
       line.insert(line.end(), piece.begin() + (i == 0 ? 0 : 1), piece.end());
       const std::vector<double> t = arc_parameters(piece);
       for (size_t k = 1; k < steps; ++k)
-        targets.row(rows[i * steps + k]) = sample_polyline(piece, t, double(k) / double(steps), Sampling::linear).transpose();
+        targets.row(rows[i * steps + k]) = sample_polyline(piece, t, double(k) / double(steps), m.settings.targets).transpose();
     }
     whole.push_back(make_span(line, rows));
   }
@@ -516,7 +517,7 @@ Steps<FitRun::Fitted> FitRun::fit_steps(const LimitFit::Impl& m, const BaseMesh&
   // Phase 1: the split points slide too, to where the fitted surface puts them along the whole edge.
   for (uint32_t round = 0; round < m.settings.slide_iterations; ++round) {
     double move = 0;
-    for (const Span& span : whole) move = std::max(move, slide(span, fitted, targets, scratch));
+    for (const Span& span : whole) move = std::max(move, slide(span, m.settings.targets, fitted, targets, scratch));
     co_yield Step{};
     solve_once();
     if (move <= tolerance) break;
@@ -538,7 +539,7 @@ Steps<FitRun::Fitted> FitRun::fit_steps(const LimitFit::Impl& m, const BaseMesh&
     Eigen::Index i = 0;
     for (const Span& span : whole)
       for (size_t k = 1; k + 1 < span.rows.size(); ++k)
-        targets.row(span.rows[k]) = sample_polyline(span.line, span.params, fractions[i++], Sampling::linear).transpose();
+        targets.row(span.rows[k]) = sample_polyline(span.line, span.params, fractions[i++], m.settings.targets).transpose();
   };
   // Each foot is searched between its neighbours' current targets, so that the targets stay in order.
   auto feet = [&](const Eigen::VectorXd& current, Eigen::VectorXd& out) {
@@ -633,7 +634,7 @@ Steps<FitRun::Fitted> FitRun::fit_steps(const LimitFit::Impl& m, const BaseMesh&
     for (const Span& span : whole)
       for (size_t k = 1; k + 1 < span.rows.size(); ++k) {
         const Vec3 x = fitted.row(span.rows[k]).transpose();
-        sum += (sample_polyline(span.line, span.params, foot_fraction(span, x, 0.0, 1.0), Sampling::linear) - x).squaredNorm();
+        sum += (sample_polyline(span.line, span.params, foot_fraction(span, x, 0.0, 1.0), m.settings.targets) - x).squaredNorm();
       }
     return sum;
   };
@@ -646,7 +647,7 @@ Steps<FitRun::Fitted> FitRun::fit_steps(const LimitFit::Impl& m, const BaseMesh&
   solve_once();
   while (report.iterations < m.settings.max_iterations) {
     double move = 0;
-    for (const Span& span : split) move = std::max(move, slide(span, fitted, targets, scratch));
+    for (const Span& span : split) move = std::max(move, slide(span, m.settings.targets, fitted, targets, scratch));
     if (move <= tolerance) break;
     co_yield Step{};
     solve_once();

@@ -14,6 +14,7 @@
 // patches) keeps the matrix definite. The normal matrix A^T A + fairness + ridge depends on topology
 // alone: it is factored once (sparse LDL^T) and a change of the points costs back-substitutions.
 //
+// Targets lie on the polylines, read between samples as FitWeights::targets says.
 // The targets start at equal arc-length steps along each piece of a network edge. A limit curve is not
 // parameterized by arc length, so the targets then slide in three phases:
 //   1. along whole edges, to the arc-length fractions the fitted limit points have along the fitted
@@ -52,6 +53,9 @@ struct FitWeights {
   // their normal matrices); fit_fairness (reconstruct.hpp): Options::fairness, raised for noisy curves.
   double fairness = 1e-3;
   double ridge = 1e-9;  // same scale, towards the initial base points
+  // How the targets read a polyline between its samples (fit_targets: smooth for exact curves, linear
+  // for noisy ones).
+  Sampling targets = Sampling::smooth;
   // Where the face split leaves thin base quads, the umbrella measures connectivity, not shape: on a
   // sliver it pulls the points across the thin side and the surface folds (the demo dome). There the
   // umbrella of the change from the initial base points (the transfinite patches, which do not fold)

@@ -39,7 +39,19 @@ Vec3 sample_polyline(std::span<const Vec3> line, std::span<const double> params,
   const double span = params[hi] - params[lo];
   if (!(span > 0)) return line[lo];
   const double w = (t - params[lo]) / span;
-  return line[lo] * (1.0 - w) + line[hi] * w;
+  if (mode == Sampling::linear || line.size() < 3) return line[lo] * (1.0 - w) + line[hi] * w;
+  // The derivative at sample i of the parabola through it and its two nearest samples.
+  auto tangent = [&](size_t i) -> Vec3 {
+    const size_t a = std::clamp<size_t>(i, 1, line.size() - 2) - 1;
+    const double h1 = params[a + 1] - params[a], h2 = params[a + 2] - params[a + 1];
+    if (!(h1 > 0) || !(h2 > 0)) return Vec3((line[hi] - line[lo]) / span);  // a repeated sample: the chord
+    const Vec3 d1 = (line[a + 1] - line[a]) / h1, d2 = (line[a + 2] - line[a + 1]) / h2;
+    const double x = params[i] - params[a + 1];  // where on the parabola, from its middle sample
+    return (d1 * h2 + d2 * h1) / (h1 + h2) + (d2 - d1) * (2 * x / (h1 + h2));
+  };
+  const double w2 = w * w, w3 = w2 * w;
+  return line[lo] * (2 * w3 - 3 * w2 + 1) + tangent(lo) * (span * (w3 - 2 * w2 + w)) + line[hi] * (3 * w2 - 2 * w3) +
+         tangent(hi) * (span * (w3 - w2));
 }
 
 uint32_t middle_sample(std::span<const double> params) {

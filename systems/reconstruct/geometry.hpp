@@ -17,8 +17,10 @@ std::vector<double> arc_parameters(std::span<const Vec3> line);
 double polyline_length(std::span<const Vec3> line);
 
 // How a polyline is read between its samples: `nearest` is the thesis's rule (the sample whose
-// parameter is closest, ties to the lower index), `linear` interpolates along the arc.
-enum class Sampling : uint8_t { nearest, linear };
+// parameter is closest, ties to the lower index), `linear` interpolates along the arc, `smooth` along the
+// cubic Hermite curve through the samples whose tangent at each is the derivative, in the arc parameter,
+// of the parabola through it and its two nearest samples (at the ends, the first or last three).
+enum class Sampling : uint8_t { nearest, linear, smooth };
 
 // The point at parameter t in [0, 1]; `params` are arc_parameters(line).
 Vec3 sample_polyline(std::span<const Vec3> line, std::span<const double> params, double t, Sampling mode);

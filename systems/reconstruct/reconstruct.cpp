@@ -64,6 +64,7 @@ struct ReconstructionCache {
   bool fit_built = false;
   std::vector<double> fit_shape;
   double fit_fairness = 0;  // the fairness it was built with (fit_fairness of the network's noise)
+  Sampling fit_targets = Sampling::smooth;  // and the reading of the polylines (exact or noisy curves)
   double noise = 0;         // noise_estimate of the network at the last refine (fire)
   bool fit_waiting = false;
   // The fit of `base` in progress (fire), between the frame that took the base and the one it ends in.
@@ -228,6 +229,8 @@ double fit_fairness(const Options& options, double noise) {
   const double beyond = noise / kNoisierCurves;
   return std::max(fairness, std::min(kNoisyFairness * beyond * beyond, kNoisiestFairness));
 }
+
+Sampling fit_targets(double noise) { return noise > kExactCurveNoise ? Sampling::linear : Sampling::smooth; }
 
 double worst_quad_aspect(const BaseMesh& base) {
   double worst = 0;
@@ -647,6 +650,7 @@ double curve_noise_deviation(const Options& options, double noise, double spread
 FitWeights fit_weights(const Options& options, double noise) {
   FitWeights weights;
   weights.fairness = fit_fairness(options, noise);
+  weights.targets = fit_targets(noise);
   if (!options.fairness_from_noise || !(kNoisyFairness > options.fairness)) {
     weights.shape = 0;
     return weights;
@@ -665,6 +669,7 @@ Status build_fit(const Options& options, ReconstructionCache& c) {
   c.fit_built = true;
   c.fit_shape = shape_weights(c.base, weights);
   c.fit_fairness = weights.fairness;
+  c.fit_targets = weights.targets;
   return Status::success();
 }
 
@@ -697,7 +702,8 @@ Result<bool> run_refine(const Mesh& net, const Options& options, ReconstructionC
   c.base = assemble(net, options, c, kBorderCornerTurnDegrees + spread);
   c.rebuild_topology = c.rebuild_topology || everything || !same_topology(c, c.base);
   if (options.method == Method::fire && c.fit_built &&
-      (weights.fairness != c.fit_fairness || shape_weights(c.base, weights) != c.fit_shape))
+      (weights.fairness != c.fit_fairness || weights.targets != c.fit_targets ||
+       shape_weights(c.base, weights) != c.fit_shape))
     c.fit_built = false;
   c.pending_subdivide = true;
   c.seen = net.frame();

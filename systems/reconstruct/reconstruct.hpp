@@ -146,6 +146,11 @@ inline constexpr double kNoisiestFairness = 1.0;  // the top of --fairness's ran
 // curves, growing with the square of the noise above kExactCurveNoise up to kNoisyFairness, and again
 // above kNoisierCurves up to kNoisiestFairness.
 double fit_fairness(const Options& options, double noise);
+// How the fit reads the polylines between their samples for that noise: smooth for exact curves (their
+// samples lie on a smooth curve, inside whose bends the chords cut by about the network_max goal),
+// linear above kExactCurveNoise (a cubic through noisy samples swings past them, and the surface folds;
+// perf/RESULTS.md). An explicit --fairness estimates no noise, so it reads them smooth.
+Sampling fit_targets(double noise);
 // A noisy curve reaching less far than kShortCurveNoises noise deviations from its ends is short: its shape
 // is mostly the noise's. The deviation is the larger of fit_noise and the sideways step of a curve turned
 // by tangent_spread_deg over kTangentReach of its length (correlated noise, which fit_noise does not

@@ -46,6 +46,29 @@ TEST_CASE("polylines are read by arc length: nearest sample or linear", "[geomet
   CHECK(sample_polyline(line, t, 0.125, Sampling::nearest) == line[0]);
 }
 
+TEST_CASE("smooth sampling passes through the samples and follows the curve between them", "[geometry]") {
+  // A quarter circle of radius 1, sampled at 9 points: the chords' midpoints lie 4.8e-3 inside it.
+  std::vector<Vec3> arc;
+  for (int i = 0; i <= 8; ++i) {
+    const double a = std::numbers::pi / 2 * i / 8;
+    arc.emplace_back(std::cos(a), std::sin(a), 0);
+  }
+  const std::vector<double> t = arc_parameters(arc);
+  double linear_error = 0, smooth_error = 0;
+  for (int k = 0; k <= 160; ++k) {
+    const double s = k / 160.0;
+    linear_error = std::max(linear_error, std::abs(sample_polyline(arc, t, s, Sampling::linear).norm() - 1));
+    smooth_error = std::max(smooth_error, std::abs(sample_polyline(arc, t, s, Sampling::smooth).norm() - 1));
+  }
+  CHECK(linear_error > 4e-3);
+  CHECK(smooth_error < linear_error / 20);
+  for (size_t i = 0; i < arc.size(); ++i) CHECK(sample_polyline(arc, t, t[i], Sampling::smooth).isApprox(arc[i], 1e-14));
+  // A straight polyline stays straight and keeps the arc parameter.
+  const std::vector<Vec3> line{{0, 0, 0}, {1, 0, 0}, {3, 0, 0}, {4, 0, 0}};
+  const std::vector<double> u = arc_parameters(line);
+  CHECK(sample_polyline(line, u, 0.6, Sampling::smooth).isApprox(Vec3(2.4, 0, 0), 1e-14));
+}
+
 TEST_CASE("splitting a polyline at its middle sample, a 2-point line at its midpoint", "[geometry]") {
   const std::vector<Vec3> line{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {2, 5, 0}};
   std::vector<Vec3> a, b;

@@ -133,6 +133,9 @@ TEST_CASE("a noisy network's fit follows its noise, and a move that changes the 
   CHECK(fit_fairness(options, noise) <= kNoisyFairness);
   // The same curves without the ripple are exact; an explicit weight is used as is.
   CHECK(fit_fairness(options, noise_estimate(grid_network(6, 4, 20, height))) == options.fairness);
+  // Exact curves are read on the smooth curve through their samples, noisy ones along their chords.
+  CHECK(fit_targets(noise_estimate(grid_network(6, 4, 20, height))) == Sampling::smooth);
+  CHECK(fit_targets(noise) == Sampling::linear);
   Options explicit_weight;
   explicit_weight.fairness_from_noise = false;
   CHECK(fit_fairness(explicit_weight, noise) == explicit_weight.fairness);
