@@ -14,7 +14,8 @@ void add_surface_options(CLI::App& cmd, SurfaceArgs& a) {
                  "fire: weight of the fit's smoothness term, 0 to 1 (smaller follows the curves more closely, larger "
                  "keeps face interiors smoother). Default: this for exact curves, raised with the noise the "
                  "polylines show (0.1 for a noise estimate of 3e-3 to 1.3e-2, beyond with its square, up to 1); given, it "
-                 "is used as is")
+                 "is used as is and the curves are fitted as exact ones (no noise estimate: no thin-quad shape "
+                 "term, and the polylines are read on the smooth curve through their samples)")
       ->capture_default_str();
   cmd.add_option("--planarity", a.planarity, "the thesis triquadrification's measure: least-squares, mean-normal or hough")
       ->capture_default_str();
