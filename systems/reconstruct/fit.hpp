@@ -14,7 +14,8 @@
 // patches) keeps the matrix definite. The normal matrix A^T A + fairness + ridge depends on topology
 // alone: it is factored once (sparse LDL^T) and a change of the points costs back-substitutions.
 //
-// Targets lie on the polylines, read between samples as FitWeights::targets says.
+// Targets lie on the polylines, read between samples as FitWeights::targets says (phase 2 below finds each
+// foot on the chords and reads the polyline at that foot's arc parameter).
 // The targets start at equal arc-length steps along each piece of a network edge. A limit curve is not
 // parameterized by arc length, so the targets then slide in three phases:
 //   1. along whole edges, to the arc-length fractions the fitted limit points have along the fitted
