@@ -1,5 +1,7 @@
 #include "systems/reconstruct/face.hpp"
 
+#include "engine/assert.hpp"
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -27,6 +29,9 @@ struct LocalEdge {
   uint32_t node = 0;
   std::vector<double> params;
   int32_t first_child = -1;  // the halves, once split: first_child (from -> mid), first_child + 1
+  std::array<bool, 2> child_reversed{false, false};  // a half stored against this edge's direction
+  VertexRef mid;              // the split point
+  Vec3 mid_point = Vec3::Zero();
   double mid_param = 0.5;    // arc parameter of the split point along the stored direction
   std::span<const Vec3> line() const { return splits ? splits->node(node) : std::span<const Vec3>(own); }
 };
@@ -84,19 +89,44 @@ class LocalMesh {
     const double whole = polyline_length(edges[e].line());
     const double part = polyline_length(first.line());
     const double mid_param = whole > 0 ? part / whole : 0.5;
+    const Vec3 mid_point = first.line().back();
     const uint32_t c = add_edge(std::move(first));
     add_edge(std::move(second));
     edges[e].first_child = static_cast<int32_t>(c);
+    edges[e].mid = mid;
+    edges[e].mid_point = mid_point;
     edges[e].mid_param = mid_param;
   }
-  // The half of a split edge that the walk meets first, and the other one, as oriented edges.
-  uint32_t first_half(uint32_t oe) const {
-    const uint32_t c = static_cast<uint32_t>(edges[oe >> 1].first_child);
-    return (oe & 1) ? ((c + 1) << 1 | 1u) : (c << 1);
+  // One edge made of two network sides walked in turn (oriented edges `a` then `b`, made just before
+  // it, one after the other), already split at the corner between them.
+  uint32_t join(uint32_t a, uint32_t b) {
+    FIRE_ASSERT((a >> 1) + 1 == (b >> 1), "the halves of a joined side are made one after the other");
+    LocalEdge whole;
+    whole.from = tail(a);
+    whole.to = tail(b ^ 1u);
+    auto walked = [](std::span<const Vec3> line, bool reversed) {
+      std::vector<Vec3> out(line.begin(), line.end());
+      if (reversed) std::reverse(out.begin(), out.end());
+      return out;
+    };
+    const std::vector<Vec3> first = walked(edges[a >> 1].line(), a & 1), second = walked(edges[b >> 1].line(), b & 1);
+    whole.own = first;
+    whole.own.insert(whole.own.end(), second.begin() + 1, second.end());
+    whole.first_child = static_cast<int32_t>(a >> 1);
+    whole.child_reversed = {(a & 1) != 0, (b & 1) != 0};
+    whole.mid = tail(b);
+    whole.mid_point = first.back();
+    const double part = polyline_length(first), rest = polyline_length(second);
+    whole.mid_param = part + rest > 0 ? part / (part + rest) : 0.5;
+    return add_edge(std::move(whole));
   }
-  uint32_t second_half(uint32_t oe) const {
-    const uint32_t c = static_cast<uint32_t>(edges[oe >> 1].first_child);
-    return (oe & 1) ? (c << 1 | 1u) : ((c + 1) << 1);
+  // The half of a split edge that the walk meets first, and the other one, as oriented edges.
+  uint32_t first_half(uint32_t oe) const { return (oe & 1) ? half(oe, 1) ^ 1u : half(oe, 0); }
+  uint32_t second_half(uint32_t oe) const { return (oe & 1) ? half(oe, 0) ^ 1u : half(oe, 1); }
+  // Half i of a split edge, oriented along it.
+  uint32_t half(uint32_t oe, uint32_t i) const {
+    const LocalEdge& edge = edges[oe >> 1];
+    return (static_cast<uint32_t>(edge.first_child) + i) << 1 | (edge.child_reversed[i] ? 1u : 0u);
   }
   // The split points of a network edge's piece below the face's own steps, in walk order.
   void append_finer_points(uint32_t oe, std::vector<VertexRef>& out) const {
@@ -106,8 +136,8 @@ class LocalMesh {
     for (uint32_t i = 1; i < span; ++i)
       out.push_back({RefKind::edge_point, edge.network_edge, (oe & 1) ? first + span - i : first + i});
   }
-  VertexRef mid(uint32_t oe) const { return edges[edges[oe >> 1].first_child].to; }
-  Vec3 mid_position(uint32_t oe) const { return edges[edges[oe >> 1].first_child].line().back(); }
+  VertexRef mid(uint32_t oe) const { return edges[oe >> 1].mid; }
+  Vec3 mid_position(uint32_t oe) const { return edges[oe >> 1].mid_point; }
   double mid_walk_param(uint32_t oe) const {
     const double t = edges[oe >> 1].mid_param;
     return (oe & 1) ? 1.0 - t : t;
@@ -235,21 +265,39 @@ FacePatch build_face_patch(const Mesh& net, uint32_t face, std::span<const EdgeS
 
 FacePatch build_face_patch(std::span<const FaceSide> sides, const FaceSettings& settings) {
   LocalMesh mesh;
-  const uint32_t n = static_cast<uint32_t>(sides.size());
-  std::vector<uint32_t> loop(n);
+  const uint32_t count = static_cast<uint32_t>(sides.size());
+  auto add_side = [&](const FaceSide& side) {
+    LocalEdge edge;
+    edge.from = {RefKind::network_vertex, side.from, 0};
+    edge.to = {RefKind::network_vertex, side.to, 0};
+    edge.splits = side.splits;
+    edge.network_edge = side.network_edge;
+    edge.node = 1;
+    return mesh.add_edge(std::move(edge)) << 1 | (side.reversed ? 1u : 0u);
+  };
+  // Start at a side that does not continue the one before it, so that joined pairs do not wrap round.
+  uint32_t start = 0;
+  while (start < count && sides[(start + count - 1) % count].joins_next) ++start;
+  FIRE_ASSERT(start < count, "every side of a face joins the next");
+  std::vector<uint32_t> loop;
   double total_length = 0;
   size_t total_segments = 0;
-  for (uint32_t k = 0; k < n; ++k) {
-    LocalEdge edge;
-    edge.from = {RefKind::network_vertex, sides[k].from, 0};
-    edge.to = {RefKind::network_vertex, sides[k].to, 0};
-    edge.splits = sides[k].splits;
-    edge.network_edge = sides[k].network_edge;
-    edge.node = 1;
-    loop[k] = mesh.add_edge(std::move(edge)) << 1 | (sides[k].reversed ? 1u : 0u);
-    total_length += sides[k].length;
-    total_segments += sides[k].segments;
+  for (uint32_t i = 0; i < count; ++i) {
+    const FaceSide& side = sides[(start + i) % count];
+    total_length += side.length;
+    total_segments += side.segments;
+    if (side.joins_next) {
+      FIRE_ASSERT(i + 1 < count && !sides[(start + i + 1) % count].joins_next, "a side joins two others");
+      const FaceSide& next = sides[(start + ++i) % count];
+      total_length += next.length;
+      total_segments += next.segments;
+      const uint32_t a = add_side(side);
+      loop.push_back(mesh.join(a, add_side(next)) << 1);
+      continue;
+    }
+    loop.push_back(add_side(side));
   }
+  const uint32_t n = static_cast<uint32_t>(loop.size());
   Refiner refiner{mesh, total_segments ? total_length / double(total_segments) : 0.0};
 
   FacePatch patch;

@@ -73,12 +73,16 @@ struct FacePatch {
 // One side of a face: a network edge, or a chain of them joined through network vertices the surface
 // leaves out (reconstruct.cpp), from network vertex `from` to `to` in its stored direction.
 struct FaceSide {
-  const EdgeSplits* splits = nullptr;  // depth = coons_steps
+  const EdgeSplits* splits = nullptr;  // depth >= coons_steps, one less for a half of a joined side
   uint32_t network_edge = 0;           // the edge slot its split points are named by (VertexRef::index)
   uint32_t from = 0, to = 0;
   bool reversed = false;  // the face's loop walks it from `to` to `from`
   double length = 0;      // its drawn polyline's length and segments: the face's sample spacing
   size_t segments = 0;
+  // FIRE: the loop goes straight on through the corner between this side and the next, so the two are
+  // one side of the face, split first at that corner and then each along its own split (the next side
+  // does not join the one after it).
+  bool joins_next = false;
 };
 
 // The face's sides in loop order. A face with 2 sides is the degenerate quad whose other two sides are

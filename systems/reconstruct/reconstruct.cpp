@@ -49,6 +49,9 @@ struct ReconstructionCache {
   Sides sides;
   std::vector<FacePatch> faces;
   std::vector<uint8_t> face_valid;
+  // Per face slot: the joined sides (FaceSide::joins_next) its entry of `faces` was built with, which
+  // follow from its neighbours too (plan_faces).
+  std::vector<std::vector<uint8_t>> face_joins;
   BaseMesh base;
   // What depends on the base mesh's topology alone.
   bool have_topology = false;
@@ -395,30 +398,116 @@ void build_sides(const Mesh& net, bool noisy, Sides& sides) {
   }
 }
 
-// How many times each side is split (EdgeSplits::depth), by its lead edge: the Coons steps, and for FIRE
-// one more for each doubling a side needs to come within kLongSideRatio of the mean side of every face
-// it borders (at most kMaxSideDoublings).
-std::vector<uint32_t> side_depths(const Mesh& net, const Options& options, const Sides& sides) {
-  std::vector<uint32_t> depth(net.edge_slots(), options.coons_steps);
-  if (options.method != Method::fire) return depth;
-  std::vector<double> length(net.edge_slots(), 0.0);
-  for (uint32_t e = 0; e < net.edge_slots(); ++e)
-    for (uint32_t m : sides.members[e]) length[e] += polyline_length(net.polyline(m >> 1));
-  std::vector<uint32_t> leads;
+// The sides of each live face slot in loop order, from its first corner that is not joined; `splits`
+// points at the cache's entry for the side, filled in later.
+std::vector<std::vector<FaceSide>> face_sides(const Mesh& net, const Sides& sides, ReconstructionCache& c) {
+  std::vector<std::vector<FaceSide>> all(net.face_slots());
   for (uint32_t f = 0; f < net.face_slots(); ++f) {
     if (!net.face_alive(f)) continue;
-    leads.clear();
-    double total = 0;
-    for (uint32_t oe : net.face_loop(f)) {
+    auto loop = net.face_loop(f);
+    const size_t n = loop.size();
+    size_t start = 0;
+    while (sides.joined[net.tail(loop[start])]) ++start;
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t oe = loop[(start + i) % n];
       if (sides.joined[net.tail(oe)]) continue;
-      leads.push_back(sides.lead[edge_of(oe)]);
-      total += length[leads.back()];
+      const uint32_t lead = sides.lead[edge_of(oe)];
+      const std::vector<uint32_t>& members = sides.members[lead];
+      const auto member = std::find_if(members.begin(), members.end(), [&](uint32_t m) { return (m >> 1) == edge_of(oe); });
+      FaceSide side{&c.edges[lead], lead, sides.from[lead], sides.to[lead], is_reversed(oe) != ((*member & 1) != 0), 0, 0};
+      for (uint32_t m : members) {
+        side.length += polyline_length(net.polyline(m >> 1));
+        side.segments += net.edges.point_count[m >> 1] - 1;
+      }
+      all[f].push_back(side);
     }
-    const double mean = total / double(leads.size());
-    for (uint32_t e : leads) {
+  }
+  return all;
+}
+
+// The network edge of `side` that touches its end `v`.
+uint32_t end_member(const Sides& sides, const FaceSide& side, uint32_t v) {
+  const std::vector<uint32_t>& members = sides.members[side.network_edge];
+  return (v == side.to ? members.back() : members.front()) >> 1;
+}
+
+// Whether side k of a face is half of a side joined at one of its ends.
+bool joined_half(const std::vector<FaceSide>& face, size_t k) {
+  return face[k].joins_next || face[(k + face.size() - 1) % face.size()].joins_next;
+}
+
+// fire: which sides of each face run straight on into the next (FaceSide::joins_next). Two sides join
+// where the loop turns by at most `straight_turn` degrees and neither is more than kLongSideRatio times the
+// other, the straightest corners first, each side in one pair at most, while the face keeps more than
+// four sides: four sides already split into a grid of quads (a disc bounded by four arcs stays so).
+// A joined pair stays only where each of its halves is a half in every face that uses it: a half is split
+// one step less than the faces' Coons steps, and a face that did not join it would have to split it.
+void plan_faces(const Mesh& net, const Options& options, const Sides& sides, double straight_turn,
+                std::vector<std::vector<FaceSide>>& all) {
+  if (options.method != Method::fire) return;
+  std::vector<std::pair<double, uint32_t>> corners;  // (turn, the side the corner ends)
+  for (std::vector<FaceSide>& face : all) {
+    const uint32_t n = static_cast<uint32_t>(face.size());
+    if (n <= 4) continue;
+    corners.clear();
+    for (uint32_t k = 0; k < n; ++k) {
+      const FaceSide& in = face[k];
+      const FaceSide& out = face[(k + 1) % n];
+      if (in.from == in.to || out.from == out.to || in.network_edge == out.network_edge) continue;
+      if (std::max(in.length, out.length) > kLongSideRatio * std::min(in.length, out.length)) continue;
+      const uint32_t v = in.reversed ? in.from : in.to;
+      const double cosine = leaving_direction(net, end_member(sides, in, v), v).dot(leaving_direction(net, end_member(sides, out, v), v));
+      const double turn = 180.0 - std::acos(std::clamp(cosine, -1.0, 1.0)) * 180.0 / std::numbers::pi;
+      if (turn <= straight_turn) corners.emplace_back(turn, k);
+    }
+    std::sort(corners.begin(), corners.end());
+    uint32_t kept = n;
+    for (const auto& [turn, k] : corners) {
+      if (kept <= 4 || face[k].joins_next || joined_half(face, k) || face[(k + 1) % n].joins_next) continue;
+      face[k].joins_next = true;
+      --kept;
+    }
+  }
+  std::vector<uint32_t> uses(net.edge_slots()), halves(net.edge_slots());
+  for (bool dropped = true; dropped;) {
+    dropped = false;
+    std::fill(uses.begin(), uses.end(), 0u);
+    std::fill(halves.begin(), halves.end(), 0u);
+    for (const std::vector<FaceSide>& face : all)
+      for (size_t k = 0; k < face.size(); ++k) {
+        ++uses[face[k].network_edge];
+        if (joined_half(face, k)) ++halves[face[k].network_edge];
+      }
+    for (std::vector<FaceSide>& face : all)
+      for (size_t k = 0; k < face.size(); ++k) {
+        const uint32_t a = face[k].network_edge, b = face[(k + 1) % face.size()].network_edge;
+        if (face[k].joins_next && (halves[a] != uses[a] || halves[b] != uses[b])) {
+          face[k].joins_next = false;
+          dropped = true;
+        }
+      }
+  }
+}
+
+// How many times each side is split (EdgeSplits::depth), by its lead edge: the Coons steps (one less for
+// the halves of a joined side), and for FIRE one more for each doubling the side needs to come within
+// kLongSideRatio of the mean side of every face it borders (at most kMaxSideDoublings).
+std::vector<uint32_t> side_depths(const Mesh& net, const Options& options, const std::vector<std::vector<FaceSide>>& all) {
+  std::vector<uint32_t> depth(net.edge_slots(), options.coons_steps);
+  if (options.method != Method::fire) return depth;
+  for (const std::vector<FaceSide>& face : all)
+    for (size_t k = 0; k < face.size(); ++k)
+      if (joined_half(face, k)) depth[face[k].network_edge] = options.coons_steps - 1;
+  for (const std::vector<FaceSide>& face : all) {
+    if (face.empty()) continue;
+    double total = 0;
+    for (const FaceSide& side : face) total += side.length;
+    const double mean = total / double(face.size());
+    for (size_t k = 0; k < face.size(); ++k) {
       uint32_t doublings = 0;
-      while (doublings < kMaxSideDoublings && length[e] > kLongSideRatio * double(1u << doublings) * mean) ++doublings;
-      depth[e] = std::max(depth[e], options.coons_steps + doublings);
+      while (doublings < kMaxSideDoublings && face[k].length > kLongSideRatio * double(1u << doublings) * mean) ++doublings;
+      const uint32_t e = face[k].network_edge;
+      depth[e] = std::max(depth[e], (joined_half(face, k) ? options.coons_steps - 1 : options.coons_steps) + doublings);
     }
   }
   return depth;
@@ -427,7 +516,7 @@ std::vector<uint32_t> side_depths(const Mesh& net, const Options& options, const
 // The per-edge and per-face stages, for the elements whose tags say they may have changed, or (edges)
 // whose short-curve scale did.
 void update_elements(const Mesh& net, const Options& options, ReconstructionCache& c, bool everything,
-                     double deviation) {
+                     double deviation, double straight_turn) {
   c.edges.resize(net.edge_slots());
   c.edge_valid.resize(net.edge_slots(), 0);
   c.edge_scale.resize(net.edge_slots(), 1.0);
@@ -436,9 +525,12 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
   c.faces.resize(net.face_slots());
   c.face_valid.resize(net.face_slots(), 0);
   c.stats = {};
+  c.face_joins.resize(net.face_slots());
   build_sides(net, options.method == Method::fire && deviation > 0, c.sides);
   const Sides& sides = c.sides;
-  const std::vector<uint32_t> depth = side_depths(net, options, sides);
+  std::vector<std::vector<FaceSide>> all_sides = face_sides(net, sides, c);
+  plan_faces(net, options, sides, straight_turn, all_sides);
+  const std::vector<uint32_t> depth = side_depths(net, options, all_sides);
   std::vector<Vec3> line;
   for (uint32_t e = 0; e < net.edge_slots(); ++e) {
     const std::vector<uint32_t>& members = sides.members[e];
@@ -481,37 +573,21 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
     ++c.stats.edges_recomputed;
   }
   const FaceSettings settings{options.method, options.coons_steps, options.planarity};
-  std::vector<FaceSide> face_sides;
+  std::vector<uint8_t> joins;
   for (uint32_t f = 0; f < net.face_slots(); ++f) {
     if (!net.face_alive(f)) {
       c.faces[f] = {};
       c.face_valid[f] = 0;
       continue;
     }
-    auto loop = net.face_loop(f);
-    bool stale = everything || !c.face_valid[f] || net.faces.changes.changed_since(f, c.seen);
-    for (uint32_t oe : loop) stale = stale || c.edge_redone[edge_of(oe)];
+    joins.clear();
+    for (const FaceSide& side : all_sides[f]) joins.push_back(side.joins_next ? 1 : 0);
+    bool stale = everything || !c.face_valid[f] || net.faces.changes.changed_since(f, c.seen) || c.face_joins[f] != joins;
+    for (uint32_t oe : net.face_loop(f)) stale = stale || c.edge_redone[edge_of(oe)];
     if (!stale) continue;
-    // One side per run of the loop from a corner that is not joined to the next.
-    const size_t n = loop.size();
-    size_t start = 0;
-    while (sides.joined[net.tail(loop[start])]) ++start;
-    face_sides.clear();
-    for (size_t i = 0; i < n; ++i) {
-      const uint32_t oe = loop[(start + i) % n];
-      if (sides.joined[net.tail(oe)]) continue;
-      const uint32_t lead = sides.lead[edge_of(oe)];
-      const std::vector<uint32_t>& members = sides.members[lead];
-      const auto member = std::find_if(members.begin(), members.end(), [&](uint32_t m) { return (m >> 1) == edge_of(oe); });
-      FaceSide side{&c.edges[lead], lead, sides.from[lead], sides.to[lead], is_reversed(oe) != ((*member & 1) != 0), 0, 0};
-      for (uint32_t m : members) {
-        side.length += polyline_length(net.polyline(m >> 1));
-        side.segments += net.edges.point_count[m >> 1] - 1;
-      }
-      face_sides.push_back(side);
-    }
-    c.faces[f] = build_face_patch(face_sides, settings);
+    c.faces[f] = build_face_patch(all_sides[f], settings);
     c.face_valid[f] = 1;
+    c.face_joins[f] = joins;
     ++c.stats.faces_recomputed;
   }
 }
@@ -698,7 +774,7 @@ Result<bool> run_refine(const Mesh& net, const Options& options, ReconstructionC
     weights = fit_weights(options, c.noise);
     deviation = curve_noise_deviation(options, c.noise, spread, mean_length);
   }
-  update_elements(net, options, c, everything, deviation);
+  update_elements(net, options, c, everything, deviation, kStraightCornerTurn - spread);
   c.base = assemble(net, options, c, kBorderCornerTurnDegrees + spread);
   c.rebuild_topology = c.rebuild_topology || everything || !same_topology(c, c.base);
   if (options.method == Method::fire && c.fit_built &&

@@ -48,6 +48,13 @@ inline constexpr double kTangentReach = 0.15;
 // side then have polygons with the finer split points between their corners.
 inline constexpr double kLongSideRatio = 2.0;
 inline constexpr uint32_t kMaxSideDoublings = 2;
+// fire: where a face's loop turns by at most this many degrees less the network's tangent_spread_deg at
+// a corner (measured as for border corners, kTangentReach; noise turns the curves' first stretches, so
+// only a corner straight beyond the noise's turning counts), the two sides there are one side of the
+// face, split first at that corner, as a curve that ends on another one's middle is; only where every
+// face of both sides sees them so (plan_faces in reconstruct.cpp), since a side is split the same way
+// for both its faces.
+inline constexpr double kStraightCornerTurn = 20.0;
 // Surface levels the options allow (the Catmull-Clark library itself refines further).
 inline constexpr uint32_t kMaxSurfaceLevels = 6;
 // Options::fit_solves_per_frame that runs a fit to its end in one call, as a rebuild does.

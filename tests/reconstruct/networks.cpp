@@ -18,13 +18,16 @@ void add_face(Mesh& m, std::initializer_list<std::pair<uint32_t, bool>> loop) {
   REQUIRE(m.add_face(oriented) != kNone);
 }
 
-}  // namespace
-
-Mesh polygon_network(uint32_t n, uint32_t samples) {
+// Corner k of n evenly spaced round the unit circle: angle 2 pi k / n.
+std::vector<double> even_angles(uint32_t n) {
   std::vector<double> angles;
   for (uint32_t k = 0; k < n; ++k) angles.push_back(2 * std::numbers::pi * k / n);
-  return polygon_network(angles, samples);
+  return angles;
 }
+
+}  // namespace
+
+Mesh polygon_network(uint32_t n, uint32_t samples) { return polygon_network(even_angles(n), samples); }
 
 Mesh polygon_network(const std::vector<double>& angles, uint32_t samples) {
   Mesh m;
@@ -37,6 +40,30 @@ Mesh polygon_network(const std::vector<double>& angles, uint32_t samples) {
     const double from = angles[k], to = k + 1 < n ? angles[k + 1] : angles[0] + 2 * std::numbers::pi;
     std::vector<Vec3> line;
     for (uint32_t i = 0; i < samples; ++i) line.push_back(point(from + (to - from) * i / (samples - 1)));
+    oriented.push_back(make_oriented(m.add_edge(corners[k], corners[(k + 1) % n], line), false));
+  }
+  REQUIRE(m.add_face(oriented) != kNone);
+  REQUIRE(m.validate() == "");
+  return m;
+}
+
+Mesh cornered_polygon_network(uint32_t n, uint32_t samples) { return cornered_polygon_network(even_angles(n), samples); }
+
+Mesh cornered_polygon_network(const std::vector<double>& angles, uint32_t samples) {
+  Mesh m;
+  auto lifted = [](const Eigen::Vector2d& q) { return Vec3(q.x(), q.y(), 0.2 * std::cos(2 * std::atan2(q.y(), q.x()))); };
+  const size_t n = angles.size();
+  std::vector<Eigen::Vector2d> at;
+  std::vector<uint32_t> corners;
+  for (double a : angles) {
+    at.emplace_back(std::cos(a), std::sin(a));
+    corners.push_back(m.add_vertex(lifted(at.back())));
+  }
+  std::vector<uint32_t> oriented;
+  for (size_t k = 0; k < n; ++k) {
+    const Eigen::Vector2d &from = at[k], &to = at[(k + 1) % n];
+    std::vector<Vec3> line;
+    for (uint32_t i = 0; i < samples; ++i) line.push_back(lifted(from + (to - from) * (double(i) / (samples - 1))));
     oriented.push_back(make_oriented(m.add_edge(corners[k], corners[(k + 1) % n], line), false));
   }
   REQUIRE(m.add_face(oriented) != kNone);

@@ -18,6 +18,11 @@ Mesh polygon_network(uint32_t n, uint32_t samples = 9);
 // The same with corners at the given increasing angles (radians, from [0, 2 pi)): side k runs from
 // corner k to corner k + 1 counter-clockwise, the last one back to corner 0.
 Mesh polygon_network(const std::vector<double>& angles, uint32_t samples = 9);
+// One face with n >= 3 sides whose loop turns at every corner: the corners as in polygon_network, each
+// side the chord between them, lifted to z = 0.2 cos(2 angle) at its points' angles (polygon_network's
+// arcs run straight on through the corners, and FIRE joins such sides, kStraightCornerTurn).
+Mesh cornered_polygon_network(uint32_t n, uint32_t samples = 9);
+Mesh cornered_polygon_network(const std::vector<double>& angles, uint32_t samples = 9);
 
 // A grid of nx by ny square faces over [0, nx] x [0, ny], every curve on the surface z = height(x, y)
 // with `samples` points; faces counter-clockwise seen from +z, numbered row by row (face j*nx + i).

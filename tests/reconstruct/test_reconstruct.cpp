@@ -90,7 +90,7 @@ TEST_CASE("thesis: the centre of a 4-sided face is its Coons point x(1/2, 1/2)",
 
 TEST_CASE("FIRE: an n-sided face becomes n quads around its centre", "[reconstruct][fire]") {
   for (uint32_t n : {2u, 3u, 4u, 5u, 6u}) {
-    const Mesh net = polygon_network(n);
+    const Mesh net = n == 2 ? polygon_network(n) : cornered_polygon_network(n);
     const BaseMesh b = base_of(net, {Method::fire, 1, 2, Planarity::least_squares});
     INFO("n = " << n);
     CHECK(b.vertex_count() == 2 * n + 1);
@@ -115,9 +115,9 @@ TEST_CASE("FIRE: an n-sided face becomes n quads around its centre", "[reconstru
 
 TEST_CASE("FIRE: a side much longer than its face's mean side gets more pieces, and the faces beside it polygons",
           "[reconstruct][fire]") {
-  // Four sides of 45 degrees and one of 180 along the circle: the long one is 2.5 times the mean side.
-  const double d = std::numbers::pi / 4;
-  const Mesh net = polygon_network({0, d, 2 * d, 3 * d, 4 * d}, 17);
+  // Four chords of 30 degrees and one of 240: the long one is 2.3 times the mean side.
+  const double d = std::numbers::pi / 6;
+  const Mesh net = cornered_polygon_network({0, d, 2 * d, 3 * d, 4 * d}, 17);
   for (uint32_t steps : {1u, 2u}) {
     INFO(steps << " Coons steps");
     const BaseMesh b = base_of(net, {Method::fire, steps, 2, Planarity::least_squares});
@@ -143,6 +143,82 @@ TEST_CASE("FIRE: a side much longer than its face's mean side gets more pieces, 
   // The thesis's Coons steps split every side alike.
   const BaseMesh thesis = base_of(net, {Method::thesis, 1, 2, Planarity::least_squares});
   for (uint32_t s = 0; s < thesis.side_count(); ++s) CHECK(thesis.side_curve_offsets[s + 1] - thesis.side_curve_offsets[s] == 2);
+}
+
+TEST_CASE("FIRE: sides that run straight on through a corner are one side, split first at that corner",
+          "[reconstruct][fire]") {
+  // A disc bounded by n arcs of one circle: every corner goes straight on. Sides join in pairs until four
+  // are left; a half of a joined side is one base edge, every other side two, and the face four quads.
+  for (uint32_t n : {4u, 5u, 6u}) {
+    INFO("n = " << n);
+    const Mesh net = polygon_network(n);
+    const BaseMesh b = base_of(net, {Method::fire, 1, 2, Planarity::least_squares});
+    const uint32_t halves = 2 * (n - 4);
+    CHECK(b.face_count() == 4);
+    check_disk(b);
+    CHECK(b.vertex_count() == n + (n - halves) + 1);
+    uint32_t one_piece = 0;
+    for (uint32_t s = 0; s < b.side_count(); ++s) {
+      const uint32_t pieces = b.side_curve_offsets[s + 1] - b.side_curve_offsets[s];
+      CHECK((pieces == 1 || pieces == 2));
+      one_piece += pieces == 1;
+    }
+    CHECK(one_piece == halves);
+    auto surface = reconstruct_surface(net, {Method::fire, 1, 2, Planarity::least_squares});
+    REQUIRE(surface.ok());
+    CHECK(surface->face_count() == 4 * 16);
+  }
+}
+
+TEST_CASE("FIRE: a straight corner joins its sides only where every face of those sides joins them",
+          "[reconstruct][fire]") {
+  // A 2 x 1 rectangle over [0, 2] x [1, 2] whose bottom runs straight on through (1, 1), below it either
+  // one more such rectangle (the vertex has valence 2: both faces join there) or two unit squares (the
+  // vertex is a corner of the squares, which split those sides in two, so the rectangle does too).
+  auto line = [](const Vec3& a, const Vec3& b) {
+    std::vector<Vec3> points;
+    for (int i = 0; i <= 8; ++i) points.push_back(a + (b - a) * (i / 8.0));
+    return points;
+  };
+  for (bool squares : {false, true}) {
+    INFO((squares ? "two squares below" : "a rectangle below"));
+    Mesh net;
+    std::vector<Vec3> at{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0}, {0, 2, 0}, {2, 2, 0}};
+    std::vector<uint32_t> v;
+    for (const Vec3& p : at) v.push_back(net.add_vertex(p));
+    auto edge = [&](uint32_t a, uint32_t b) { return net.add_edge(v[a], v[b], line(at[a], at[b])); };
+    const uint32_t left = edge(3, 4), right = edge(4, 5), top_right = edge(5, 7), top = edge(7, 6), top_left = edge(6, 3);
+    const uint32_t bottom_left = edge(0, 3), bottom_right = edge(2, 5);
+    std::vector<uint32_t> upper{make_oriented(left, false), make_oriented(right, false), make_oriented(top_right, false),
+                                make_oriented(top, false), make_oriented(top_left, false)};
+    if (squares) {
+      const uint32_t a = edge(0, 1), b = edge(1, 2), middle = edge(1, 4);
+      const uint32_t first[] = {make_oriented(a, false), make_oriented(middle, false), make_oriented(left, true),
+                                make_oriented(bottom_left, true)};
+      const uint32_t second[] = {make_oriented(b, false), make_oriented(bottom_right, false), make_oriented(right, true),
+                                 make_oriented(middle, true)};
+      REQUIRE(net.add_face(first) != kNone);
+      REQUIRE(net.add_face(second) != kNone);
+    } else {
+      const uint32_t bottom = edge(0, 2);
+      const uint32_t lower[] = {make_oriented(bottom, false), make_oriented(bottom_right, false), make_oriented(right, true),
+                                make_oriented(left, true), make_oriented(bottom_left, true)};
+      REQUIRE(net.add_face(lower) != kNone);
+    }
+    const uint32_t upper_face = net.add_face(upper);
+    REQUIRE(upper_face != kNone);
+    REQUIRE(net.validate() == "");
+    const BaseMesh b = base_of(net, {Method::fire, 1, 2, Planarity::least_squares});
+    check_disk(b);
+    uint32_t upper_quads = 0;
+    for (uint32_t f = 0; f < b.face_count(); ++f) upper_quads += b.face_source[f] == upper_face;
+    CHECK(upper_quads == (squares ? 5u : 4u));
+    // The two halves are one base edge each where they join, two where the squares split them.
+    uint32_t one_piece = 0;
+    for (uint32_t s = 0; s < b.side_count(); ++s) one_piece += b.side_curve_offsets[s + 1] - b.side_curve_offsets[s] == 1;
+    CHECK(one_piece == (squares ? 0u : 2u));
+    CHECK(b.vertex_count() == (squares ? 8u + 10u + 3u : 7u + 6u + 2u));
+  }
 }
 
 TEST_CASE("FIRE: a border vertex is a corner only where the border turns", "[reconstruct][fire]") {
