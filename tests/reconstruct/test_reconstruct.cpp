@@ -278,6 +278,47 @@ TEST_CASE("FIRE: a border turn no larger than the noise's own turning is no corn
   CHECK_FALSE(kink_is_corner(net));
 }
 
+TEST_CASE("FIRE: a straight corner joins its sides only beyond the noise's own turning", "[reconstruct][fire][noise]") {
+  // A 4 x 4 grid whose first two bottom faces are one: its bottom runs straight on through (1, 0), a border
+  // vertex of valence 2, which the face joins (five base faces for its six corners); (1, 1) is a corner of
+  // the faces above, which split the sides there, so the face keeps it.
+  Mesh net = grid_network(4, 4, 17, [](double x, double y) { return 0.05 * x * y; });
+  const uint32_t nx = 4, vertical = 5 * nx;
+  net.remove_face(0);
+  net.remove_face(1);
+  net.remove_edge(vertical + 1);
+  const uint32_t loop[] = {make_oriented(0, false),          make_oriented(1, false), make_oriented(vertical + 2, false),
+                           make_oriented(nx + 1, true),       make_oriented(nx, true), make_oriented(vertical, true)};
+  const uint32_t merged = net.add_face(loop);
+  REQUIRE(merged != kNone);
+  REQUIRE(net.validate() == "");
+  auto base_faces = [&](const Mesh& m) {
+    const BaseMesh b = base_of(m, {Method::fire, 1, 2, Planarity::least_squares});
+    return std::count(b.face_source.begin(), b.face_source.end(), merged);
+  };
+  CHECK(tangent_spread_deg(net) < 0.5);
+  CHECK(base_faces(net) == 5);
+  // Every curve but the two joined ones bowed up, by one to three times a height, as a tracked pen errs along
+  // a stroke: the curves leave their vertices out of one plane (tangent_spread_deg), and a corner counts as
+  // straight only where it turns by less than 20 degrees less that spread.
+  auto bowed = [&](double height) {
+    Mesh m = net;
+    for (uint32_t e = 2; e < m.edge_slots(); ++e) {
+      if (!m.edge_alive(e)) continue;
+      const uint32_t first = m.edges.point_offset[e], count = m.edges.point_count[e];
+      for (uint32_t s = 1; s + 1 < count; ++s)
+        m.points.set(first + s, m.points[first + s] + Vec3(0, 0, height * (1 + e % 3) * std::sin(std::numbers::pi * s / (count - 1))));
+    }
+    return m;
+  };
+  const Mesh slightly = bowed(0.01), strongly = bowed(0.15);
+  INFO("tangent spread " << tangent_spread_deg(slightly) << " and " << tangent_spread_deg(strongly) << " degrees");
+  CHECK(tangent_spread_deg(slightly) < kStraightCornerTurn / 2);
+  CHECK(base_faces(slightly) == 5);
+  CHECK(tangent_spread_deg(strongly) > kStraightCornerTurn);
+  CHECK(base_faces(strongly) == 6);
+}
+
 TEST_CASE("the worst base quad's aspect: 1 for a square, 1/w for a 1 x w rectangle", "[reconstruct]") {
   BaseMesh b;
   b.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {2, 0, 0}, {2, 0.25, 0}, {1, 0.25, 0}};
