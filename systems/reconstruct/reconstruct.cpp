@@ -124,6 +124,11 @@ Vec3 leaving_direction(const Mesh& net, uint32_t e, uint32_t v) {
   return d.normalized();
 }
 
+// How many degrees a curve turns passing through a vertex, from the directions its two sides leave it in.
+double turn_degrees(const Vec3& leaving, const Vec3& other_leaving) {
+  return 180.0 - std::acos(std::clamp(leaving.dot(other_leaving), -1.0, 1.0)) * 180.0 / std::numbers::pi;
+}
+
 // A border network vertex is a corner of the surface where the border turns by more than
 // `threshold_deg`; where it goes straight on it is a smooth point of the border.
 bool border_corner(const Mesh& net, uint32_t v, double threshold_deg) {
@@ -134,9 +139,7 @@ bool border_corner(const Mesh& net, uint32_t v, double threshold_deg) {
       border[count++] = e;
     }
   if (count != 2) return true;
-  const double cosine = leaving_direction(net, border[0], v).dot(leaving_direction(net, border[1], v));
-  const double turn = 180.0 - std::acos(std::clamp(cosine, -1.0, 1.0)) * 180.0 / std::numbers::pi;
-  return !(turn <= threshold_deg);
+  return !(turn_degrees(leaving_direction(net, border[0], v), leaving_direction(net, border[1], v)) <= threshold_deg);
 }
 
 
@@ -401,6 +404,14 @@ void build_sides(const Mesh& net, bool noisy, Sides& sides) {
 // The sides of each live face slot in loop order, from its first corner that is not joined; `splits`
 // points at the cache's entry for the side, filled in later.
 std::vector<std::vector<FaceSide>> face_sides(const Mesh& net, const Sides& sides, ReconstructionCache& c) {
+  // Each side's drawn length and segments, once for both its faces.
+  std::vector<double> length(net.edge_slots(), 0.0);
+  std::vector<size_t> segments(net.edge_slots(), 0);
+  for (uint32_t lead = 0; lead < net.edge_slots(); ++lead)
+    for (uint32_t m : sides.members[lead]) {
+      length[lead] += polyline_length(net.polyline(m >> 1));
+      segments[lead] += net.edges.point_count[m >> 1] - 1;
+    }
   std::vector<std::vector<FaceSide>> all(net.face_slots());
   for (uint32_t f = 0; f < net.face_slots(); ++f) {
     if (!net.face_alive(f)) continue;
@@ -414,12 +425,8 @@ std::vector<std::vector<FaceSide>> face_sides(const Mesh& net, const Sides& side
       const uint32_t lead = sides.lead[edge_of(oe)];
       const std::vector<uint32_t>& members = sides.members[lead];
       const auto member = std::find_if(members.begin(), members.end(), [&](uint32_t m) { return (m >> 1) == edge_of(oe); });
-      FaceSide side{&c.edges[lead], lead, sides.from[lead], sides.to[lead], is_reversed(oe) != ((*member & 1) != 0), 0, 0};
-      for (uint32_t m : members) {
-        side.length += polyline_length(net.polyline(m >> 1));
-        side.segments += net.edges.point_count[m >> 1] - 1;
-      }
-      all[f].push_back(side);
+      all[f].push_back({&c.edges[lead], lead, sides.from[lead], sides.to[lead], is_reversed(oe) != ((*member & 1) != 0),
+                        length[lead], segments[lead]});
     }
   }
   return all;
@@ -456,8 +463,8 @@ void plan_faces(const Mesh& net, const Options& options, const Sides& sides, dou
       if (in.from == in.to || out.from == out.to || in.network_edge == out.network_edge) continue;
       if (std::max(in.length, out.length) > kLongSideRatio * std::min(in.length, out.length)) continue;
       const uint32_t v = in.reversed ? in.from : in.to;
-      const double cosine = leaving_direction(net, end_member(sides, in, v), v).dot(leaving_direction(net, end_member(sides, out, v), v));
-      const double turn = 180.0 - std::acos(std::clamp(cosine, -1.0, 1.0)) * 180.0 / std::numbers::pi;
+      const double turn = turn_degrees(leaving_direction(net, end_member(sides, in, v), v),
+                                       leaving_direction(net, end_member(sides, out, v), v));
       if (turn <= straight_turn) corners.emplace_back(turn, k);
     }
     std::sort(corners.begin(), corners.end());
