@@ -32,6 +32,12 @@ constexpr double kJumpGate_m = 0.02;      // pen positions this far apart are di
 constexpr double kMaxPenSpeed_m_s = 5.0;  // a hand moves the pen no faster
 constexpr double kBridgeSpeed_m_s = 1.0;  // a drawing hand, while both cameras lose the pen, moves it no faster
 constexpr double kFollowStep_px = 40;     // the pen's blob moves less than this between two frames of a camera
+// Of the pairs that fit where the pen could be, the nearer wins unless it is worse off its epipolar line
+// than the pen's own pixel noise explains. A light that shone merged with the pen's blob and split from it
+// fits a few millimetres off and a pixel or more off the line; once taken, the pen is what looks like the
+// light beside it, and the light then holds the lifted pen down. A pixel of misfit counts as this distance:
+// a few frames' motion, against the quarter pixel of a true pair's noise.
+constexpr double kMisfitDistance_m = 0.02;
 
 // The median of the recent gaps, taken when a gap is added: every report and frame reads it.
 double median_period(const std::deque<double>& gaps_us) {
@@ -238,7 +244,8 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
   // fits the geometry. While the pen is down and both cameras saw it last, a light beside it in either
   // camera is not paired: once the pen leaves one camera's view, that reflection fits the other camera's
   // pen centimetres deeper, and the stroke would end there. Of the rest, the fit nearest the pen's last
-  // position wins. A stroke only starts from a frame where every fitting pair agrees.
+  // position wins, its epipolar misfit counted as distance (kMisfitDistance_m). A stroke only starts from a
+  // frame where every fitting pair agrees.
   std::array<tracking::Triangulation, tracking::kIrSlots * tracking::kIrSlots> fits;
   std::array<std::array<int, 2>, tracking::kIrSlots * tracking::kIrSlots> fit_blobs;
   int fit_count = 0;
@@ -268,10 +275,15 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
   int best = -1;
   if (s.down) {
     const double gate = reach_m(t - s.last_seen_t, options.short_gap_us);
-    for (int c = 0; c < fit_count; ++c)
-      if ((fits[c].X - s.last_position).norm() <= gate &&
-          (best < 0 || (fits[c].X - s.last_position).norm() < (fits[best].X - s.last_position).norm()))
+    double best_cost = std::numeric_limits<double>::infinity();
+    for (int c = 0; c < fit_count; ++c) {
+      const double distance = (fits[c].X - s.last_position).norm();
+      const double cost = std::hypot(distance, kMisfitDistance_m * fits[c].reprojection_error_px);
+      if (distance <= gate && cost < best_cost) {
         best = c;
+        best_cost = cost;
+      }
+    }
     // Seen again after a longer gap, but not where the pen could have got to: it was lifted and put down
     // elsewhere, so a new stroke starts here.
     if (best < 0 && t - s.last_seen_t > static_cast<double>(options.short_gap_us)) end_stroke(s, out);
