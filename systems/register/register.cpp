@@ -1,6 +1,8 @@
 #include "systems/register/register.hpp"
 
 #include <algorithm>
+#include <cstdint>
+#include <optional>
 #include <string>
 
 #include "engine/text.hpp"
@@ -39,6 +41,38 @@ void touch_mark(const InputEvent& e, RegistrationState& s, std::vector<Rejection
   s.touched.push_back({e.mark, mean, e.p});
 }
 
+// The rigid motion of the marks touched, but the one at `left_out` (none left out by default).
+Result<tracking::RigidTransform> fit_marks(const std::vector<MarkTouch>& touched, size_t left_out = SIZE_MAX) {
+  std::vector<Vec3> measured, model;
+  for (size_t i = 0; i < touched.size(); ++i)
+    if (i != left_out) {
+      measured.push_back(touched[i].measured);
+      model.push_back(touched[i].model);
+    }
+  return tracking::register_rigid(measured, model);
+}
+
+struct OddMark {
+  uint32_t mark = 0;
+  double distance = 0;  // metres, from where the other marks' motion puts it
+};
+
+// The mark without which the others fit a rigid motion best, when they fit within kMaxResidual and are at
+// least three: the mark a registration's rejection names, the likeliest to have been touched wrong.
+std::optional<OddMark> odd_mark(const std::vector<MarkTouch>& touched) {
+  if (touched.size() < 4) return std::nullopt;
+  std::optional<OddMark> odd;
+  double best_residual = kMaxResidual;
+  for (size_t left_out = 0; left_out < touched.size(); ++left_out) {
+    const Result<tracking::RigidTransform> T = fit_marks(touched, left_out);
+    if (!T || !(T->rms_residual <= best_residual)) continue;
+    best_residual = T->rms_residual;
+    const MarkTouch& m = touched[left_out];
+    odd = OddMark{m.mark, (T->R * m.measured + T->t - m.model).norm()};
+  }
+  return odd;
+}
+
 void register_marks(const InputEvent& e, RegistrationState& s, std::vector<Rejection>& rejections) {
   auto reject = [&](const std::string& why) {
     rejections.push_back({e.t_us, e.line, "register: " + why + "; the marks touched are kept"});
@@ -48,19 +82,20 @@ void register_marks(const InputEvent& e, RegistrationState& s, std::vector<Rejec
            "(rest the pen on each mark and log cmd mark N X Y Z)");
     return;
   }
-  std::vector<Vec3> measured, model;
-  for (const MarkTouch& m : s.touched) {
-    measured.push_back(m.measured);
-    model.push_back(m.model);
-  }
-  Result<tracking::RigidTransform> T = tracking::register_rigid(measured, model);
+  Result<tracking::RigidTransform> T = fit_marks(s.touched);
   if (!T) {
     reject(T.error());
     return;
   }
   if (!(T->rms_residual <= kMaxResidual)) {
-    reject("the marks do not fit one rigid motion (residual " + format_mm(T->rms_residual) + ", at most " + format_mm(kMaxResidual) +
-           "): a mark was touched in the wrong place or logged with the wrong number or coordinates");
+    const std::string misfit = "the marks do not fit one rigid motion (residual " + format_mm(T->rms_residual) + ", at most " +
+                               format_mm(kMaxResidual) + "): ";
+    if (const std::optional<OddMark> odd = odd_mark(s.touched))
+      reject(misfit + "mark " + std::to_string(odd->mark) + " fits worst, " + format_mm(odd->distance) + " from where the other " +
+             std::to_string(s.touched.size() - 1) + " put it; touch it again (it was touched in the wrong place, logged with " +
+             "the wrong number or coordinates, or touched before the object moved)");
+    else
+      reject(misfit + "a mark was touched in the wrong place or logged with the wrong number or coordinates");
     return;
   }
   s.transform = *T;

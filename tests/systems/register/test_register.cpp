@@ -151,7 +151,48 @@ TEST_CASE("marks on a line, a moving pen, a wrong mark and an unseen pen are rej
   run(w, wrong, {register_command(t, 5)});
   REQUIRE(wrong.size() == 1);
   CHECK(wrong[0].reason.find("register: the marks do not fit one rigid motion") == 0);
+  // The other three fit, so the rejection names the odd one, and touching it again mends the registration.
+  INFO(wrong[0].reason);
+  CHECK(wrong[0].reason.find("mark 2 fits worst, 30.00 mm from where the other 3 put it; touch it again") != std::string::npos);
   CHECK(!w.transform);
+  touch(w, wrong, t, 2, kMarks[2], 6);
+  run(w, wrong, {register_command(t, 7)});
+  CHECK(wrong.size() == 1);
+  REQUIRE(w.transform);
+  CHECK(w.done.back().marks == 4);
+}
+
+TEST_CASE("a mark touched before the object turned is named when the next registration does not fit") {
+  RegistrationState s;
+  std::vector<Rejection> rejections;
+  int64_t t = 0;
+  // Mark 0 touched, the registration rejected (one mark); the object turns, and marks 1, 2, 3 are touched in
+  // the new pose. Mark 0's touch still counts, from the old pose.
+  touch(s, rejections, t, 0, kMarks[0], 1);
+  run(s, rejections, {register_command(t, 2)});
+  REQUIRE(rejections.size() == 1);
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.5, Vec3::UnitY()).toRotationMatrix();
+  auto touch_turned = [&](uint32_t n, uint32_t line) {
+    std::vector<InputEvent> frames{event(t, EventKind::Down)};
+    for (int k = 0; k < 80; ++k, t += 10'000) frames.push_back(pen(t, turn * to_rig(kMarks[n])));
+    frames.push_back(mark(t, n, kMarks[n], line));
+    frames.push_back(event(t, EventKind::Up));
+    run(s, rejections, frames);
+    t += 500'000;
+  };
+  for (uint32_t n = 1; n < 4; ++n) touch_turned(n, 10 + n);
+  run(s, rejections, {register_command(t, 20)});
+  REQUIRE(rejections.size() == 2);
+  CHECK(rejections[1].reason.find("register: the marks do not fit one rigid motion") == 0);
+  CHECK(rejections[1].reason.find("mark 0 fits worst, ") != std::string::npos);
+  CHECK(rejections[1].reason.find("touched before the object moved") != std::string::npos);
+  CHECK(!s.transform);
+  touch_turned(0, 21);
+  run(s, rejections, {register_command(t, 22)});
+  CHECK(rejections.size() == 2);
+  REQUIRE(s.transform);
+  const Vec3 p(0.01, 0.01, 0.1);
+  CHECK((s.transform->R * (turn * to_rig(p)) + s.transform->t - p).norm() < 1e-9);
 }
 
 TEST_CASE("a second registration replaces the transform") {
