@@ -38,6 +38,7 @@ constexpr double kFollowStep_px = 40;     // the pen's blob moves less than this
 // light beside it, and the light then holds the lifted pen down. A pixel of misfit counts as this distance:
 // a few frames' motion, against the quarter pixel of a true pair's noise.
 constexpr double kMisfitDistance_m = 0.02;
+constexpr double kOnsetReachUs = 1'000'000;  // how far back a light's first frame is looked for
 
 // The median of the recent gaps, taken when a gap is added: every report and frame reads it.
 double median_period(const std::deque<double>& gaps_us) {
@@ -158,6 +159,21 @@ bool beside_pen(const CameraWindow& w, size_t j, int b, double seen_t, const Vec
   for (int i = 1; i < f.blob_count[m]; ++i)
     if ((f.blobs[m][i] - pen_px).norm() < (f.blobs[m][nearest] - pen_px).norm()) nearest = i;
   return blob != nearest;
+}
+
+// When blob b of a camera's frame j began to shine: the instant of the first frame of its chain of links,
+// followed back no farther than kOnsetReachUs (nothing if it shone longer, or since the window began).
+std::optional<double> lit_since(const CameraWindow& w, size_t j, int b) {
+  const CameraFrames& f = w.frames;
+  int blob = b;
+  for (size_t m = j; m > 0 && f.t_frame_us[j] - f.t_frame_us[m - 1] <= kOnsetReachUs; --m) {
+    int from = -1;
+    for (int i = 0; i < f.blob_count[m - 1]; ++i)
+      if (w.links[m - 1][i] == blob) from = i;
+    if (from < 0) return f.t_frame_us[m];
+    blob = from;
+  }
+  return std::nullopt;
 }
 
 // The blobs of a camera's frame j that may be the pen: not one beside it.
@@ -293,11 +309,33 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
     }
   }
   if (!s.down) {
-    best = 0;
-    for (int c = 1; c < fit_count; ++c) {
-      if ((fits[c].X - fits[best].X).norm() > kJumpGate_m) best = -1;
-      if (best < 0) break;
-      if (fits[c].reprojection_error_px < fits[best].reprojection_error_px) best = c;
+    // The best-fitting pair when every fitting pair agrees, else -1.
+    auto agreed = [&] {
+      int b = 0;
+      for (int c = 1; c < fit_count; ++c) {
+        if ((fits[c].X - fits[b].X).norm() > kJumpGate_m) return -1;
+        if (fits[c].reprojection_error_px < fits[b].reprojection_error_px) b = c;
+      }
+      return b;
+    };
+    best = agreed();
+    // The pen's LED lights up in both cameras at once, and a reflection level with it that shone before
+    // (a lamp, a glint) did not: where the pairs disagree, those whose two blobs began to shine together are
+    // the ones that may start a stroke.
+    if (best < 0) {
+      const double together_us = tracking::kMaxInterpolationGap * std::max(period_of(s.cameras[0]), period_of(w1));
+      int kept = 0;
+      for (int c = 0; c < fit_count; ++c) {
+        const std::optional<double> since0 = lit_since(s.cameras[0], k, fit_blobs[c][0]);
+        const std::optional<double> since1 = lit_since(w1, ip.frame, ip.source[size_t(fit_blobs[c][1])]);
+        if (!since0 || !since1 || std::abs(*since0 - (*since1 - s.time_offset_us)) > together_us) continue;
+        fits[kept] = fits[c];
+        fit_blobs[kept++] = fit_blobs[c];
+      }
+      if (kept > 0) {
+        fit_count = kept;
+        best = agreed();
+      }
     }
     // A light that appears in camera 1's later frame is not interpolated yet; the pen put down between
     // the two frames is one, and then the reflection level with it is all camera 1 offers, and fits

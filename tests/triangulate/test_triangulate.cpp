@@ -261,9 +261,10 @@ TEST_CASE("a reflection level with the pen in camera 1 is not paired with camera
     for (const PenSample& p : track.samples)
       CHECK((p.raw - pen_path(static_cast<double>(p.t_us) * 1e-6)).norm() < 1e-4);
   }
-  SECTION("the pen lights between camera 1's exposure and camera 0's: the stroke waits until one point fits") {
+  SECTION("the pen lights between camera 1's exposure and camera 0's: the stroke starts on the pair lit together") {
     // Lit from 0.048 s: camera 0's frame at 0.050 s sees it, camera 1's at 0.045 s only the reflection,
-    // which shines until 0.1 s.
+    // which shines until 0.1 s. At 0.050 s the reflection is the only light camera 1 can be interpolated
+    // with, so the start waits; from 0.060 s the pen's pair, lit in both cameras at once, starts it.
     DeviceStreams s;
     for (double t = 0.0; t < 1.0; t += 0.010)
       if (t >= 0.048) push_frame(s.cameras[0], t * 1e6, {rig.c0.project(pen_path(t))});
@@ -275,10 +276,34 @@ TEST_CASE("a reflection level with the pen in camera 1 is not paired with camera
     }
     const PenTrack track = run_system(s, rig, 0.0);
     CHECK(track.strokes == 1);
-    CHECK(track.ambiguous >= 5);
-    REQUIRE(track.samples.size() > 80);
+    CHECK(track.ambiguous == 1);
+    REQUIRE(track.samples.size() > 90);
+    CHECK(track.samples.front().t_us == 60'000);
     for (const PenSample& p : track.samples)
       CHECK((p.raw - pen_path(static_cast<double>(p.t_us) * 1e-6)).norm() < 1e-4);
+  }
+  SECTION("a lamp level with the pen that shone before the pen lit does not hold the start back") {
+    // The pen rests on a mark, lit from 0.595 s to 1.4 s; camera 1 sees the lamp from 0.3 s on. Both pairs fit
+    // from the first frame: the pen's, lit in both cameras at once, starts the stroke there, and the lamp's,
+    // which shone 0.3 s before camera 0 saw anything, does not hold it back.
+    const Vec3 rest = pen_path(0.6);
+    const Vec2 lamp = rig.c1.project(rig.c0.centre() + 1.04 * (rest - rig.c0.centre()));
+    auto lit = [](double t) { return t >= 0.595 && t < 1.4; };
+    DeviceStreams s;
+    for (double t = 0.0; t < 2.0; t += 0.010)
+      if (lit(t)) push_frame(s.cameras[0], t * 1e6, {rig.c0.project(rest)});
+      else push_frame(s.cameras[0], t * 1e6, {});
+    for (double t = 0.005; t < 2.0; t += 0.010) {
+      if (t < 0.3) push_frame(s.cameras[1], t * 1e6, {});
+      else if (lit(t)) push_frame(s.cameras[1], t * 1e6, {lamp, rig.c1.project(rest)});
+      else push_frame(s.cameras[1], t * 1e6, {lamp});
+    }
+    const PenTrack track = run_system(s, rig, 0.0);
+    CHECK(track.strokes == 1);
+    CHECK(track.ambiguous == 0);
+    REQUIRE(track.samples.size() > 75);
+    CHECK(track.samples.front().t_us == 600'000);
+    for (const PenSample& p : track.samples) CHECK((p.raw - rest).norm() < 1e-4);
   }
 }
 
