@@ -50,15 +50,18 @@ void drop_pauses(std::vector<Vec3>& stroke, const Vec3& start, double start_radi
   stroke = std::move(kept);
 }
 
-// The vertex of `face` nearest to p if it lies within `radius`, as a curve end; else `end` as it was.
+// The vertex of `face` nearest to p, or to the curve point p snapped to, if it lies within `radius`, as a
+// curve end; else `end` as it was. A curve point that close to a vertex is the vertex within the pen's error,
+// and a new vertex there would leave a curve piece shorter than the radius beside it.
 CurveEnd at_vertex(const Mesh& mesh, uint32_t face, const CurveEnd& end, const Vec3& p, double radius) {
   CurveEnd best = end;
   double nearest = radius;
+  const Vec3 snapped = mesh.polyline(end.edge)[end.point];
   for (uint32_t oriented : mesh.face_loop(face)) {
     const uint32_t e = edge_of(oriented);
     const std::span<const Vec3> line = mesh.polyline(e);
     for (uint32_t k : {uint32_t(0), uint32_t(line.size() - 1)})
-      if (const double d = (line[k] - p).norm(); d < nearest) {
+      if (const double d = std::min((line[k] - p).norm(), (line[k] - snapped).norm()); d < nearest) {
         nearest = d;
         best = {e, k};
       }

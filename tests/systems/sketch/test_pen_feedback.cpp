@@ -180,6 +180,25 @@ TEST_CASE("a mouse stroke's end lands on a vertex within its logged snap radius,
   CHECK(w->mesh.vertex_count() == 6);
 }
 
+TEST_CASE("a stroke end whose curve point lies within the vertex radius of a vertex lands on that vertex",
+          "[sketch][feedback]") {
+  // The left curve has a point every 2 mm. The pen ends 3.2 mm from the corner (0, 0.1), beyond the logged 3 mm,
+  // but 2.5 mm from the curve point (0, 0.098), which is 2 mm from the corner: a vertex there would leave a
+  // curve piece of 2 mm beside the corner, shorter than the pen's own error.
+  Log log = open_border();
+  log.event("down");
+  for (int k = 0; k <= 50; ++k) log.pen(0, 0.1 - 0.002 * k);
+  log.event("up");
+  log.event("down").pen(0.05, 0).pen(0.03, 0.05).event("pen 0.0025 0.098 0 0.003");
+  auto w = replay(log);
+  REQUIRE(w->mesh.face_count() == 1);
+  CHECK(w->pen_feedback.target == Vec3(0, 0.1, 0));
+  log.event("up");
+  w = replay(log);
+  REQUIRE(w->mesh.face_count() == 2);
+  CHECK(w->mesh.vertex_count() == 5);
+}
+
 TEST_CASE("a stroke's pauses at its ends are not drawn: no curve point lingers within the vertex snap of its ends",
           "[sketch]") {
   // A diagonal from corner to corner, the pen resting 21 samples on each end first (jittering within 1 mm)
