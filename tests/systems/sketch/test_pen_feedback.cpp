@@ -52,6 +52,14 @@ Log open_border() {
   return log;
 }
 
+// The square closed by a left curve with a point every 2 mm.
+Log square_with_dense_left() {
+  Log log = open_border();
+  log.event("down");
+  for (int k = 0; k <= 50; ++k) log.pen(0, 0.1 - 0.002 * k);
+  return log.event("up");
+}
+
 Log closed_square() {
   Log log = open_border();
   log.stroke({{0, 0.1, 0}, {0, 0.05, 0}, {0.002, 0.001, 0}});
@@ -152,12 +160,8 @@ TEST_CASE("the pen's feedback is not part of the replay hash", "[sketch][feedbac
 
 TEST_CASE("a mouse stroke's end lands on a vertex within its logged snap radius, and the feedback shows that vertex",
           "[sketch][feedback]") {
-  // The square closed by a left curve with a point every 2 mm, so a polyline point lies nearer the pen than
-  // the corner (0, 0.1) does.
-  Log log = open_border();
-  log.event("down");
-  for (int k = 0; k <= 50; ++k) log.pen(0, 0.1 - 0.002 * k);
-  log.event("up");
+  // A polyline point of the left curve lies nearer the pen than the corner (0, 0.1) does.
+  const Log log = square_with_dense_left();
   Log plain = log, mouse = log;
   // Each ends 1.1 mm from the left curve's point (0, 0.098) and 2.7 mm from the corner.
   plain.event("down").pen(0.05, 0).pen(0.03, 0.05).pen(0.001, 0.0975);
@@ -182,13 +186,10 @@ TEST_CASE("a mouse stroke's end lands on a vertex within its logged snap radius,
 
 TEST_CASE("a stroke end whose curve point lies within the vertex radius of a vertex lands on that vertex",
           "[sketch][feedback]") {
-  // The left curve has a point every 2 mm. The pen ends 3.2 mm from the corner (0, 0.1), beyond the logged 3 mm,
-  // but 2.5 mm from the curve point (0, 0.098), which is 2 mm from the corner: a vertex there would leave a
-  // curve piece of 2 mm beside the corner, shorter than the pen's own error.
-  Log log = open_border();
-  log.event("down");
-  for (int k = 0; k <= 50; ++k) log.pen(0, 0.1 - 0.002 * k);
-  log.event("up");
+  // The pen ends 3.2 mm from the corner (0, 0.1), beyond the logged 3 mm, but 2.5 mm from the left curve's
+  // point (0, 0.098), which is 2 mm from the corner: a vertex there would leave a curve piece of 2 mm beside
+  // the corner, shorter than the pen's own error.
+  Log log = square_with_dense_left();
   log.event("down").pen(0.05, 0).pen(0.03, 0.05).event("pen 0.0025 0.098 0 0.003");
   auto w = replay(log);
   REQUIRE(w->mesh.face_count() == 1);
