@@ -6,8 +6,9 @@
 //   cmd register      the rigid transform from the marks touched since the last registration (Umeyama,
 //                     tracking::register_rigid); from then on every pen sample is mapped into the object's frame
 // A registration that cannot be made (fewer than 3 marks, collinear marks, a residual over kMaxResidual) is
-// rejected in words, naming the mark that fits worst where the others fit, and keeps the marks touched; a later registration (the object turned) replaces the
-// transform, and curves already drawn stay where they are. Before the first registration samples pass unchanged.
+// rejected in words, naming the mark that fits worst where the others fit, and keeps the marks touched; a
+// later registration (the object turned) replaces the transform, and curves already drawn stay where they
+// are. Before the first registration samples pass unchanged.
 // A touch is not a curve: a stroke is held back until the pen leaves kTouchRadius around its first sample, and
 // one that never does (the pen resting on a mark) is dropped.
 #include <cstdint>

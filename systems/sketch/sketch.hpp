@@ -21,8 +21,8 @@ struct SketchSettings {
                                 // unless the end's pen sample carries its own radius (InputEvent::snap)
   uint32_t close_samples = 16;  // points on the straight edge made by `cmd close`
   // A split's end within this distance of one of its face's vertices, or whose nearest polyline point is, lands
-  // on that vertex (0: off, the nearest polyline point always). A tracked pen never ends exactly on a vertex; a new vertex a millimetre from an old
-  // one leaves a sliver of an edge and faces with extra sides. An end whose pen sample carries its own radius
+  // on that vertex (0: off, the nearest polyline point always). A tracked pen never ends exactly on a vertex;
+  // a new vertex a millimetre from an old one leaves a sliver of an edge and faces with extra sides. An end whose pen sample carries its own radius
   // (the mouse) lands on a vertex within the larger of the two: a cursor cannot hit a vertex exactly either.
   // The stroke's samples within that radius of where an end lands are the pen pausing there, and are not drawn.
   double vertex_snap = 0;
