@@ -31,6 +31,7 @@ constexpr double kNextSearchUs = 10'000;     // ... later ones this far either s
 constexpr double kJumpGate_m = 0.02;      // pen positions this far apart are different things
 constexpr double kMaxPenSpeed_m_s = 5.0;  // a hand moves the pen no faster
 constexpr double kBridgeSpeed_m_s = 1.0;  // a drawing hand, while both cameras lose the pen, moves it no faster
+constexpr double kSpeedUp_m_s = 1.0;      // a hand speeds the pen up by no more than this from one frame to the next
 constexpr double kFollowStep_px = 40;     // the pen's blob moves less than this between two frames of a camera
 // Of the pairs that fit where the pen could be, the nearer wins unless it is worse off its epipolar line
 // than the pen's own pixel noise explains. A light that shone merged with the pen's blob and split from it
@@ -132,10 +133,14 @@ std::optional<Followed> follow_on_ray(const tracking::Camera& cam, std::span<con
   return best;
 }
 
-// How far the pen may be from where it was last seen after `dt_us`: a hand's fastest flick over a short
-// gap; over a longer one the pen was hidden while a drawing hand went on, which is slower.
-double reach_m(double dt_us, int64_t short_gap_us) {
-  const double speed = dt_us <= static_cast<double>(short_gap_us) ? kMaxPenSpeed_m_s : kBridgeSpeed_m_s;
+// How far the pen may be from where it was last seen after `dt_us`, moving at `speed_m_s` (filtered): over a
+// short gap, up to twice as fast and kSpeedUp_m_s more, as a flick starts, but no faster than a hand moves it;
+// over a longer one the pen was hidden while a drawing hand went on, which is slower. A resting pen does not
+// jump centimetres in a frame: a light level with it that lights as it goes out fits that far off.
+double reach_m(double dt_us, int64_t short_gap_us, double speed_m_s) {
+  const double speed = dt_us <= static_cast<double>(short_gap_us)
+                           ? std::min(kMaxPenSpeed_m_s, 2 * speed_m_s + kSpeedUp_m_s)
+                           : kBridgeSpeed_m_s;
   return kJumpGate_m + speed * dt_us * 1e-6;
 }
 
@@ -225,7 +230,7 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
     // evidence of it: a reflection near where the pen vanished fits one ray as well, and would hold a
     // lifted pen down until it is put down elsewhere, joining two strokes. Both cameras take it up again.
     if (!s.down || (s.lost_now && t - s.last_seen_t > static_cast<double>(options.short_gap_us))) return;
-    const double gate = reach_m(t - s.last_seen_t, options.short_gap_us);
+    const double gate = reach_m(t - s.last_seen_t, options.short_gap_us, s.filter.derivative.norm());
     const Candidates c0 = maybe_pen(s.cameras[0], k, s.last_seen_t, s.pen_px[0]);
     std::optional<Followed> x =
         follow_on_ray(rig.cam0, std::span<const Vec2>(c0.px.data(), size_t(c0.count)), s.pen_px[0], s.last_position, gate);
@@ -290,7 +295,7 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
   }
   int best = -1;
   if (s.down) {
-    const double gate = reach_m(t - s.last_seen_t, options.short_gap_us);
+    const double gate = reach_m(t - s.last_seen_t, options.short_gap_us, s.filter.derivative.norm());
     double best_cost = std::numeric_limits<double>::infinity();
     for (int c = 0; c < fit_count; ++c) {
       const double distance = (fits[c].X - s.last_position).norm();

@@ -282,6 +282,30 @@ TEST_CASE("a reflection level with the pen in camera 1 is not paired with camera
     for (const PenSample& p : track.samples)
       CHECK((p.raw - pen_path(static_cast<double>(p.t_us) * 1e-6)).norm() < 1e-4);
   }
+  SECTION("a lamp level with a resting pen that lights as the pen goes out does not take its place") {
+    // The pen rests until 0.992 s. Camera 1's last frame with it (0.985 s) also shows a lamp on its epipolar
+    // line, 6 % farther along camera 0's ray (5 cm deeper), and camera 0's last frame (0.990 s) pairs only with
+    // that lamp: camera 1's pen does not go on into a later frame. A resting pen does not jump 5 cm in a frame,
+    // so the stroke ends where it was; the pen goes down again 4 cm away at 1.6 s, a second stroke.
+    const Vec3 rest = pen_path(0.5), next = rest + Vec3(0.04, 0, 0);
+    const Vec2 lamp = rig.c1.project(rig.c0.centre() + 1.06 * (rest - rig.c0.centre()));
+    auto where = [&](double t) { return t < 1.0 ? rest : next; };
+    auto lit = [](double t) { return t < 0.992 || t >= 1.6; };
+    DeviceStreams s;
+    for (double t = 0.0; t < 2.2; t += 0.010)
+      if (lit(t)) push_frame(s.cameras[0], t * 1e6, {rig.c0.project(where(t))});
+      else push_frame(s.cameras[0], t * 1e6, {});
+    for (double t = 0.005; t < 2.2; t += 0.010) {
+      if (t < 0.98) push_frame(s.cameras[1], t * 1e6, {rig.c1.project(where(t))});
+      else if (lit(t)) push_frame(s.cameras[1], t * 1e6, {rig.c1.project(where(t)), lamp});
+      else push_frame(s.cameras[1], t * 1e6, {lamp});
+    }
+    const PenTrack track = run_system(s, rig, 0.0);
+    CHECK(track.strokes == 2);
+    REQUIRE(track.samples.size() > 90);
+    for (const PenSample& p : track.samples)
+      CHECK((p.raw - where(static_cast<double>(p.t_us) * 1e-6)).norm() < 1e-4);
+  }
   SECTION("a lamp level with the pen that shone before the pen lit does not hold the start back") {
     // The pen rests on a mark, lit from 0.595 s to 1.4 s; camera 1 sees the lamp from 0.3 s on. Both pairs fit
     // from the first frame: the pen's, lit in both cameras at once, starts the stroke there, and the lamp's,
