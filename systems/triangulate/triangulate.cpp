@@ -144,6 +144,14 @@ double reach_m(double dt_us, int64_t short_gap_us, double speed_m_s) {
   return kJumpGate_m + speed * dt_us * 1e-6;
 }
 
+// The blob of a camera's frame m - 1 whose link goes on to blob b of frame m (links are mutual, so at most
+// one does), or -1: b began to shine in frame m.
+int linked_from(const CameraWindow& w, size_t m, int b) {
+  for (int i = 0; i < w.frames.blob_count[m - 1]; ++i)
+    if (w.links[m - 1][i] == b) return i;
+  return -1;
+}
+
 // Whether blob b of a camera's frame j continues, link by link, a light that shone beside the pen in the
 // camera's last frame at or before `seen_t` (the pen there being the blob nearest `pen_px`): a reflection
 // next to the pen fits the pen's ray as well once the pen is lifted, and following it would hold the pen
@@ -153,10 +161,7 @@ bool beside_pen(const CameraWindow& w, size_t j, int b, double seen_t, const Vec
   int blob = b;
   size_t m = j;
   while (blob >= 0 && m > 0 && f.t_frame_us[m] > seen_t) {
-    int from = -1;
-    for (int i = 0; i < f.blob_count[m - 1]; ++i)
-      if (w.links[m - 1][i] == blob) from = i;
-    blob = from;
+    blob = linked_from(w, m, blob);
     --m;
   }
   if (blob < 0 || f.t_frame_us[m] > seen_t || f.blob_count[m] < 2) return false;
@@ -172,9 +177,7 @@ std::optional<double> lit_since(const CameraWindow& w, size_t j, int b) {
   const CameraFrames& f = w.frames;
   int blob = b;
   for (size_t m = j; m > 0 && f.t_frame_us[j] - f.t_frame_us[m - 1] <= kOnsetReachUs; --m) {
-    int from = -1;
-    for (int i = 0; i < f.blob_count[m - 1]; ++i)
-      if (w.links[m - 1][i] == blob) from = i;
+    const int from = linked_from(w, m, blob);
     if (from < 0) return f.t_frame_us[m];
     blob = from;
   }
@@ -348,9 +351,7 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
     if (best >= 0 && ip.frame + 1 < f1.size()) {
       const size_t later = ip.frame + 1;
       for (int b = 0; b < f1.blob_count[later] && best >= 0; ++b) {
-        bool continues = false;
-        for (int i = 0; i < f1.blob_count[ip.frame]; ++i) continues |= w1.links[ip.frame][i] == b;
-        if (continues) continue;
+        if (linked_from(w1, later, b) >= 0) continue;
         for (int i = 0; i < f0.blob_count[k] && best >= 0; ++i) {
           const tracking::Triangulation tri = tracking::triangulate(rig.cam0, rig.cam1, f0.blobs[k][i], f1.blobs[later][b],
                                                                     options.method, options.max_reprojection_px);

@@ -50,6 +50,12 @@ PenTrack run_system(const DeviceStreams& s, const Rig& rig, double offset_us) {
   return run_system_full(s, rig, offset_us).track;
 }
 
+// Every sample within 0.1 mm of where the pen was at its instant (`where`: seconds -> position).
+template <class Where>
+void check_on_path(const std::vector<PenSample>& samples, Where where) {
+  for (const PenSample& p : samples) CHECK((p.raw - where(static_cast<double>(p.t_us) * 1e-6)).norm() < 1e-4);
+}
+
 }  // namespace
 
 TEST_CASE("time offset, interpolation and triangulation recover an exactly observed pen") {
@@ -81,8 +87,7 @@ TEST_CASE("a stray blob on the pen's epipolar line in one camera is never taken 
     const PenTrack track = run_system(s, rig, 0.0);
     CHECK(track.strokes == 1);
     REQUIRE(track.samples.size() > 290);
-    for (const PenSample& p : track.samples)
-      CHECK((p.raw - pen_path(static_cast<double>(p.t_us) * 1e-6)).norm() < 1e-4);
+    check_on_path(track.samples, pen_path);
   }
   SECTION("it is there from the start: no stroke starts while two points fit") {
     const DeviceStreams s = exact_streams(rig, 1.0, 0.0, 0.0);
@@ -185,8 +190,7 @@ TEST_CASE("a lifted pen is not held down by a reflection one camera sees near wh
     }
     const SystemRun run = run_system_full(s, rig, 0.0);
     CHECK(run.track.strokes == 2);
-    for (const PenSample& p : run.track.samples)
-      CHECK((p.raw - where(static_cast<double>(p.t_us) * 1e-6)).norm() < 1e-4);
+    check_on_path(run.track.samples, where);
   }
 }
 
@@ -258,8 +262,7 @@ TEST_CASE("a reflection level with the pen in camera 1 is not paired with camera
     const PenTrack track = run_system(s, rig, 0.0);
     CHECK(track.strokes == 1);
     REQUIRE(track.samples.size() > 90);
-    for (const PenSample& p : track.samples)
-      CHECK((p.raw - pen_path(static_cast<double>(p.t_us) * 1e-6)).norm() < 1e-4);
+    check_on_path(track.samples, pen_path);
   }
   SECTION("the pen lights between camera 1's exposure and camera 0's: the stroke starts on the pair lit together") {
     // Lit from 0.048 s: camera 0's frame at 0.050 s sees it, camera 1's at 0.045 s only the reflection,
@@ -279,8 +282,7 @@ TEST_CASE("a reflection level with the pen in camera 1 is not paired with camera
     CHECK(track.ambiguous == 1);
     REQUIRE(track.samples.size() > 90);
     CHECK(track.samples.front().t_us == 60'000);
-    for (const PenSample& p : track.samples)
-      CHECK((p.raw - pen_path(static_cast<double>(p.t_us) * 1e-6)).norm() < 1e-4);
+    check_on_path(track.samples, pen_path);
   }
   SECTION("a lamp level with a resting pen that lights as the pen goes out does not take its place") {
     // The pen rests until 0.992 s. Camera 1's last frame with it (0.985 s) also shows a lamp on its epipolar
@@ -303,8 +305,7 @@ TEST_CASE("a reflection level with the pen in camera 1 is not paired with camera
     const PenTrack track = run_system(s, rig, 0.0);
     CHECK(track.strokes == 2);
     REQUIRE(track.samples.size() > 90);
-    for (const PenSample& p : track.samples)
-      CHECK((p.raw - where(static_cast<double>(p.t_us) * 1e-6)).norm() < 1e-4);
+    check_on_path(track.samples, where);
   }
   SECTION("a lamp level with the pen that shone before the pen lit does not hold the start back") {
     // The pen rests on a mark, lit from 0.595 s to 1.4 s; camera 1 sees the lamp from 0.3 s on. Both pairs fit
@@ -327,7 +328,7 @@ TEST_CASE("a reflection level with the pen in camera 1 is not paired with camera
     CHECK(track.ambiguous == 0);
     REQUIRE(track.samples.size() > 75);
     CHECK(track.samples.front().t_us == 600'000);
-    for (const PenSample& p : track.samples) CHECK((p.raw - rest).norm() < 1e-4);
+    check_on_path(track.samples, [&](double) { return rest; });
   }
 }
 

@@ -60,6 +60,18 @@ Log square_with_dense_left() {
   return log.event("up");
 }
 
+// A stroke left open on the square of square_with_dense_left: the feedback shows where its end would land;
+// lifted, it splits the square with that many vertices in the mesh.
+void check_end_lands(Log log, const Vec3& target, uint32_t vertices) {
+  auto w = replay(log);
+  REQUIRE(w->mesh.face_count() == 1);
+  CHECK(w->pen_feedback.target == target);
+  log.event("up");
+  w = replay(log);
+  REQUIRE(w->mesh.face_count() == 2);
+  CHECK(w->mesh.vertex_count() == vertices);
+}
+
 Log closed_square() {
   Log log = open_border();
   log.stroke({{0, 0.1, 0}, {0, 0.05, 0}, {0.002, 0.001, 0}});
@@ -167,21 +179,10 @@ TEST_CASE("a mouse stroke's end lands on a vertex within its logged snap radius,
   plain.event("down").pen(0.05, 0).pen(0.03, 0.05).pen(0.001, 0.0975);
   mouse.event("down").pen(0.05, 0).pen(0.03, 0.05).event("pen 0.001 0.0975 0 0.005");
 
-  auto w = replay(mouse);
-  REQUIRE(w->mesh.face_count() == 1);
-  CHECK(w->pen_feedback.target == Vec3(0, 0.1, 0));
-  mouse.event("up");
-  w = replay(mouse);
-  REQUIRE(w->mesh.face_count() == 2);
-  CHECK(w->mesh.vertex_count() == 5);  // the corners and the bottom's middle: no new vertex beside the corner
-
+  // The corners and the bottom's middle: no new vertex beside the corner.
+  check_end_lands(mouse, Vec3(0, 0.1, 0), 5);
   // Without a logged radius (and no vertex snap in the session), the nearest polyline point.
-  w = replay(plain);
-  CHECK(w->pen_feedback.target == Vec3(0, 0.098, 0));
-  plain.event("up");
-  w = replay(plain);
-  REQUIRE(w->mesh.face_count() == 2);
-  CHECK(w->mesh.vertex_count() == 6);
+  check_end_lands(plain, Vec3(0, 0.098, 0), 6);
 }
 
 TEST_CASE("a stroke end whose curve point lies within the vertex radius of a vertex lands on that vertex",
@@ -191,13 +192,7 @@ TEST_CASE("a stroke end whose curve point lies within the vertex radius of a ver
   // the corner, shorter than the pen's own error.
   Log log = square_with_dense_left();
   log.event("down").pen(0.05, 0).pen(0.03, 0.05).event("pen 0.0025 0.098 0 0.003");
-  auto w = replay(log);
-  REQUIRE(w->mesh.face_count() == 1);
-  CHECK(w->pen_feedback.target == Vec3(0, 0.1, 0));
-  log.event("up");
-  w = replay(log);
-  REQUIRE(w->mesh.face_count() == 2);
-  CHECK(w->mesh.vertex_count() == 5);
+  check_end_lands(log, Vec3(0, 0.1, 0), 5);
 }
 
 TEST_CASE("a stroke's pauses at its ends are not drawn: no curve point lingers within the vertex snap of its ends",
