@@ -24,7 +24,10 @@ struct DeviceInfo {
   uint16_t product = 0;
   std::string serial;  // a Bluetooth remote's address, as the backend reports it
   std::string path;    // what open() takes
+  std::string product_name{};  // as the device names itself (hidapi's product string); empty where not given
 };
+// A Wii Remote by its ids and, where given, its name: only these take camera and pad roles.
+inline bool is_wii_remote(const DeviceInfo& info) { return is_wii_remote(info.vendor, info.product, info.product_name); }
 
 // "00:1f:32:aa:bb:cc" and "001F32AABBCC" both give "00:1F:32:AA:BB:CC"; anything that is not
 // twelve hex digits (with or without separators) is returned unchanged.

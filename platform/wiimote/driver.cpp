@@ -1,7 +1,9 @@
 #include "platform/wiimote/driver.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <set>
 
 namespace fire::wiimote {
 
@@ -29,6 +31,7 @@ struct Driver::Link {
   std::string missing_why = "not found";
   std::string last_warning;
   MachineState last_state = MachineState::Starting;
+  std::set<uint8_t> named_short;  // report ids already named for coming shorter than their layout
   // What other threads may read.
   mutable std::mutex mutex;
   RemoteView view;
@@ -55,7 +58,7 @@ Result<Scan> Driver::open_all() {
   Scan scan;
   const int64_t now = clock_();
   for (const DeviceInfo& info : *found) {
-    if (!is_wii_remote(info.vendor, info.product)) {
+    if (!is_wii_remote(info)) {
       scan.not_remotes.push_back(info);
       continue;
     }
@@ -112,7 +115,7 @@ void Driver::reopen(Link& link, int64_t now) {
     } else {
       bool present = false;
       for (const DeviceInfo& info : *found) {
-        if (!is_wii_remote(info.vendor, info.product) || normalize_address(info.serial) != link.address) continue;
+        if (!is_wii_remote(info) || normalize_address(info.serial) != link.address) continue;
         present = true;
         link.info = info;
         opened = backend_.open(info);
@@ -239,7 +242,13 @@ bool Driver::step(Link& link, int read_timeout_ms) {
     // Stamped with when the read returned, not when the log's lock was free (a live log keeps its order).
     log_.hid(device, r.report, now);
     link.machine.on_report(r.report, now, out);
-    if (is_camera(link.role) && link.machine.state() == MachineState::Running) objects = ir_object_count(r.report);
+    name_short_report(link, r.report, now);
+    if (is_camera(link.role) && link.machine.state() == MachineState::Running) {
+      const DecodedReport ir = decode_ir_report(r.report);
+      if (ir.status == ReportStatus::Ok)
+        objects = static_cast<int>(std::count_if(ir.report.slots.begin(), ir.report.slots.end(),
+                                                 [](const IrSlot& slot) { return slot.seen; }));
+    }
   }
   link.machine.tick(now, out);
   uint8_t leds = 0;
@@ -265,6 +274,16 @@ bool Driver::step(Link& link, int read_timeout_ms) {
   write_all(link, out, rumble, now);
   publish(link, now);
   return r.status == ReadStatus::Report;
+}
+
+void Driver::name_short_report(Link& link, std::span<const uint8_t> report, int64_t now) {
+  const size_t expected = input_report_size(report[0]);
+  if (report.size() >= expected || link.named_short.contains(report[0])) return;
+  link.named_short.insert(report[0]);
+  char text[128];
+  std::snprintf(text, sizeof text, "report 0x%02X has %zu bytes, its layout %zu: kept in the log, not read (named once)",
+                report[0], report.size(), expected);
+  notice(link, now, text);
 }
 
 void Driver::poll(int read_timeout_ms) {

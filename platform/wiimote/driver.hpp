@@ -8,6 +8,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <string>
 #include <thread>
 #include <vector>
@@ -88,6 +89,7 @@ class Driver {
   void lose(Link& link, const std::string& why, int64_t now);
   void write_all(Link& link, std::vector<Bytes>& out, bool rumble, int64_t now);
   void publish(Link& link, int64_t now);
+  void name_short_report(Link& link, std::span<const uint8_t> report, int64_t now);
   void notice(const Link& link, int64_t now, std::string text);
   void pen_notice(int64_t now, std::string text);
 

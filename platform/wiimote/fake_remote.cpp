@@ -28,9 +28,19 @@ class FakeHandle : public Device {
 
 }  // namespace
 
-FakeRemote::FakeRemote(FakeRemoteOptions options, Clock clock) : options_(std::move(options)), clock_(std::move(clock)) {
+bool valid_data_mode(uint8_t mode) { return (mode >= 0x30 && mode <= 0x37) || (mode >= 0x3D && mode <= 0x3F); }
+
+uint64_t seed_of(const FakeRemoteOptions& o) {
+  if (o.schedule.seed) return o.schedule.seed;
+  return std::hash<std::string>{}(normalize_address(o.address));
+}
+
+FakeRemote::FakeRemote(FakeRemoteOptions options, Clock clock)
+    : options_(std::move(options)), clock_(std::move(clock)), schedule_rng_(seed_of(options_)) {
   power_on_locked();
 }
+
+double FakeRemote::uniform_locked() { return std::uniform_real_distribution<double>(0, 1)(schedule_rng_); }
 
 void FakeRemote::power_on_locked() {
   leds_ = 0;
@@ -43,9 +53,15 @@ void FakeRemote::power_on_locked() {
   configured_ = false;
   bad_active_ = BadState::None;
   buttons_ = 0;
-  fresh_ = true;
+  slot_fixed_.fill(false);
+  extension_ = false;
   queue_.clear();
+  answers_.clear();
   held_.clear();
+  const int64_t now = clock_();
+  const FakeSchedule& f = options_.schedule;
+  next_battery_ns_ = f.battery_step_ns > 0 ? now + f.battery_step_ns : -1;
+  next_extension_ns_ = f.extension_every_ns > 0 ? now + f.extension_every_ns : -1;
 }
 
 void FakeRemote::set_blob_source(BlobSource source) {
@@ -57,7 +73,7 @@ void FakeRemote::set_buttons(uint16_t buttons) {
   std::lock_guard lock(mutex_);
   const bool changed = buttons != buttons_;
   buttons_ = buttons;
-  if (changed && plugged_ && !continuous_) queue_locked(data_report_locked(clock_()));
+  if (changed && plugged_ && !continuous_) answer_locked(data_report_locked(clock_()));
 }
 
 void FakeRemote::drop_acks(uint8_t id, int count) {
@@ -84,6 +100,11 @@ void FakeRemote::send_status() {
   if (plugged_) status_locked();
 }
 
+void FakeRemote::extension_event() {
+  std::lock_guard lock(mutex_);
+  if (plugged_) extension_locked();
+}
+
 void FakeRemote::inject(Bytes report) {
   std::lock_guard lock(mutex_);
   if (plugged_) queue_locked(std::move(report));
@@ -104,6 +125,7 @@ void FakeRemote::unplug() {
   plugged_ = false;
   ++generation_;
   queue_.clear();
+  answers_.clear();
   held_.clear();
   arrived_.notify_all();
 }
@@ -157,6 +179,14 @@ uint8_t FakeRemote::register_at(uint32_t address) const {
   const auto it = registers_.find(address);
   return it == registers_.end() ? 0 : it->second;
 }
+uint8_t FakeRemote::battery() const {
+  std::lock_guard lock(mutex_);
+  return options_.battery;
+}
+int FakeRemote::refused_camera_writes() const {
+  std::lock_guard lock(mutex_);
+  return refused_camera_writes_;
+}
 uint64_t FakeRemote::generation() const {
   std::lock_guard lock(mutex_);
   return generation_;
@@ -176,6 +206,14 @@ void FakeRemote::queue_locked(Bytes report) {
   arrived_.notify_all();
 }
 
+void FakeRemote::answer_locked(Bytes report, int64_t extra_ns) {
+  const FakeSchedule& f = options_.schedule;
+  const int64_t jitter = f.jitter_ns > 0 ? static_cast<int64_t>(uniform_locked() * double(f.jitter_ns)) : 0;
+  // The radio keeps a remote's reports in order: a late one holds back those after it.
+  last_answer_ns_ = std::max(last_answer_ns_, clock_() + f.latency_ns + jitter + extra_ns);
+  answers_.emplace_back(last_answer_ns_, std::move(report));
+}
+
 void FakeRemote::ack_locked(uint8_t id, uint8_t error) {
   if (never_ack_) return;
   auto it = drop_acks_.find(id);
@@ -183,13 +221,43 @@ void FakeRemote::ack_locked(uint8_t id, uint8_t error) {
     --it->second;
     return;
   }
-  queue_locked({kInAck, uint8_t(buttons_ >> 8), uint8_t(buttons_), id, error});
+  const FakeSchedule& f = options_.schedule;
+  if (f.ack_drop > 0 && uniform_locked() < f.ack_drop) return;
+  int64_t late = 0;
+  if (f.ack_late > 0 && uniform_locked() < f.ack_late)
+    late = f.late_min_ns + static_cast<int64_t>(uniform_locked() * double(f.late_max_ns - f.late_min_ns));
+  answer_locked({kInAck, uint8_t(buttons_ >> 8), uint8_t(buttons_), id, error}, late);
 }
 
 void FakeRemote::status_locked() {
-  const uint8_t flags = static_cast<uint8_t>(leds_ | (pixel_clock_ ? 0x08 : 0) | (options_.battery < 0x20 ? 0x01 : 0));
-  queue_locked({kInStatus, uint8_t(buttons_ >> 8), uint8_t(buttons_), flags, 0x00, 0x00, options_.battery});
+  const uint8_t flags = static_cast<uint8_t>(leds_ | (pixel_clock_ ? kStatusCameraOn : 0) |
+                                             (extension_ ? kStatusExtension : 0) |
+                                             (options_.battery < 0x20 ? kStatusBatteryLow : 0));
+  answer_locked({kInStatus, uint8_t(buttons_ >> 8), uint8_t(buttons_), flags, 0x00, 0x00, options_.battery});
   continuous_ = false;  // the trap the notes describe: reporting stops until 0x12 is sent again
+}
+
+void FakeRemote::extension_locked() {
+  extension_ = !extension_;
+  // The camera loses power and its registers with it, as Dolphin's does.
+  pixel_clock_ = logic_ = false;
+  block1_ = block2_ = false;
+  registers_.clear();
+  configured_ = false;
+  status_locked();
+}
+
+void FakeRemote::run_schedule_locked(int64_t now) {
+  const FakeSchedule& f = options_.schedule;
+  if (next_battery_ns_ >= 0 && now >= next_battery_ns_) {
+    next_battery_ns_ = now + f.battery_step_ns;
+    if (options_.battery > 0) --options_.battery;
+    status_locked();
+  }
+  if (next_extension_ns_ >= 0 && now >= next_extension_ns_) {
+    next_extension_ns_ = now + f.extension_every_ns;
+    extension_locked();
+  }
 }
 
 Status FakeRemote::host_write(uint64_t generation, std::span<const uint8_t> r) {
@@ -199,13 +267,21 @@ Status FakeRemote::host_write(uint64_t generation, std::span<const uint8_t> r) {
   if (r.size() < 2) return Status::success();  // nothing a remote can act on
   const uint8_t id = r[0], flags = r[1];
   const bool wants_ack = flags & kAckRequestBit;
+  const FakeSchedule& f = options_.schedule;
+  const bool acknowledged = id == kOutWriteMemory || (wants_ack && (id == kOutLeds || id == kOutReportingMode ||
+                                                                     id == kOutIrPixelClock || id == 0x14 ||
+                                                                     id == 0x19 || id == kOutIrLogic));
+  if (acknowledged && f.busy > 0 && uniform_locked() < f.busy) {
+    ack_locked(id, kAckBusy);  // not acted on: the host must send it again
+    return Status::success();
+  }
   rumble_ = flags & kRumbleBit;
   switch (id) {
     case kOutLeds:
       leds_ = flags & kLedBits;
       break;
     case kOutReportingMode:
-      if (r.size() < 3) break;
+      if (r.size() < 3 || !valid_data_mode(r[2])) break;  // a mode no remote has: ignored
       continuous_ = flags & kEnableBit;
       mode_ = r[2];
       next_report_ns_ = clock_() + options_.phase_ns;
@@ -234,6 +310,11 @@ Status FakeRemote::host_write(uint64_t generation, std::span<const uint8_t> r) {
       if (r.size() < 6) return Status::success();
       if (flags & kEnableBit) {
         const uint32_t address = uint32_t{r[2]} << 16 | uint32_t{r[3]} << 8 | r[4];
+        if ((address >> 16) == (kRegIrControl >> 16) && !(pixel_clock_ && logic_)) {
+          ++refused_camera_writes_;
+          ack_locked(id, kAckNoCamera);  // the camera is off and does not answer
+          return Status::success();
+        }
         const size_t n = std::min<size_t>(r[5], r.size() - 6);
         for (size_t k = 0; k < n; ++k) registers_[address + static_cast<uint32_t>(k)] = r[6 + k];
         if (address == kRegIrBlock1 && n == 9) block1_ = true;
@@ -260,16 +341,16 @@ Bytes FakeRemote::data_report_locked(int64_t t_ns) {
     out[2] = uint8_t(buttons_);
     return out;
   }
-  IrObjects objects{};
-  if (camera_working_locked() && blobs_) objects = blobs_(t_ns);
-  const bool any = std::any_of(objects.begin(), objects.end(), [](const IrObject& o) { return o.seen; });
-  Bytes out = ir_extended_report(objects, fresh_ && !any);
-  if (any) fresh_ = false;
-  out[1] = uint8_t(buttons_ >> 8);
-  out[2] = uint8_t(buttons_);
-  out[3] = static_cast<uint8_t>(streamed_ >> 16);
-  out[4] = static_cast<uint8_t>(streamed_ >> 8);
-  out[5] = static_cast<uint8_t>(streamed_);
+  IrReport report{.report_id = kInIrExtended,
+                  .buttons = {uint8_t(buttons_ >> 8), uint8_t(buttons_)},
+                  .accel = {uint8_t(streamed_ >> 16), uint8_t(streamed_ >> 8), uint8_t(streamed_)},
+                  .slots = {}};
+  if (camera_working_locked() && blobs_) report.slots = blobs_(t_ns);
+  Bytes out = encode_ir_report(report);
+  for (size_t k = 0; k < kIrSlots; ++k) {
+    slot_fixed_[k] = slot_fixed_[k] || report.slots[k].seen;
+    if (!slot_fixed_[k]) std::fill_n(out.begin() + 6 + 3 * static_cast<std::ptrdiff_t>(k), 3, uint8_t{0});
+  }
   return out;
 }
 
@@ -280,15 +361,25 @@ ReadResult FakeRemote::host_read(uint64_t generation, int timeout_ms) {
   };
   for (int pass = 0; pass < 2; ++pass) {
     if (!plugged_ || generation != generation_) return gone();
-    if (continuous_ && options_.rate_hz > 0) {
-      const int64_t period = static_cast<int64_t>(std::llround(1e9 / options_.rate_hz));
-      const int64_t now = clock_();
-      if (now - next_report_ns_ > kMaxBacklogReports * period) next_report_ns_ = now - kMaxBacklogReports * period;
-      while (next_report_ns_ <= now) {
+    const int64_t now = clock_();
+    run_schedule_locked(now);
+    const int64_t period = options_.rate_hz > 0 ? static_cast<int64_t>(std::llround(1e9 / options_.rate_hz)) : 0;
+    if (continuous_ && period > 0 && now - next_report_ns_ > kMaxBacklogReports * period)
+      next_report_ns_ = now - kMaxBacklogReports * period;
+    // The stream and the answers on the radio, in the order of their instants.
+    for (;;) {
+      const bool stream_due = continuous_ && period > 0 && next_report_ns_ <= now;
+      const bool answer_due = !answers_.empty() && answers_.front().first <= now;
+      if (answer_due && (!stream_due || answers_.front().first <= next_report_ns_)) {
+        queue_.push_back(std::move(answers_.front().second));
+        answers_.pop_front();
+      } else if (stream_due) {
         Bytes r = data_report_locked(next_report_ns_);
         ++streamed_;
         next_report_ns_ += period;
         (hold_ ? held_ : queue_).push_back(std::move(r));
+      } else {
+        break;
       }
     }
     if (!queue_.empty()) {
@@ -334,7 +425,10 @@ Result<std::vector<DeviceInfo>> FakeBus::enumerate() {
   for (const auto& r : remotes_)
     if (r->plugged())
       out.push_back({.vendor = kNintendoVendor, .product = r->options().product, .serial = r->options().address,
-                     .path = "fake:" + r->options().address});
+                     .path = "fake:" + r->options().address,
+                     .product_name = !r->options().name.empty()                  ? r->options().name
+                                     : r->options().product == kProductRemotePlus ? "Nintendo RVL-CNT-01-TR"
+                                                                                  : "Nintendo RVL-CNT-01"});
   out.insert(out.end(), others_.begin(), others_.end());
   // Real enumeration order changes from one call to the next; so does this one's.
   if (!out.empty()) std::rotate(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(rotation_++ % out.size()), out.end());

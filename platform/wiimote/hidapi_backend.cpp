@@ -63,7 +63,7 @@ Result<std::vector<DeviceInfo>> HidapiBackend::enumerate() {
   hid_device_info* list = hid_enumerate(kNintendoVendor, 0);
   for (hid_device_info* d = list; d; d = d->next)
     out.push_back({.vendor = d->vendor_id, .product = d->product_id, .serial = narrow(d->serial_number),
-                   .path = d->path ? d->path : ""});
+                   .path = d->path ? d->path : "", .product_name = narrow(d->product_string)});
   hid_free_enumeration(list);
   return out;
 }

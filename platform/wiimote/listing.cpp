@@ -26,7 +26,7 @@ Result<Listing> list_remotes(Backend& backend, const std::vector<RemoteAssignmen
   if (!found) return Result<Listing>::failure(found.error());
   Listing out;
   for (const DeviceInfo& info : *found) {
-    if (!is_wii_remote(info.vendor, info.product)) {
+    if (!is_wii_remote(info)) {
       out.others.push_back(info);
       continue;
     }

@@ -4,8 +4,13 @@
 
 namespace fire::wiimote {
 
-bool is_wii_remote(uint16_t vendor, uint16_t product) {
-  return vendor == kNintendoVendor && (product == kProductRemote || product == kProductRemotePlus);
+bool is_wii_remote(uint16_t vendor, uint16_t product, std::string_view product_name) {
+  if (vendor != kNintendoVendor || (product != kProductRemote && product != kProductRemotePlus)) return false;
+  if (product_name.empty()) return true;
+  // hidapi gives "Nintendo RVL-CNT-01", the kernel's HID_NAME the same; some stacks drop the maker.
+  for (std::string_view model : {"RVL-CNT-01", "RVL-CNT-01-TR"})
+    if (product_name == model || product_name == "Nintendo " + std::string(model)) return true;
+  return false;
 }
 
 SensitivityBlocks sensitivity_blocks(int level) {
@@ -63,12 +68,12 @@ size_t input_report_size(uint8_t id) {
 }
 
 std::optional<Ack> parse_ack(std::span<const uint8_t> report) {
-  if (report.size() != input_report_size(kInAck) || report[0] != kInAck) return std::nullopt;
+  if (report.size() < input_report_size(kInAck) || report[0] != kInAck) return std::nullopt;
   return Ack{.report_id = report[3], .error = report[4]};
 }
 
 std::optional<StatusReport> parse_status(std::span<const uint8_t> report) {
-  if (report.size() != input_report_size(kInStatus) || report[0] != kInStatus) return std::nullopt;
+  if (report.size() < input_report_size(kInStatus) || report[0] != kInStatus) return std::nullopt;
   return StatusReport{.flags = report[3], .battery = report[6]};
 }
 
@@ -76,40 +81,8 @@ std::optional<uint16_t> core_buttons(std::span<const uint8_t> report) {
   if (report.empty()) return std::nullopt;
   const uint8_t id = report[0];
   const bool carries = (id >= 0x20 && id <= 0x22) || (id >= 0x30 && id <= 0x37) || id == 0x3E || id == 0x3F;
-  if (!carries || report.size() != input_report_size(id)) return std::nullopt;
+  if (!carries || report.size() < input_report_size(id)) return std::nullopt;
   return static_cast<uint16_t>((report[1] << 8 | report[2]) & kAllButtons);
-}
-
-std::optional<int> ir_object_count(std::span<const uint8_t> report) {
-  if (report.size() != input_report_size(kInIrExtended) || report[0] != kInIrExtended) return std::nullopt;
-  int n = 0;
-  for (size_t k = 0; k < 4; ++k) {
-    const uint8_t b0 = report[6 + 3 * k], b1 = report[7 + 3 * k], b2 = report[8 + 3 * k];
-    const int x = b0 | ((b2 & 0x30) << 4);
-    const int y = b1 | ((b2 & 0xC0) << 2);
-    const bool fresh_zero = x == 0 && y == 0 && (b2 & 0x0F) == 0;
-    n += y < 768 && !fresh_zero;
-  }
-  return n;
-}
-
-Bytes ir_extended_report(const IrObjects& objects, bool fresh) {
-  Bytes out(input_report_size(kInIrExtended), 0);
-  out[0] = kInIrExtended;
-  for (size_t k = 0; k < 4; ++k) {
-    const IrObject& o = objects[k];
-    uint8_t* b = out.data() + 6 + 3 * k;
-    if (!o.seen) {
-      const uint8_t empty = fresh ? 0x00 : 0xFF;
-      b[0] = b[1] = b[2] = empty;
-      continue;
-    }
-    const int x = std::min<int>(o.x, 1023), y = std::min<int>(o.y, 767);
-    b[0] = static_cast<uint8_t>(x & 0xFF);
-    b[1] = static_cast<uint8_t>(y & 0xFF);
-    b[2] = static_cast<uint8_t>(((y >> 8) & 0x03) << 6 | ((x >> 8) & 0x03) << 4 | (o.size & 0x0F));
-  }
-  return out;
 }
 
 }  // namespace fire::wiimote

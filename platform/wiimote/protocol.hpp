@@ -1,13 +1,17 @@
 #pragma once
-// The few Wii Remote reports the driver writes and reads (shared/wiimote-protocol.md). Kept here,
-// not taken from systems/tracking/hid.hpp, because platform/ never includes systems/: the driver
-// only needs to build output reports, read acknowledgements and status reports, and see whether
-// an IR report holds any object. Every parser accepts any byte sequence.
+// The few Wii Remote reports the driver writes and reads (shared/wiimote-protocol.md): output
+// reports, acknowledgements, status reports and buttons. IR reports are read with the one codec,
+// engine/ir_report.hpp. Every parser accepts any byte sequence; a report longer than its layout is
+// read for the layout's bytes, as the kernel reads it.
 #include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <string>
+#include <string_view>
 #include <vector>
+
+#include "engine/ir_report.hpp"
 
 namespace fire::wiimote {
 
@@ -16,7 +20,10 @@ using Bytes = std::vector<uint8_t>;
 inline constexpr uint16_t kNintendoVendor = 0x057E;
 inline constexpr uint16_t kProductRemote = 0x0306;      // the original Wii Remote
 inline constexpr uint16_t kProductRemotePlus = 0x0330;  // Wii Remote Plus (-TR)
-bool is_wii_remote(uint16_t vendor, uint16_t product);
+// The ids are shared with the Wii U Pro Controller (RVL-CNT-01-UC) and the Balance Board
+// (RVL-WBC-01), so where the backend gives the product name it must be a Wii Remote's (RVL-CNT-01 or
+// RVL-CNT-01-TR); an empty name is not known and the ids decide.
+bool is_wii_remote(uint16_t vendor, uint16_t product, std::string_view product_name = {});
 
 // Output report ids.
 inline constexpr uint8_t kOutLeds = 0x11;
@@ -74,20 +81,20 @@ struct Ack {
   uint8_t report_id = 0;
   uint8_t error = 0;
 };
+// Acknowledgement error codes the driver acts on (the kernel's hid-wiimote and Dolphin).
+inline constexpr uint8_t kAckBusy = 4;         // try the same report again a little later
+inline constexpr uint8_t kAckNoCamera = 7;     // a camera register written while the camera is off
 std::optional<Ack> parse_ack(std::span<const uint8_t> report);
 
+inline constexpr uint8_t kStatusBatteryLow = 0x01, kStatusExtension = 0x02, kStatusCameraOn = 0x08;
 struct StatusReport {
   uint8_t flags = 0;    // 0x01 battery low, 0x02 extension, 0x04 speaker, 0x08 IR camera on, LEDs in 0xF0
   uint8_t battery = 0;  // the raw level; kBatteryFull is a fresh pair of cells
-  bool battery_low() const { return flags & 0x01; }
+  bool battery_low() const { return flags & kStatusBatteryLow; }
+  bool camera_on() const { return flags & kStatusCameraOn; }
 };
 inline constexpr uint8_t kBatteryFull = 0xC8;
 std::optional<StatusReport> parse_status(std::span<const uint8_t> report);
-
-// Objects in a well-formed 0x33 report: a slot counts unless it is the all-ones empty marker, a
-// y beyond the sensor, or a fresh remote's zero slot (x = y = 0, size 0). nullopt when the report
-// is not a complete 0x33.
-std::optional<int> ir_object_count(std::span<const uint8_t> report);
 
 // The core buttons, as the first two payload bytes of the reports that carry them (0x20-0x22, and the
 // data reports 0x30-0x37, 0x3E, 0x3F) hold them, first byte high (wiibrew.org, "Core Buttons").
@@ -97,17 +104,5 @@ inline constexpr uint16_t kButtonLeft = 0x0100, kButtonRight = 0x0200, kButtonDo
 inline constexpr uint16_t kAllButtons = 0x1F9F;
 // The buttons held when `report` was sent; nullopt for a report that does not carry them or is too short.
 std::optional<uint16_t> core_buttons(std::span<const uint8_t> report);
-
-// One IR object as a 0x33 report carries it.
-struct IrObject {
-  bool seen = false;
-  uint16_t x = 0;    // 0..1023
-  uint16_t y = 0;    // 0..767
-  uint8_t size = 0;  // 0..15
-};
-using IrObjects = std::array<IrObject, 4>;
-// The 18 bytes of a 0x33 report; unseen slots are FF FF FF, or zeros when `fresh` (a remote that
-// has not yet seen light).
-Bytes ir_extended_report(const IrObjects& objects, bool fresh);
 
 }  // namespace fire::wiimote

@@ -1,5 +1,6 @@
 #include "platform/wiimote/remote_machine.hpp"
 
+#include <algorithm>
 #include <cstdio>
 
 namespace fire::wiimote {
@@ -12,7 +13,12 @@ std::string hex_id(uint8_t id) {
 }
 
 constexpr std::string_view kDriverHint =
-    "is the kernel's hid-wiimote driver bound to it? (docs/wiimote.md says how to unbind it)";
+    "is the kernel's hid-wiimote driver bound to it? FIRE needs hid-generic, which takes a Wii Remote only with "
+    "hid.ignore_special_drivers=1 (`fire devices` checks; docs/wiimote.md)";
+
+bool is_camera_register_write(const Bytes& report) {
+  return report.size() > 2 && report[0] == kOutWriteMemory && report[2] == (kRegIrControl >> 16);
+}
 
 }  // namespace
 
@@ -45,28 +51,34 @@ std::string_view state_name(MachineState state) {
 
 RemoteMachine::RemoteMachine(Role role, StartupOptions options) : role_(role), options_(options) {}
 
+std::vector<RemoteMachine::Step> RemoteMachine::camera_steps() const {
+  const uint8_t enable[] = {kIrControlEnable};
+  const uint8_t mode[] = {kIrModeExtended};
+  const SensitivityBlocks s = sensitivity_blocks(options_.sensitivity);
+  return {{ir_pixel_clock_report(true), Await::Ack},
+          {ir_logic_report(true), Await::Ack},
+          {write_register_report(kRegIrControl, enable), Await::Ack},
+          {write_register_report(kRegIrBlock1, s.block1), Await::Ack},
+          {write_register_report(kRegIrBlock2, s.block2), Await::Ack},
+          {write_register_report(kRegIrMode, mode), Await::Ack},
+          {write_register_report(kRegIrControl, enable), Await::Ack, true}};
+}
+
 void RemoteMachine::plan_sequence() {
   plan_.clear();
   // The status report first: it gives the battery, and the reporting mode, sent last, survives it.
   plan_.push_back({status_request_report(), Await::Status});
   plan_.push_back({leds_report(leds_, true), Await::Ack});
-  if (is_camera(role_)) {
-    const uint8_t enable[] = {kIrControlEnable};
-    const uint8_t mode[] = {kIrModeExtended};
-    const SensitivityBlocks s = sensitivity_blocks(options_.sensitivity);
-    plan_.push_back({ir_pixel_clock_report(true), Await::Ack});
-    plan_.push_back({ir_logic_report(true), Await::Ack});
-    plan_.push_back({write_register_report(kRegIrControl, enable), Await::Ack});
-    plan_.push_back({write_register_report(kRegIrBlock1, s.block1), Await::Ack});
-    plan_.push_back({write_register_report(kRegIrBlock2, s.block2), Await::Ack});
-    plan_.push_back({write_register_report(kRegIrMode, mode), Await::Ack});
-    plan_.push_back({write_register_report(kRegIrControl, enable), Await::Ack});
-  }
+  if (is_camera(role_))
+    for (Step& step : camera_steps()) plan_.push_back(std::move(step));
   // The command pad reports its buttons when they change; the cameras report continuously.
   plan_.push_back({reporting_mode_report(expected_mode(), is_camera(role_), true), Await::Ack});
   next_ = 0;
   in_flight_ = false;
+  resend_at_.reset();
   tries_ = 0;
+  camera_refusals_ = 0;
+  camera_ready_ = false;
 }
 
 void RemoteMachine::begin(int64_t now, uint8_t leds, std::vector<Bytes>& out) {
@@ -89,10 +101,23 @@ void RemoteMachine::send_current(int64_t now, std::vector<Bytes>& out) {
   out.push_back(plan_[next_].report);
   in_flight_ = true;
   sent_at_ = now;
+  resend_at_.reset();
   ++tries_;
+  if (plan_[next_].await == Await::Ack) {
+    owed_.push_back({.report_id = plan_[next_].report[0], .sent_at = now, .token = ++last_token_});
+    in_flight_token_ = last_token_;
+  }
+}
+
+void RemoteMachine::forget_expired_acks(int64_t now) {
+  std::erase_if(owed_, [&](const Owed& o) { return now - o.sent_at >= options_.ack_timeout_ns; });
 }
 
 void RemoteMachine::step_done(int64_t now, std::vector<Bytes>& out) {
+  if (plan_[next_].camera_done) {
+    camera_ready_ = true;
+    if (state_ == MachineState::Running) warning_.clear();  // set up again after it was switched off
+  }
   ++next_;
   tries_ = 0;
   in_flight_ = false;
@@ -123,6 +148,7 @@ void RemoteMachine::abandon(int64_t now, const std::string& why, std::vector<Byt
   plan_.clear();
   next_ = 0;
   in_flight_ = false;
+  resend_at_.reset();
   error_ = why + ", in " + std::to_string(failed_sequences_) + " start-ups: the remote does not answer; " +
            std::string(kDriverHint);
 }
@@ -149,6 +175,68 @@ void RemoteMachine::queue_mode_step(int64_t now, std::vector<Bytes>& out) {
   if (idle) send_current(now, out);
 }
 
+void RemoteMachine::queue_camera_setup(int64_t now, std::vector<Bytes>& out) {
+  const bool idle = next_ >= plan_.size();
+  if (idle) {
+    plan_.clear();
+    next_ = 0;
+  }
+  camera_refusals_ = 0;
+  for (Step& step : camera_steps()) plan_.push_back(std::move(step));
+  plan_.push_back({reporting_mode_report(expected_mode(), true, true), Await::Ack});
+  if (idle) send_current(now, out);
+}
+
+bool RemoteMachine::restart_camera_steps() {
+  for (size_t k = next_ + 1; k-- > 0;) {
+    if (plan_[k].report[0] != kOutIrPixelClock) continue;
+    next_ = k;
+    tries_ = 0;
+    return true;
+  }
+  return false;
+}
+
+void RemoteMachine::on_ack(const Ack& ack, int64_t now, std::vector<Bytes>& out) {
+  forget_expired_acks(now);
+  // In order: the oldest write of this id still owed an ack is the one acknowledged, and any
+  // older write owed one will not get it now.
+  const auto it = std::find_if(owed_.begin(), owed_.end(), [&](const Owed& o) { return o.report_id == ack.report_id; });
+  if (it == owed_.end()) return;  // unasked for, or later than its write's timeout
+  const uint64_t token = it->token;
+  owed_.erase(owed_.begin(), it + 1);
+  // A late acknowledgement of a write sent before the one in flight.
+  if (!in_flight_ || token != in_flight_token_) return;
+  if (ack.error == 0) {
+    step_done(now, out);
+    return;
+  }
+  const std::string refused = "report " + hex_id(ack.report_id) + " refused with error " + std::to_string(ack.error);
+  if (ack.error == kAckNoCamera && is_camera_register_write(plan_[next_].report)) {
+    // The camera did not answer: it is off, so its set-up starts again from the pixel clock.
+    if (++camera_refusals_ >= options_.max_tries) {
+      abandon(now, refused + " (the camera is off) in " + std::to_string(camera_refusals_) + " camera set-ups", out);
+      return;
+    }
+    if (restart_camera_steps()) {
+      ++resends_;
+      send_current(now, out);
+      return;
+    }
+  }
+  if (tries_ >= options_.max_tries) {
+    abandon(now, refused, out);
+    return;
+  }
+  ++resends_;
+  if (ack.error == kAckBusy) {
+    in_flight_ = false;
+    resend_at_ = now + options_.busy_wait_ns;
+    return;
+  }
+  send_current(now, out);
+}
+
 void RemoteMachine::on_report(std::span<const uint8_t> report, int64_t now, std::vector<Bytes>& out) {
   if (report.empty()) return;
   last_report_ = now;
@@ -157,6 +245,11 @@ void RemoteMachine::on_report(std::span<const uint8_t> report, int64_t now, std:
     if (state_ == MachineState::Failed) return;
     if (in_flight_ && plan_[next_].await == Await::Status) {
       step_done(now, out);
+    } else if (is_camera(role_) && camera_ready_ && !status->camera_on()) {
+      // An extension event, or another driver, switched the camera off; Dolphin sets it up again.
+      camera_ready_ = false;
+      warning_ = "the camera was switched off (status report): setting it up again";
+      queue_camera_setup(now, out);
     } else if (!mode_step_pending()) {
       // After any status report the remote stops reporting until it is sent its mode again.
       queue_mode_step(now, out);
@@ -165,16 +258,7 @@ void RemoteMachine::on_report(std::span<const uint8_t> report, int64_t now, std:
   }
   if (state_ == MachineState::Failed) return;
   if (const auto ack = parse_ack(report)) {
-    // Acknowledgements of anything but the report in flight are stale or unasked for: ignored.
-    if (!in_flight_ || plan_[next_].await != Await::Ack || plan_[next_].report[0] != ack->report_id) return;
-    if (ack->error == 0) {
-      step_done(now, out);
-    } else if (tries_ >= options_.max_tries) {
-      abandon(now, "report " + hex_id(ack->report_id) + " refused with error " + std::to_string(ack->error), out);
-    } else {
-      ++resends_;
-      send_current(now, out);
-    }
+    on_ack(*ack, now, out);
     return;
   }
   if (state_ != MachineState::Running || !is_data_report(report[0])) return;
@@ -194,7 +278,7 @@ void RemoteMachine::on_report(std::span<const uint8_t> report, int64_t now, std:
     }
     return;
   }
-  if (const auto objects = ir_object_count(report); objects && *objects > 0) {
+  if (ir_blob_count(report) > 0) {
     if (!seen_object_ && dark_restarts_ >= options_.max_dark_restarts) warning_.clear();
     seen_object_ = true;
   }
@@ -202,8 +286,13 @@ void RemoteMachine::on_report(std::span<const uint8_t> report, int64_t now, std:
 
 void RemoteMachine::tick(int64_t now, std::vector<Bytes>& out) {
   if (state_ == MachineState::Failed) return;
+  if (resend_at_) {
+    if (now >= *resend_at_) send_current(now, out);
+    return;
+  }
   if (in_flight_) {
     if (now - sent_at_ < options_.ack_timeout_ns) return;
+    forget_expired_acks(now);
     if (tries_ >= options_.max_tries) {
       const Step& step = plan_[next_];
       abandon(now,

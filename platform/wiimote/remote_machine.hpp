@@ -3,8 +3,11 @@
 // fed the reports that arrive and the time, and answers with the output reports to write. The
 // sequence is the notes' IR camera initialisation (shared/wiimote-protocol.md). Every report
 // whose acknowledgement it waits for asks for one (bit 0x02); it never waits for one it did not
-// ask for; each wait has a timeout and a bounded number of tries, and a sequence that cannot
-// finish is restarted a bounded number of times before the remote is given up with a reason.
+// ask for. Acknowledgements are matched to writes in order, as the kernel's hid-wiimote does: every
+// set-up write is report 0x16, so a late ack of one write must not pass for the next. A write is
+// sent again only once its ack can no longer come (the kernel's 1 s), or after an error ack; each
+// wait has a bounded number of tries, and a sequence that cannot finish is restarted a bounded
+// number of times before the remote is given up with a reason.
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -26,8 +29,9 @@ inline bool is_camera(Role role) { return role != Role::CommandPad; }
 
 struct StartupOptions {
   int sensitivity = 3;  // 1..5, or kHighSensitivity
-  int64_t ack_timeout_ns = 200'000'000;
-  int max_tries = 4;       // sends of one report before its sequence is abandoned
+  int64_t ack_timeout_ns = 1'000'000'000;  // the kernel's: an ack later than this is taken as lost
+  int64_t busy_wait_ns = 50'000'000;       // after error 4 (busy), before the same report again
+  int max_tries = 4;       // sends of one report (or camera set-ups refused with error 7) before its sequence is abandoned
   int max_sequences = 3;   // sequences abandoned before the remote is given up
   // A camera that shows no IR object this long after starting may have come up dark: it is set up
   // again, a bounded number of times, then runs on with a warning (the pen may simply be off).
@@ -71,8 +75,20 @@ class RemoteMachine {
   struct Step {
     Bytes report;
     Await await = Await::Ack;
+    bool camera_done = false;  // the last step of the camera's set-up
+  };
+  // A write whose acknowledgement may still come.
+  struct Owed {
+    uint8_t report_id = 0;
+    int64_t sent_at = 0;
+    uint64_t token = 0;
   };
   void plan_sequence();
+  std::vector<Step> camera_steps() const;
+  void on_ack(const Ack& ack, int64_t now, std::vector<Bytes>& out);
+  void forget_expired_acks(int64_t now);
+  bool restart_camera_steps();
+  void queue_camera_setup(int64_t now, std::vector<Bytes>& out);
   void send_current(int64_t now, std::vector<Bytes>& out);
   void step_done(int64_t now, std::vector<Bytes>& out);
   void abandon(int64_t now, const std::string& why, std::vector<Bytes>& out);
@@ -88,7 +104,13 @@ class RemoteMachine {
   size_t next_ = 0;         // the step in flight (or to send), plan_.size() when idle
   bool in_flight_ = false;
   int64_t sent_at_ = 0;
+  std::optional<int64_t> resend_at_;  // the step waits for a busy remote, not for an ack
+  std::vector<Owed> owed_;            // oldest first
+  uint64_t last_token_ = 0;
+  uint64_t in_flight_token_ = 0;
   int tries_ = 0;
+  int camera_refusals_ = 0;  // camera set-ups restarted after error 7, this sequence
+  bool camera_ready_ = false;
   int sequences_ = 0;
   int failed_sequences_ = 0;
   int resends_ = 0;

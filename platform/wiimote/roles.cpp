@@ -41,7 +41,7 @@ std::optional<Role> role_of(const std::string& address, const std::vector<Remote
   }
   std::vector<std::string> remotes;
   for (const DeviceInfo& d : found)
-    if (is_wii_remote(d.vendor, d.product)) remotes.push_back(normalize_address(d.serial));
+    if (is_wii_remote(d)) remotes.push_back(normalize_address(d.serial));
   std::sort(remotes.begin(), remotes.end());
   remotes.erase(std::unique(remotes.begin(), remotes.end()), remotes.end());
   const auto it = std::find(remotes.begin(), remotes.end(), a);

@@ -10,7 +10,7 @@
 #include <optional>
 #include <random>
 
-#include "systems/tracking/hid.hpp"
+#include "engine/ir_report.hpp"
 #include "systems/tracking/registration.hpp"
 #include "systems/tracking/rig_io.hpp"
 

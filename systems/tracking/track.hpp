@@ -19,14 +19,30 @@
 
 #include "engine/common.hpp"
 #include "engine/input_log.hpp"
+#include "engine/ir_report.hpp"
 #include "engine/session_dir.hpp"
 #include "systems/tracking/calibration.hpp"
 #include "systems/tracking/camera.hpp"
-#include "systems/tracking/hid.hpp"
 #include "systems/tracking/signal.hpp"
 #include "systems/tracking/triangulation.hpp"
 
 namespace fire::tracking {
+
+// Per-category counts of what a stream of reports held.
+struct ReportCounts {
+  size_t ir_reports = 0;          // decoded IR reports (0x33, 0x36, 0x37)
+  size_t not_ir = 0;              // valid reports without IR data, skipped
+  size_t garbled = 0;             // hex that did not parse, or no bytes at all
+  size_t bad_length = 0;          // truncated IR reports
+  size_t unknown_id = 0;          // report ids no Wii Remote sends
+  size_t unknown_device = 0;      // devices that are no camera: not 0 or 1 in a log without device records,
+                                  // or with no camera role in the log's `meta device` records
+  size_t pad_reports = 0;         // reports of the command pad (role `pad` in `meta device`): no camera data
+  size_t bad_device_records = 0;  // `meta device` records that do not read as D ADDRESS ROLE PRODUCT, or whose
+                                  // product is no Wii Remote's (0306, 0330): their device is no camera
+  size_t out_of_range_slots = 0;  // blobs with impossible coordinates, dropped from kept reports
+  size_t rejected_reports() const { return garbled + bad_length + unknown_id + unknown_device; }
+};
 
 // The IR reports of one camera, one entry per report (structure of arrays).
 struct CameraFrames {

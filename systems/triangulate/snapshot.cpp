@@ -14,10 +14,10 @@ void put(SnapshotWriter& out, const Vec2& p) {
 }
 bool get(SnapshotReader& in, Vec2& p) { return in.get(p.x()) && in.get(p.y()); }
 
-void put(SnapshotWriter& out, const std::array<Vec2, tracking::kIrSlots>& blobs) {
+void put(SnapshotWriter& out, const std::array<Vec2, kIrSlots>& blobs) {
   for (const Vec2& p : blobs) put(out, p);
 }
-bool get(SnapshotReader& in, std::array<Vec2, tracking::kIrSlots>& blobs) {
+bool get(SnapshotReader& in, std::array<Vec2, kIrSlots>& blobs) {
   for (Vec2& p : blobs)
     if (!get(in, p)) return false;
   return true;
@@ -70,7 +70,7 @@ void get_report(SnapshotReader& in, CameraReport& r) {
   in.get(r.line);
   in.get(r.blob_count);
   get(in, r.blobs);
-  if ((camera != 0 && camera != 1) || r.blob_count > tracking::kIrSlots) in.fail();
+  if ((camera != 0 && camera != 1) || r.blob_count > kIrSlots) in.fail();
   r.camera = camera;
 }
 
@@ -111,7 +111,7 @@ void get_window(SnapshotReader& in, CameraWindow& c) {
   if (f.line.size() != frames || f.t_frame_us.size() != frames || f.blob_count.size() != frames || f.blobs.size() != frames)
     in.fail();
   for (uint8_t count : f.blob_count)
-    if (count > tracking::kIrSlots) in.fail();
+    if (count > kIrSlots) in.fail();
   in.get(n);
   c.links.clear();
   for (uint64_t k = 0; k < n && in.ok(); ++k) in.get(c.links.emplace_back());

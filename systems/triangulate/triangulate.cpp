@@ -186,7 +186,7 @@ std::optional<double> lit_since(const CameraWindow& w, size_t j, int b) {
 
 // The blobs of a camera's frame j that may be the pen: not one beside it.
 struct Candidates {
-  std::array<Vec2, tracking::kIrSlots> px;
+  std::array<Vec2, kIrSlots> px;
   int count = 0;
 };
 Candidates maybe_pen(const CameraWindow& w, size_t j, double seen_t, const Vec2& pen_px) {
@@ -270,11 +270,11 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
   // pen centimetres deeper, and the stroke would end there. Of the rest, the fit nearest the pen's last
   // position wins, its epipolar misfit counted as distance (kMisfitDistance_m). A stroke only starts from a
   // frame where every fitting pair agrees.
-  std::array<tracking::Triangulation, tracking::kIrSlots * tracking::kIrSlots> fits;
-  std::array<std::array<int, 2>, tracking::kIrSlots * tracking::kIrSlots> fit_blobs;
+  std::array<tracking::Triangulation, kIrSlots * kIrSlots> fits;
+  std::array<std::array<int, 2>, kIrSlots * kIrSlots> fit_blobs;
   int fit_count = 0;
   const bool pen_pixels_current = s.down && s.last_seen_t == s.last_sample_t;
-  std::array<bool, tracking::kIrSlots> beside0{}, beside1{};
+  std::array<bool, kIrSlots> beside0{}, beside1{};
   if (pen_pixels_current) {
     for (int i = 0; i < f0.blob_count[k]; ++i) beside0[size_t(i)] = beside_pen(s.cameras[0], k, i, s.last_seen_t, s.pen_px[0]);
     for (int j = 0; j < ip.count; ++j)

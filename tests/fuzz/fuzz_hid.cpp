@@ -3,10 +3,10 @@
 #include <cstdint>
 #include <span>
 
-#include "systems/tracking/hid.hpp"
+#include "engine/ir_report.hpp"
 #include "tests/fuzz/fuzz_check.hpp"
 
-using namespace fire::tracking;
+using namespace fire;
 
 namespace {
 
@@ -34,9 +34,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FUZZ_CHECK(ir_id, "Ok only for IR report ids");
   FUZZ_CHECK(d.out_of_range_slots >= 0 && d.out_of_range_slots <= kIrSlots, "out-of-range count within the slots");
   for (const IrSlot& s : d.report.slots)
-    if (s.seen) FUZZ_CHECK(s.x <= 1023 && s.y <= 767 && s.size <= 15, "a seen slot lies in the camera's range");
+    if (s.seen) {
+      FUZZ_CHECK(s.x <= 1023 && s.y <= 767 && s.size <= 15, "a seen slot lies in the camera's range");
+      FUZZ_CHECK(s.x != 0 || s.y != 0 || s.size != 0, "a fresh remote's zero slot is empty");
+    }
   const std::vector<uint8_t> encoded = encode_ir_report(d.report);
-  FUZZ_CHECK(encoded.size() == size, "the encoder writes the report id's length");
+  FUZZ_CHECK(encoded.size() + d.trailing_bytes == size, "the encoder writes the report id's length");
   const DecodedReport again = decode_ir_report(encoded);
   FUZZ_CHECK(again.status == ReportStatus::Ok && again.out_of_range_slots == 0, "an encoded report decodes cleanly");
   FUZZ_CHECK(same_report(d.report, again.report), "decode -> encode -> decode keeps the report");

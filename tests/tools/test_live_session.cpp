@@ -138,7 +138,7 @@ struct LiveRig {
     for (int c = 0; c < 2; ++c)
       (c ? cam1 : cam0)->set_blob_source([this, c](int64_t t) {
         const int64_t o = origin.load();
-        return o < 0 ? IrObjects{} : scenario.blobs.at(c, t - o);
+        return o < 0 ? IrSlots{} : scenario.blobs.at(c, t - o);
       });
     REQUIRE(driver.open_all().ok());
     SessionWriteOptions options;

@@ -6,7 +6,7 @@
 #include "platform/files.hpp"
 #include "platform/wiimote/hidapi_backend.hpp"
 #include "platform/wiimote/roles.hpp"
-#include "systems/tracking/hid.hpp"
+#include "engine/ir_report.hpp"
 #include "tools/fire/session_rig.hpp"
 
 namespace fire::cli {
@@ -101,12 +101,12 @@ void AppLive::observe(std::span<const InputEvent> taken) {
       continue;
     }
     if (e.device < 0 || e.device > 1) continue;
-    const tracking::DecodedReport d = tracking::decode_ir_report(e.bytes);
-    if (d.status != tracking::ReportStatus::Ok) continue;
+    const DecodedReport d = decode_ir_report(e.bytes);
+    if (d.status != ReportStatus::Ok) continue;
     window::CameraView& view = cameras_[size_t(e.device)];
     view.present = true;
     view.blobs.clear();
-    for (const tracking::IrSlot& s : d.report.slots)
+    for (const IrSlot& s : d.report.slots)
       if (s.seen) view.blobs.push_back({float(s.x), float(s.y), int(s.size)});
     view.pen_seen = !view.blobs.empty();
   }

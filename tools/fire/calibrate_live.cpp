@@ -15,7 +15,7 @@
 #include "platform/wiimote/fake_remote.hpp"
 #include "platform/wiimote/hidapi_backend.hpp"
 #include "systems/tracking/camera.hpp"
-#include "systems/tracking/hid.hpp"
+#include "engine/ir_report.hpp"
 #include "systems/tracking/simulate.hpp"
 #include "tools/fire/fake_rig.hpp"
 #include "tools/fire/live_session.hpp"
@@ -32,11 +32,11 @@ class WandCoverage {
 
   void add(const InputEvent& e) {
     if (e.kind != EventKind::Hid || e.device < 0 || e.device > 1) return;
-    const tracking::DecodedReport d = tracking::decode_ir_report(e.bytes);
-    if (d.status != tracking::ReportStatus::Ok) return;
+    const DecodedReport d = decode_ir_report(e.bytes);
+    if (d.status != ReportStatus::Ok) return;
     Camera& c = cameras_[size_t(e.device)];
     int seen = 0;
-    for (const tracking::IrSlot& s : d.report.slots) {
+    for (const IrSlot& s : d.report.slots) {
       if (!s.seen) continue;
       ++seen;
       const int col = std::min(kColumns - 1, s.x * kColumns / tracking::kWiimoteWidth);

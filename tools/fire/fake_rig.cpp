@@ -7,30 +7,28 @@
 
 #include "platform/obj.hpp"
 #include "systems/synth/network_from_mesh.hpp"
-#include "systems/tracking/hid.hpp"
+#include "engine/ir_report.hpp"
 #include "systems/tracking/simulate.hpp"
 #include "tools/fire/pad.hpp"
 #include "tools/fire/session_rig.hpp"
 
 namespace fire::cli {
 
-using wiimote::IrObjects;
-
-IrObjects SimulatedBlobs::at(int camera, int64_t t_ns) const {
+IrSlots SimulatedBlobs::at(int camera, int64_t t_ns) const {
   // Frames further apart than this are a gap (the pen unseen, a lost report): nothing to interpolate across.
   constexpr int64_t kMaxGapNs = 25'000'000;
   const auto& f = frames[size_t(camera)];
   auto next = std::upper_bound(f.begin(), f.end(), t_ns,
-                               [](int64_t t, const std::pair<int64_t, IrObjects>& p) { return t < p.first; });
+                               [](int64_t t, const std::pair<int64_t, IrSlots>& p) { return t < p.first; });
   if (next == f.begin()) return {};
   const auto& [t0, before] = *std::prev(next);
   if (next == f.end() || next->first - t0 > kMaxGapNs) return before;
   // The fake remote's frames are not the simulator's: a blob held from the simulator's last frame would be up
   // to a frame old, differently for each camera, and triangulated as if it were now.
   const double s = double(t_ns - t0) / double(next->first - t0);
-  IrObjects out = before;
+  IrSlots out = before;
   for (size_t k = 0; k < out.size(); ++k) {
-    const wiimote::IrObject &a = before[k], &b = next->second[k];
+    const IrSlot &a = before[k], &b = next->second[k];
     if (!a.seen || !b.seen) continue;
     out[k].x = uint16_t(std::lround(a.x + s * (double(b.x) - a.x)));
     out[k].y = uint16_t(std::lround(a.y + s * (double(b.y) - a.y)));
@@ -42,11 +40,11 @@ SimulatedBlobs simulated_blobs_of(const std::vector<InputEvent>& events) {
   SimulatedBlobs out;
   for (const InputEvent& e : events) {
     if (e.kind != EventKind::Hid || e.device < 0 || e.device > 1) continue;
-    const tracking::DecodedReport d = tracking::decode_ir_report(e.bytes);
-    if (d.status != tracking::ReportStatus::Ok) continue;
-    IrObjects o{};
+    const DecodedReport d = decode_ir_report(e.bytes);
+    if (d.status != ReportStatus::Ok) continue;
+    IrSlots o{};
     for (size_t k = 0; k < o.size(); ++k) {
-      const tracking::IrSlot& s = d.report.slots[k];
+      const IrSlot& s = d.report.slots[k];
       o[k] = {.seen = s.seen, .x = s.x, .y = s.y, .size = s.size};
     }
     out.frames[size_t(e.device)].push_back({e.t_us * 1000, o});
@@ -138,7 +136,7 @@ FakeRig::FakeRig(SimulatedBlobs blobs, bool with_pad, std::vector<PadPress> pres
     remotes_.push_back(bus_.add_remote({.address = kAddresses[r], .phase_ns = int64_t(3 + 4 * r) * 1'000'000}));
     if (r < 2)
       remotes_[r]->set_blob_source([this, r](int64_t t) {
-        return origin_ns_ < 0 ? IrObjects{} : blobs_.at(int(r), t - origin_ns_);
+        return origin_ns_ < 0 ? IrSlots{} : blobs_.at(int(r), t - origin_ns_);
       });
   }
 }

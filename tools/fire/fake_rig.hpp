@@ -18,10 +18,10 @@ namespace fire::cli {
 
 // What each camera of a simulated rig saw: the blobs of the simulator's camera reports in arrival order.
 struct SimulatedBlobs {
-  std::array<std::vector<std::pair<int64_t, wiimote::IrObjects>>, 2> frames;  // (arrival ns, blobs) per camera
+  std::array<std::vector<std::pair<int64_t, IrSlots>>, 2> frames;  // (arrival ns, blobs) per camera
   // What camera `camera` shows `t_ns` after the simulation began: each blob seen in the reports arrived
   // before and after, interpolated between them; the last report's blobs across a gap or at the end.
-  wiimote::IrObjects at(int camera, int64_t t_ns) const;
+  IrSlots at(int camera, int64_t t_ns) const;
 };
 // The blobs of a simulated session's camera reports (devices 0 and 1, mode 0x33).
 SimulatedBlobs simulated_blobs_of(const std::vector<InputEvent>& events);

@@ -1,8 +1,8 @@
-#include "systems/tracking/hid.hpp"
+#include "engine/ir_report.hpp"
 
 #include <algorithm>
 
-namespace fire::tracking {
+namespace fire {
 namespace {
 
 constexpr uint16_t kUnseenCoordinate = 1023;
@@ -20,9 +20,10 @@ bool is_non_ir_report(uint8_t id) {
   }
 }
 
-// Shared by both modes: a slot is unseen when y reads 1023 (the device's all-ones marker).
+// Shared by both modes: a slot is unseen when y reads 1023 (the device's all-ones marker) or when
+// it is a fresh remote's zeros.
 void set_slot(IrSlot& slot, uint16_t x, uint16_t y, uint8_t size, int& out_of_range) {
-  if (y == kUnseenCoordinate) return;
+  if (y == kUnseenCoordinate || (x == 0 && y == 0 && size == 0)) return;
   if (y >= 768) {
     ++out_of_range;
     return;
@@ -56,6 +57,15 @@ uint16_t field_y(const IrSlot& s) { return s.seen ? std::min<uint16_t>(s.y, 1023
 
 }  // namespace
 
+size_t ir_report_size(uint8_t id) {
+  switch (id) {
+    case 0x33: return kReport33Size;
+    case 0x36: return kReport36Size;
+    case 0x37: return kReport37Size;
+    default: return 0;
+  }
+}
+
 DecodedReport decode_ir_report(std::span<const uint8_t> bytes) {
   DecodedReport out;
   if (bytes.empty()) return out;
@@ -65,16 +75,17 @@ DecodedReport decode_ir_report(std::span<const uint8_t> bytes) {
     out.status = ReportStatus::NotIr;
     return out;
   }
-  const size_t expected = id == 0x33 ? kReport33Size : id == 0x36 ? kReport36Size : id == 0x37 ? kReport37Size : 0;
+  const size_t expected = ir_report_size(id);
   if (expected == 0) {
     out.status = ReportStatus::UnknownId;
     return out;
   }
-  if (bytes.size() != expected) {
+  if (bytes.size() < expected) {
     out.status = ReportStatus::BadLength;
     return out;
   }
   out.status = ReportStatus::Ok;
+  out.trailing_bytes = bytes.size() - expected;
   out.report.buttons = {bytes[1], bytes[2]};
   if (id == 0x36) {
     decode_basic(bytes.subspan<3, 10>(), out);
@@ -88,10 +99,18 @@ DecodedReport decode_ir_report(std::span<const uint8_t> bytes) {
   return out;
 }
 
+int ir_blob_count(std::span<const uint8_t> bytes) {
+  const DecodedReport d = decode_ir_report(bytes);
+  if (d.status != ReportStatus::Ok) return 0;
+  int n = 0;
+  for (const IrSlot& s : d.report.slots) n += s.seen;
+  return n;
+}
+
 std::vector<uint8_t> encode_ir_report(const IrReport& report) {
   const uint8_t id = report.report_id;
-  if (id != 0x33 && id != 0x36 && id != 0x37) return {};
-  std::vector<uint8_t> out(id == 0x33 ? kReport33Size : id == 0x36 ? kReport36Size : kReport37Size, 0);
+  if (ir_report_size(id) == 0) return {};
+  std::vector<uint8_t> out(ir_report_size(id), 0);
   out[0] = id;
   out[1] = report.buttons[0];
   out[2] = report.buttons[1];
@@ -126,4 +145,4 @@ std::vector<uint8_t> encode_ir_report(const IrReport& report) {
   return out;
 }
 
-}  // namespace fire::tracking
+}  // namespace fire

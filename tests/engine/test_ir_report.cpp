@@ -2,9 +2,9 @@
 #include <catch2/catch.hpp>
 #include <vector>
 
-#include "systems/tracking/hid.hpp"
+#include "engine/ir_report.hpp"
 
-using namespace fire::tracking;
+using namespace fire;
 
 namespace {
 
@@ -82,12 +82,17 @@ TEST_CASE("basic-mode reports 0x36 and 0x37 pack two objects in five bytes") {
 TEST_CASE("garbled, truncated and foreign reports get a status, never a crash") {
   const std::vector<uint8_t> good = encode_ir_report(report_with(0x33, {{true, 10, 20, 3}}));
   SECTION("no bytes") { CHECK(decode_ir_report({}).status == ReportStatus::Empty); }
-  SECTION("every truncation and one byte too many") {
+  SECTION("every truncation is named; a longer report is read for its layout's bytes, as the kernel reads it") {
     for (size_t n = 1; n < good.size(); ++n)
       CHECK(decode_ir_report(std::span(good.data(), n)).status == ReportStatus::BadLength);
     std::vector<uint8_t> longer = good;
-    longer.push_back(0);
-    CHECK(decode_ir_report(longer).status == ReportStatus::BadLength);
+    longer.insert(longer.end(), {0xFF, 0x00, 0x12, 0x34});  // a clone's padding
+    const DecodedReport d = decode_ir_report(longer);
+    REQUIRE(d.status == ReportStatus::Ok);
+    CHECK(d.trailing_bytes == 4);
+    CHECK(d.report.slots[0].seen);
+    CHECK(d.report.slots[0].x == 10);
+    CHECK(ir_blob_count(longer) == 1);
   }
   SECTION("ids no Wii Remote sends") {
     for (uint8_t id : {uint8_t{0x00}, uint8_t{0x11}, uint8_t{0x99}, uint8_t{0xFF}}) {
@@ -127,6 +132,27 @@ TEST_CASE("garbled, truncated and foreign reports get a status, never a crash") 
           if (s.seen) CHECK((s.x < 1024 && s.y < 768));
       }
   }
+}
+
+TEST_CASE("a fresh remote's zero slots are empty, not blobs at the corner, while it fixes them one by one") {
+  // Slot 0 lit, slots 1-3 still 00 00 00 (xwiimote #88), then slot 1 fixed to FF FF FF.
+  std::vector<uint8_t> b{0x33, 0, 0, 0x80, 0x80, 0x80, 0x10, 0x20, 0x03, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+  DecodedReport d = decode_ir_report(b);
+  REQUIRE(d.status == ReportStatus::Ok);
+  CHECK(d.report.slots[0].seen);
+  for (int k = 1; k < kIrSlots; ++k) CHECK_FALSE(d.report.slots[k].seen);
+  CHECK(ir_blob_count(b) == 1);
+  std::fill(b.begin() + 9, b.begin() + 12, uint8_t{0xFF});
+  CHECK(ir_blob_count(b) == 1);
+  // A dark camera whose slots are all zeros shows no pen.
+  std::fill(b.begin() + 6, b.end(), uint8_t{0});
+  CHECK(ir_blob_count(b) == 0);
+  // A blob at the corner with a size is still a blob; basic mode carries no size, so its zeros are empty.
+  b[8] = 0x01;
+  CHECK(ir_blob_count(b) == 1);
+  std::vector<uint8_t> basic(kReport36Size, 0);
+  basic[0] = 0x36;
+  CHECK(ir_blob_count(basic) == 0);
 }
 
 TEST_CASE("encoding an unknown report id gives no bytes") {
