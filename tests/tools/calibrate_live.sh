@@ -3,13 +3,7 @@
 # each camera's progress and the bundle adjustment converging, and writes the rig that the offline
 # fire calibrate gives on that folder, byte for byte.
 #   calibrate_live.sh FIRE_BINARY WORK_DIR
-set -euo pipefail
-fire="$1"
-dir="$2"
-rm -rf "$dir"
-mkdir -p "$dir"
-cd "$dir"
-fail() { echo "FAIL: $*" >&2; exit 1; }
+source "$(dirname "${BASH_SOURCE[0]}")/../work_dir.sh"
 
 "$fire" calibrate --live --fake-rig 7 --session live --samples 600 --coverage 0.3 --max-seconds 30 -o live.json \
   >live.out 2>live.err </dev/null || fail "calibrate --live failed: $(cat live.err)"

@@ -2,13 +2,7 @@
 # fire devices --sys-root on made-up /sys trees (laid out as the kernel lays them out): one line per
 # remote naming the step it misses, exit 1 unless every Wii Remote is ready, no hidapi at all.
 #   fire_devices_sysfs.sh FIRE_BINARY WORK_DIR
-set -euo pipefail
-fire="$1"
-dir="$2"
-rm -rf "$dir"
-mkdir -p "$dir"
-cd "$dir"
-fail() { echo "FAIL: $*" >&2; exit 1; }
+source "$(dirname "${BASH_SOURCE[0]}")/../../work_dir.sh"
 
 # sysfs ROOT [PARAMETER]: an empty tree; PARAMETER is ignore_special_drivers' content, none if not given.
 sysfs() {
