@@ -2,7 +2,7 @@
 // The session folder of engine/SESSION.md on disk: a writer that appends the input log and makes it
 // durable at commit points, writes snapshots atomically and keeps the newest few (and resumes a session
 // after a crash); and a reader that recovers the log a crash left and lists the snapshots, newest first. What a snapshot holds is its
-// writer's business (tools/fire/session_store.hpp for a World).
+// writer's business (tools/app/session_store.hpp for a World).
 #include <cstdint>
 #include <functional>
 #include <optional>

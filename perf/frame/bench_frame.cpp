@@ -27,8 +27,8 @@
 
 #include "perf/frame/grid_drawing.hpp"
 #include "platform/files.hpp"
-#include "tools/fire/session.hpp"
-#include "tools/fire/session_rig.hpp"
+#include "tools/app/session.hpp"
+#include "tools/app/session_rig.hpp"
 
 using namespace fire;
 
@@ -66,7 +66,7 @@ Run replay(const std::vector<InputEvent>& events, uint32_t levels, double snap, 
     run.problem = scheduler.error();
     return run;
   }
-  // The replay loop of tools/fire/session.cpp, watching each frame for a commit and for the surface.
+  // The replay loop of tools/app/session.cpp, watching each frame for a commit and for the surface.
   begin_frame(w, 0, w.log.events.front().t_us);
   // Frame index of the last commit whose faces are not shown yet (a border stroke's never are), and of the
   // first shown one whose surface has not settled yet (a commit while a fit runs abandons that fit: the

@@ -1,4 +1,4 @@
-// The app frame as `fire app` shows it (tools/fire/app_window.hpp: systems, uploads, draw, HUD, present
+// The app frame as `fire app` shows it (tools/app/app_window.hpp: systems, uploads, draw, HUD, present
 // with vsync) in a real GLFW window, 1280 x 720, on the surface and curves of perf/frame's grid drawing.
 // Run under an X server (perf/render/run.sh starts Xvfb). Per network and subdivision level:
 //   - idle: the frame sustained for --seconds with nothing drawn: mean fps, p50 and p99 frame time (wall
@@ -22,7 +22,7 @@
 
 #include "perf/frame/grid_drawing.hpp"
 #include "platform/clock.hpp"
-#include "tools/fire/app_window.hpp"
+#include "tools/app/app_window.hpp"
 
 using namespace fire;
 
@@ -53,7 +53,7 @@ struct Stat {
 
 struct Stages {
   Stat systems, wait, upload, hud, present;
-  void add(const cli::FrameStages& s) {
+  void add(const app::FrameStages& s) {
     systems.add(s.systems);
     wait.add(s.wait);
     upload.add(s.upload);
@@ -115,19 +115,19 @@ Measurement run(const Config& c, double seconds) {
     return r;
   }
 
-  auto opened = cli::AppWindow::open(w, scheduler, 1280, 720, {}, {});
+  auto opened = app::AppWindow::open(w, scheduler, 1280, 720, {}, {});
   if (!opened) {
     r.problem = opened.error();
     return r;
   }
-  cli::AppWindow& app = **opened;
+  app::AppWindow& app = **opened;
   if (app.width() != 1280 || app.height() != 720) {
     r.problem = "the window is " + std::to_string(app.width()) + "x" + std::to_string(app.height()) + ", not 1280x720";
     return r;
   }
   r.device = app.context().device_name();
   r.samples = uint32_t(app.renderer().samples());
-  const render::Orbit orbit = frame_orbit(cli::scene_box(w.mesh, w.surface, {}), app.width(), app.height());
+  const render::Orbit orbit = frame_orbit(app::scene_box(w.mesh, w.surface, {}), app.width(), app.height());
   // The app's loop without its input handling: events are drained, none is made.
   auto frame = [&] {
     app.window().poll();

@@ -25,7 +25,7 @@
 #include "perf/soak/memory.hpp"
 #include "platform/clock.hpp"
 #include "platform/session_files.hpp"
-#include "tools/fire/session_store.hpp"
+#include "tools/app/session_store.hpp"
 
 using namespace fire;
 using soak::peak_mib;

@@ -4,7 +4,7 @@
 // is the order of their stamps and the log never goes back in time.
 //
 // Two destinations. A stream (a bare log file): each line is written and flushed as it comes.
-// A live session (tools/fire/live_session.hpp): the stamped events are held, in stamp order, until
+// A live session (tools/app/live_session.hpp): the stamped events are held, in stamp order, until
 // the frame loop takes those before a time, which it writes to the session folder and delivers.
 #include <cstdint>
 #include <deque>

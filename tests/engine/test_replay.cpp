@@ -4,7 +4,7 @@
 #include <map>
 
 #include "systems/split/split_system.hpp"
-#include "tools/fire/session.hpp"
+#include "tools/app/session.hpp"
 
 using namespace fire;
 

@@ -22,8 +22,8 @@
 #include "platform/obj.hpp"
 #include "systems/tracking/simulate.hpp"
 #include "tests/temp_dir.hpp"
-#include "tools/fire/session_rig.hpp"
-#include "tools/fire/session_store.hpp"
+#include "tools/app/session_rig.hpp"
+#include "tools/app/session_store.hpp"
 
 using namespace fire;
 namespace fs = std::filesystem;

@@ -14,7 +14,7 @@
 
 #include "platform/session_files.hpp"
 #include "tests/fuzz/fuzz_check.hpp"
-#include "tools/fire/session_store.hpp"
+#include "tools/app/session_store.hpp"
 
 using namespace fire;
 

@@ -18,15 +18,15 @@
 #include "systems/tracking/simulate.hpp"
 #include "tests/platform/wiimote/helpers.hpp"
 #include "tests/temp_dir.hpp"
-#include "tools/fire/fake_rig.hpp"
-#include "tools/fire/live_session.hpp"
-#include "tools/fire/session_rig.hpp"
+#include "tools/app/fake_rig.hpp"
+#include "tools/app/live_session.hpp"
+#include "tools/app/session_rig.hpp"
 
 using namespace fire;
 using namespace fire::wiimote;
 using namespace fire::wiimote::test;
-using fire::cli::SimulatedBlobs;
-using fire::cli::simulated_blobs_of;
+using fire::app::SimulatedBlobs;
+using fire::app::simulated_blobs_of;
 namespace fs = std::filesystem;
 
 namespace {

@@ -1,16 +1,16 @@
-// The command pad (tools/fire/pad.hpp): presses from its reports, the mapping the help lists, the curve
-// drawn last; and the fake person's presses for the simulated commands (tools/fire/fake_rig.hpp).
+// The command pad (tools/app/pad.hpp): presses from its reports, the mapping the help lists, the curve
+// drawn last; and the fake person's presses for the simulated commands (tools/app/fake_rig.hpp).
 #include <catch2/catch.hpp>
 
 #include <set>
 
 #include "platform/wiimote/protocol.hpp"
 #include "systems/split/edit.hpp"
-#include "tools/fire/fake_rig.hpp"
-#include "tools/fire/pad.hpp"
+#include "tools/app/fake_rig.hpp"
+#include "tools/app/pad.hpp"
 
 using namespace fire;
-using namespace fire::cli;
+using namespace fire::app;
 using namespace fire::wiimote;
 
 namespace {

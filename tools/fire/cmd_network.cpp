@@ -9,9 +9,9 @@
 #include "platform/network_file.hpp"
 #include "platform/surface_io.hpp"
 #include "tools/fire/commands.hpp"
-#include "tools/fire/session.hpp"
-#include "tools/fire/session_rig.hpp"
-#include "tools/fire/session_store.hpp"
+#include "tools/app/session.hpp"
+#include "tools/app/session_rig.hpp"
+#include "tools/app/session_store.hpp"
 #include "tools/fire/surface_args.hpp"
 
 namespace fire::cli {

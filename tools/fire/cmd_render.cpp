@@ -15,8 +15,8 @@
 #include "systems/reconstruct/reconstruct.hpp"
 #include "tools/fire/commands.hpp"
 #include "tools/fire/surface_args.hpp"
-#include "tools/fire/session.hpp"
-#include "tools/fire/session_rig.hpp"
+#include "tools/app/session.hpp"
+#include "tools/app/session_rig.hpp"
 
 namespace fire::cli {
 

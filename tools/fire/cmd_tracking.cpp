@@ -19,10 +19,10 @@
 #include "systems/tracking/simulate.hpp"
 #include "systems/tracking/track.hpp"
 #include "systems/triangulate/triangulate.hpp"
-#include "tools/fire/calibrate_live.hpp"
+#include "tools/app/calibrate_live.hpp"
 #include "tools/fire/commands.hpp"
-#include "tools/fire/session_rig.hpp"
-#include "tools/fire/session_store.hpp"
+#include "tools/app/session_rig.hpp"
+#include "tools/app/session_store.hpp"
 
 #ifndef FIRE_DEFAULT_MESH
 #define FIRE_DEFAULT_MESH "../shared/data/meshes/pawn.obj"
@@ -244,7 +244,7 @@ struct CalibrateArgs {
   std::optional<double> wand_length_m;
   int max_iterations = 100;
   bool live = false;
-  LiveWandOptions live_options;
+  app::LiveWandOptions live_options;
 };
 
 // Shows the bundle adjustment converging on stderr: each pass's start, the frames it drops as
@@ -294,9 +294,9 @@ class AdjustmentPrinter {
 // The wand's reports: the log or folder given, or (--live) those the remotes send now, recorded.
 Result<InputLog> wand_log(const CalibrateArgs& a, std::vector<std::string>& notes) {
   if (!a.live) return read_log_or_session(a.log_path, notes);
-  LiveWandOptions live = a.live_options;
+  app::LiveWandOptions live = a.live_options;
   if (a.wand_length_m) live.wand_length_m = *a.wand_length_m;
-  auto events = record_live_wand(live);
+  auto events = app::record_live_wand(live);
   if (!events) return Result<InputLog>::failure(events.error());
   InputLog log;
   log.events = std::move(*events);

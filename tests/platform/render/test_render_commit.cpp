@@ -9,7 +9,7 @@
 
 #include "perf/frame/grid_drawing.hpp"
 #include "platform/render/renderer.hpp"
-#include "tools/fire/session.hpp"
+#include "tools/app/session.hpp"
 
 using namespace fire;
 using namespace fire::render;

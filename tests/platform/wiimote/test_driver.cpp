@@ -14,13 +14,13 @@
 #include "systems/tracking/simulate.hpp"
 #include "systems/tracking/track.hpp"
 #include "tests/platform/wiimote/helpers.hpp"
-#include "tools/fire/fake_rig.hpp"
+#include "tools/app/fake_rig.hpp"
 
 using namespace fire;
 using namespace fire::wiimote;
 using namespace fire::wiimote::test;
-using fire::cli::SimulatedBlobs;
-using fire::cli::simulated_blobs_of;
+using fire::app::SimulatedBlobs;
+using fire::app::simulated_blobs_of;
 
 namespace {
 

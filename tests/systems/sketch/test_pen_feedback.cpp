@@ -4,7 +4,7 @@
 // stroke's ends land: on a vertex within the snap radius, the pen's pauses there not drawn.
 #include <catch2/catch.hpp>
 
-#include "tools/fire/session.hpp"
+#include "tools/app/session.hpp"
 
 using namespace fire;
 

@@ -1,8 +1,8 @@
-#include "tools/fire/app_window.hpp"
+#include "tools/app/app_window.hpp"
 
 #include <algorithm>
 
-namespace fire::cli {
+namespace fire::app {
 
 render::Box scene_box(const Mesh& mesh, const SurfaceLevels& surface, std::span<const Vec3> reference) {
   render::Box box;
@@ -140,4 +140,4 @@ bool AppWindow::display(const render::Orbit& orbit, render::Image* capture) {
   return *shown;
 }
 
-}  // namespace fire::cli
+}  // namespace fire::app

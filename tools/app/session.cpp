@@ -1,4 +1,4 @@
-#include "tools/fire/session.hpp"
+#include "tools/app/session.hpp"
 
 #include <cstdio>
 #include <cstdlib>

@@ -1,8 +1,8 @@
-#include "tools/fire/pad.hpp"
+#include "tools/app/pad.hpp"
 
 #include "platform/wiimote/protocol.hpp"
 
-namespace fire::cli {
+namespace fire::app {
 
 const std::array<PadBinding, 9>& pad_bindings() {
   using namespace wiimote;
@@ -47,4 +47,4 @@ std::optional<Vec3> last_curve_point(const EditHistory& history) {
   return drawn->points[drawn->points.size() / 2];
 }
 
-}  // namespace fire::cli
+}  // namespace fire::app

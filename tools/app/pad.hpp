@@ -14,7 +14,7 @@
 #include "engine/common.hpp"
 #include "systems/split/edit.hpp"
 
-namespace fire::cli {
+namespace fire::app {
 
 enum class PadAction : uint8_t { CloseBorder, Undo, Redo, DeleteLastCurve, SharpLastCurve, TouchMark, Register, PreviousMark, NextMark };
 
@@ -47,4 +47,4 @@ class PadPresses {
 // which pick the curve nearest a point; none when nothing drawn can be undone.
 std::optional<Vec3> last_curve_point(const EditHistory& history);
 
-}  // namespace fire::cli
+}  // namespace fire::app

@@ -14,8 +14,8 @@
 
 #include "platform/session_files.hpp"
 #include "platform/wiimote/log_writer.hpp"
-#include "tools/fire/session.hpp"
-#include "tools/fire/session_store.hpp"
+#include "tools/app/session.hpp"
+#include "tools/app/session_store.hpp"
 
 namespace fire {
 

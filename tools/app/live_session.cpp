@@ -1,4 +1,4 @@
-#include "tools/fire/live_session.hpp"
+#include "tools/app/live_session.hpp"
 
 #include <limits>
 

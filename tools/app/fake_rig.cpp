@@ -1,4 +1,4 @@
-#include "tools/fire/fake_rig.hpp"
+#include "tools/app/fake_rig.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,10 +9,10 @@
 #include "systems/synth/network_from_mesh.hpp"
 #include "engine/ir_report.hpp"
 #include "systems/tracking/simulate.hpp"
-#include "tools/fire/pad.hpp"
-#include "tools/fire/session_rig.hpp"
+#include "tools/app/pad.hpp"
+#include "tools/app/session_rig.hpp"
 
-namespace fire::cli {
+namespace fire::app {
 
 IrSlots SimulatedBlobs::at(int camera, int64_t t_ns) const {
   // Frames further apart than this are a gap (the pen unseen, a lost report): nothing to interpolate across.
@@ -161,4 +161,4 @@ void FakeRig::advance(int64_t ns, wiimote::Driver& driver, const std::function<v
   }
 }
 
-}  // namespace fire::cli
+}  // namespace fire::app

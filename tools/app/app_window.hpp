@@ -12,10 +12,10 @@
 #include "platform/render/present.hpp"
 #include "platform/window/hud.hpp"
 #include "platform/window/window.hpp"
-#include "tools/fire/session.hpp"
-#include "tools/fire/session_store.hpp"
+#include "tools/app/session.hpp"
+#include "tools/app/session_store.hpp"
 
-namespace fire::cli {
+namespace fire::app {
 
 // What the view frames: the curves, the surface and the reference mesh.
 render::Box scene_box(const Mesh& mesh, const SurfaceLevels& surface, std::span<const Vec3> reference);
@@ -103,4 +103,4 @@ class AppWindow {
   int64_t session_origin_us_ = 0;
 };
 
-}  // namespace fire::cli
+}  // namespace fire::app

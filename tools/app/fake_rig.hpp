@@ -14,7 +14,7 @@
 #include "platform/wiimote/driver.hpp"
 #include "platform/wiimote/fake_remote.hpp"
 
-namespace fire::cli {
+namespace fire::app {
 
 // What each camera of a simulated rig saw: the blobs of the simulator's camera reports in arrival order.
 struct SimulatedBlobs {
@@ -92,4 +92,4 @@ class FakeDrawingRig {
   std::string rig_json_, marks_json_;
 };
 
-}  // namespace fire::cli
+}  // namespace fire::app

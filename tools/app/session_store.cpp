@@ -1,11 +1,11 @@
-#include "tools/fire/session_store.hpp"
+#include "tools/app/session_store.hpp"
 
 #include <algorithm>
 #include <limits>
 #include <nlohmann/json.hpp>
 
 #include "platform/files.hpp"
-#include "tools/fire/session_rig.hpp"
+#include "tools/app/session_rig.hpp"
 
 namespace fire {
 

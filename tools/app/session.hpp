@@ -65,7 +65,7 @@ Scheduler make_scheduler(World& world, Scheduler::Clock clock);
 void begin_frame(World& world, uint64_t index, int64_t begin_us);
 // Called before each frame runs (its events not delivered yet) and after it (before the next one begins,
 // so the snapping index has synced with every write of the frame): the session writer's log appends and
-// snapshots (tools/fire/session_store.hpp).
+// snapshots (tools/app/session_store.hpp).
 struct ReplayHooks {
   std::function<void(World&)> before_frame;
   std::function<void(const World&)> after_frame;

@@ -12,7 +12,7 @@
 
 #include "engine/session_dir.hpp"
 #include "platform/session_files.hpp"
-#include "tools/fire/session.hpp"
+#include "tools/app/session.hpp"
 
 namespace fire {
 

@@ -1,4 +1,4 @@
-#include "tools/fire/calibrate_live.hpp"
+#include "tools/app/calibrate_live.hpp"
 
 #include <poll.h>
 #include <unistd.h>
@@ -17,10 +17,10 @@
 #include "systems/tracking/camera.hpp"
 #include "engine/ir_report.hpp"
 #include "systems/tracking/simulate.hpp"
-#include "tools/fire/fake_rig.hpp"
-#include "tools/fire/live_session.hpp"
+#include "tools/app/fake_rig.hpp"
+#include "tools/app/live_session.hpp"
 
-namespace fire::cli {
+namespace fire::app {
 
 namespace {
 
@@ -170,4 +170,4 @@ Result<std::vector<InputEvent>> record_live_wand(const LiveWandOptions& o) {
   return events;
 }
 
-}  // namespace fire::cli
+}  // namespace fire::app

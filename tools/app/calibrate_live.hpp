@@ -9,7 +9,7 @@
 
 #include "engine/input_log.hpp"
 
-namespace fire::cli {
+namespace fire::app {
 
 struct LiveWandOptions {
   std::string session_dir;  // a new session folder: the reports are recorded there as they arrive
@@ -27,4 +27,4 @@ struct LiveWandOptions {
 // failed: no folder, fewer than two cameras, a failed write.
 Result<std::vector<InputEvent>> record_live_wand(const LiveWandOptions& options);
 
-}  // namespace fire::cli
+}  // namespace fire::app

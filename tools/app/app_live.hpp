@@ -12,11 +12,11 @@
 #include "platform/clock.hpp"
 #include "platform/window/hud.hpp"
 #include "platform/wiimote/driver.hpp"
-#include "tools/fire/fake_rig.hpp"
-#include "tools/fire/live_session.hpp"
-#include "tools/fire/pad.hpp"
+#include "tools/app/fake_rig.hpp"
+#include "tools/app/live_session.hpp"
+#include "tools/app/pad.hpp"
 
-namespace fire::cli {
+namespace fire::app {
 
 struct AppLiveOptions {
   std::string rig_path;     // the rig file (fire calibrate): cameras and the remotes' roles
@@ -82,4 +82,4 @@ class AppLive {
   bool stopped_ = false;
 };
 
-}  // namespace fire::cli
+}  // namespace fire::app

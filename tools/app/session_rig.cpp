@@ -1,4 +1,4 @@
-#include "tools/fire/session_rig.hpp"
+#include "tools/app/session_rig.hpp"
 
 #include <algorithm>
 #include <cmath>

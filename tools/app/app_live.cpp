@@ -1,4 +1,4 @@
-#include "tools/fire/app_live.hpp"
+#include "tools/app/app_live.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -7,9 +7,9 @@
 #include "platform/wiimote/hidapi_backend.hpp"
 #include "platform/wiimote/roles.hpp"
 #include "engine/ir_report.hpp"
-#include "tools/fire/session_rig.hpp"
+#include "tools/app/session_rig.hpp"
 
-namespace fire::cli {
+namespace fire::app {
 
 namespace {
 
@@ -214,4 +214,4 @@ Status AppLive::finish() {
   return live_->finish();
 }
 
-}  // namespace fire::cli
+}  // namespace fire::app
