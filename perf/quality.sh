@@ -6,7 +6,8 @@
 # each surface with `fire eval` against the control mesh's limit surface and with perf/folds.py. Then the
 # demo dome (tools/demo/sketch.log), which has no ground truth: folds, faces facing down and how far its
 # curves lie from the surface. Then the simulated tracked drawing of the pawn (`fire simulate drawing` through the
-# simulated rig), measured against the pawn. Prints markdown tables for perf/RESULTS.md on stdout; progress on stderr.
+# simulated rig), measured against the pawn. Prints markdown tables for perf/notes/quality.md (and the rows of
+# perf/RESULTS.md) on stdout; progress on stderr.
 #
 # usage: perf/quality.sh [FIRE_BINARY]      (default: build/fire)
 # env:   BASELINE=FIRE    a fire binary built from the commit to compare times with (say, main before a

@@ -7,7 +7,7 @@
 # defaults (the accuracy scenario), and the nominal focal length 2 % wrong with camera 1's clock 5 ms
 # off. A second table changes one condition at a time beyond the scenario (seed 1, optimal method),
 # to show where the margins are; it does not count towards "All targets met".
-# The tables go to stdout (for perf/RESULTS.md), progress to stderr.
+# The tables go to stdout (for perf/notes/tracking.md and perf/RESULTS.md), progress to stderr.
 #
 # usage: perf/tracking_accuracy.sh [FIRE_BINARY]      (default: build/fire)
 # env:   SEEDS   space-separated seeds (default "1 2 3 4 5"); each seed is both --seed and --rig-seed

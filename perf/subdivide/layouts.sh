@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Benchmarks (a) and (b) against OpenSubdiv under several code layouts. OpenSubdiv's
 # StencilTable::UpdateValues is a template compiled into bench_subdivide, and its inner loop runs up to
-# 40 % faster or slower depending on where the loop lands (perf/RESULTS.md); ours barely moves. This
+# 40 % faster or slower depending on where the loop lands (perf/notes/subdivide.md); ours barely moves. This
 # builds the benchmark once per alignment setting, each in its own folder build-layout-NAME, runs each
 # RUNS times (interleaved, 11 repetitions), and prints the (a) and (b) columns as one Markdown table, so
 # that a ratio can be quoted against the peer's best layout.

@@ -22,7 +22,7 @@
 //   triangles are copied. Then, and when SurfaceLevels::frame is newer than the last frame uploaded, the
 //   vertices in SurfaceLevels::changed are converted to float and copied where they differ from what the
 //   block holds: a commit copies the triangles of the patches it changed and the vertices whose values
-//   moved (the limit fit moves most of them a little at every commit: perf/RESULTS.md).
+//   moved (the limit fit moves most of them a little at every commit: perf/notes/render.md).
 // Buffers are host-visible; growing one re-uploads its whole content (counted as well). The surface's
 // buffers grow by half again, and are laid out afresh when freed blocks outnumber the used ones.
 #include <cstdint>
@@ -42,8 +42,8 @@ namespace fire::render {
 struct RenderSettings {
   uint32_t width = 1280, height = 720;
   // Samples per pixel (1, 2, 4 or 8; the largest the device has, up to this). 0: the environment's
-  // FIRE_SAMPLES if set, else by device: 1 on a CPU device (lavapipe, where 4x costs 2.6 times the frame,
-  // perf/RESULTS.md), 4 on a GPU.
+  // FIRE_SAMPLES if set, else by device: 1 on a CPU device (lavapipe, where 4x samples cost much of the
+  // frame: perf/notes/render.md), 4 on a GPU.
   uint32_t samples = 0;
   // The colour format drawn in: the window's swapchain format for the present path (R8G8B8A8_SRGB or
   // B8G8R8A8_SRGB; image() returns RGBA either way).

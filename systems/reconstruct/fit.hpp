@@ -34,8 +34,8 @@
 //      a factor 6 per solve on smooth data) to a surface through every sample, which phase 2's creep
 //      does not reach (test_reconstruct's exact grid). The fit keeps phase 3's solution only if its
 //      fitted points lie closer to the polylines (sum of squared distances) than phase 2's.
-//   Without phase 2 the split points freeze where phase 1 left them (perf/RESULTS.md has the pawn's
-//   network_max with and without it).
+//   Without phase 2 the split points freeze where phase 1 left them (perf/notes/quality.md,
+//   "Reconstruction quality", has the pawn's network_max with and without it).
 // Each phase stops when no target moves more than `tolerance` times the base mesh's size.
 //
 // FitRun is the same fit a few back-substitutions at a time, for the frame (the subdivide system spreads
@@ -64,8 +64,8 @@ struct FitWeights {
   // per vertex of a quad whose aspect (quad_aspect) exceeds `shape_aspect`. The reconstruction scales
   // it with the curves' noise, as the fairness: the exact curves' fairness for exact curves, this at
   // kNoisyFairness (fit_weights in reconstruct.cpp).
-  // perf/RESULTS.md, "Thin quads keep their transfinite shape; the fairness follows the noise", has
-  // the sweeps.
+  // perf/notes/quality.md, "Thin quads keep their transfinite shape; the fairness follows the noise",
+  // has the sweeps.
   double shape = 0.1;
   double shape_aspect = 3;
   uint32_t slide_iterations = 10;  // solves of phase 1
@@ -75,7 +75,7 @@ struct FitWeights {
   double min_target_spacing = 0.3;
   size_t anderson_depth = 10;      // steps mixed in phase 2
   // Where the surface can follow its curves, the fairness that keeps it from folding where it cannot
-  // holds it off them (the pawn's collar against the rook's foot ring: perf/RESULTS.md). So after phase 2
+  // holds it off them (the pawn's collar against the rook's foot ring: perf/notes/quality.md). So after phase 2
   // the base vertices on which only network edges depend whose fitted points and polylines lie within
   // `followed_distance` (times the base mesh's size) of each other get `followed_fairness` on their
   // fairness rows, the fit is factored again, and phase 2 runs on with the solves left but

@@ -317,7 +317,7 @@ std::vector<Vec3> scaled_polyline(std::span<const Vec3> line, double scale) {
 // With noisy curves, an interior network vertex where just two curves meet is left out of the base mesh:
 // its two edges become one side of both its faces. Kept, it would be a base vertex of valence 2, and a
 // fit stiff enough for the noise pins that degenerate Catmull-Clark vertex to the turn the curve takes
-// there and pleats the two quads at it (the rook's battlement notches, perf/RESULTS.md). Exact curves
+// there and pleats the two quads at it (the rook's battlement notches, perf/notes/quality.md). Exact curves
 // keep it: the fit follows them closely, and a turn inside one side would fold it instead. Never where
 // a face would keep fewer than two corners, nor between edges of different sharpness.
 std::vector<uint8_t> joined_vertices(const Mesh& net, bool noisy) {
@@ -729,7 +729,7 @@ double curve_noise_deviation(const Options& options, double noise, double spread
 // The shape term comes with the noise too: noisy hand-drawn curves keep their thin quads' transfinite
 // shape. Exact curves are followed as drawn, so for them it weighs only as much as their fairness: the
 // full weight would cost the rook's exact network its rms goal, none lets a sliver's quads fold (the
-// rook K = 2 network's face 186; perf/RESULTS.md). An explicit --fairness has none.
+// rook K = 2 network's face 186; perf/notes/quality.md). An explicit --fairness has none.
 FitWeights fit_weights(const Options& options, double noise) {
   FitWeights weights;
   weights.fairness = fit_fairness(options, noise);

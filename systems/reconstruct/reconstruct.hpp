@@ -44,7 +44,7 @@ inline constexpr double kTangentReach = 0.15;
 // fire: a side more than this many times as long as the mean side of a face it borders is split into
 // twice the pieces, again while it is still so much longer, at most kMaxSideDoublings times: the face's
 // quads along it are then not stretched along the curve, and the fit has the base points to follow it
-// (the demo dome's longest curve; perf/RESULTS.md, "Long sides get more pieces"). The faces on either
+// (the demo dome's longest curve; perf/notes/quality.md, "Long sides get more pieces"). The faces on either
 // side then have polygons with the finer split points between their corners.
 inline constexpr double kLongSideRatio = 2.0;
 inline constexpr uint32_t kMaxSideDoublings = 2;
@@ -130,8 +130,9 @@ inline constexpr double kExactCurveNoise = 3e-4;
 // third differences of noise_estimate cannot see. 0 when fewer than kSpreadVertices vertices count.
 inline constexpr size_t kSpreadVertices = 4;
 double tangent_spread_deg(const Mesh& net);
-// Over this, curves that noise_estimate finds exact are not: the quality table's exact networks give at
-// most 0.6 degrees, its correlated-noise ones 3.8 or more (perf/RESULTS.md).
+// Over this, curves that noise_estimate finds exact are not: it lies between the spreads of the quality
+// table's exact networks and of its correlated-noise ones (perf/notes/quality.md, "Correlated noise seen
+// where curves meet").
 inline constexpr double kDisagreeingTangentsDeg = 2.0;
 // The noise the fit's fairness follows: noise_estimate, except for curves it finds exact whose tangents
 // disagree (tangent_spread_deg over kDisagreeingTangentsDeg), which count as noisy as the noise at which
@@ -141,12 +142,12 @@ double fit_noise(const Mesh& net);
 double fit_noise(double noise, double spread_deg);
 // The fairness noisy curves reach, and keep up to kNoisierCurves: on pawn, rook and torus at 1 to 4 % noise
 // and on the simulated tracked drawing it gives fewer folds and a smaller rms and hausdorff than 1e-3 or
-// 1e-2 (perf/RESULTS.md).
+// 1e-2 (perf/notes/quality.md, "Thin quads keep their transfinite shape; the fairness follows the noise").
 inline constexpr double kNoisyFairness = 0.1;
-// Above this noise estimate (4 % noise per sample gives 1.8e-2 to 2.3e-2) the fairness grows again with
-// the square of the noise: it keeps the pawn at 4 % from folding and the rook from folding as much, while
-// the torus at 1 and 2 % (6.3e-3, 1.2e-2), whose big faces have no curve inside and flatten under more,
-// stays at kNoisyFairness (perf/RESULTS.md).
+// Above this noise estimate (chosen by a sweep over the noisy networks' estimates) the fairness grows again
+// with the square of the noise: it keeps the pawn at 4 % from folding and the rook from folding as much,
+// while the torus at 1 and 2 %, whose big faces have no curve inside and flatten under more, stays at
+// kNoisyFairness (perf/notes/quality.md, "The fairness grows again above 4 % noise").
 inline constexpr double kNoisierCurves = 1.3e-2;
 inline constexpr double kNoisiestFairness = 1.0;  // the top of --fairness's range
 // The fairness the fit uses for a network whose noise_estimate is `noise`: Options::fairness for exact
@@ -156,7 +157,8 @@ double fit_fairness(const Options& options, double noise);
 // How the fit reads the polylines between their samples for that noise: smooth for exact curves (their
 // samples lie on a smooth curve, inside whose bends the chords cut by about the network_max goal),
 // linear above kExactCurveNoise (a cubic through noisy samples swings past them, and the surface folds;
-// perf/RESULTS.md). An explicit --fairness estimates no noise, so it reads them smooth.
+// perf/notes/quality.md, "Exact curves are read on the smooth curve through their samples"). An explicit
+// --fairness estimates no noise, so it reads them smooth.
 Sampling fit_targets(double noise);
 // A noisy curve reaching less far than kShortCurveNoises noise deviations from its ends is short: its shape
 // is mostly the noise's. The deviation is the larger of fit_noise and the sideways step of a curve turned
@@ -164,8 +166,9 @@ Sampling fit_targets(double noise);
 // measure), times the mean polyline length; none for exact curves or an explicit --fairness. The surface
 // takes a short curve as its chord plus a part of its departure from the chord, none below
 // kChordCurveNoises deviations, growing linearly to all of it. The rook's noisy folds were
-// nearly all at its 1.3 mm hole, whose curves reach 1 to 3 deviations at 1 to 4 % noise and whose
-// scribbles crossed their neighbours; the torus's shortest curves reach 9 (perf/RESULTS.md). The drawn
+// nearly all at the small hole in its bottom, whose curves reach only a few deviations and whose
+// scribbles crossed their neighbours, while the torus's shortest curves reach more than kShortCurveNoises
+// (perf/notes/quality.md, "Short noisy curves taken nearer their chords"). The drawn
 // curves stay as drawn: only the surface's polylines (the refine stage's edge splits) change.
 inline constexpr double kChordCurveNoises = 3;
 inline constexpr double kShortCurveNoises = 6;

@@ -34,7 +34,7 @@ void blend_ends(std::vector<Vec3>& stroke, const Vec3& start, const Vec3& end, d
 // `end` (searched in the half of the stroke next to that end): a pen pauses when it is put down and lifted, and
 // the samples of a pause wander within the tracking error while the stroke's length grows. Left in, a curve
 // spends part of its length on the spot, and the surface, whose rows follow the curves by length, is crumpled
-// where several such curves meet (the simulated drawing's pole, perf/RESULTS.md). The end samples stay, for
+// where several such curves meet (the simulated drawing's pole, perf/notes/quality.md). The end samples stay, for
 // blend_ends to move onto the ends.
 void drop_pauses(std::vector<Vec3>& stroke, const Vec3& start, double start_radius, const Vec3& end, double end_radius) {
   const size_t n = stroke.size(), half = n / 2;

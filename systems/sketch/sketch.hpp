@@ -33,7 +33,7 @@ struct SketchSettings {
 };
 
 // For a pen tracked by the rig: vertex_snap (metres), a few times the tracked pen's error at rest, and
-// blend_reach. Measured on the simulated drawing in perf/RESULTS.md.
+// blend_reach. Measured on the simulated drawing in perf/notes/drawing.md.
 inline constexpr double kTrackedVertexSnap = 0.003;
 inline constexpr double kTrackedBlendReach = 1.0 / 3;
 

@@ -1,7 +1,7 @@
 // Evaluation: regular patches straight from their 4x4 base points where the refinement has them, and
 // level by level elsewhere, each level's stencils applied straight from its index arrays, the weights
 // following from the vertex rule and valence. Against explicit (source, weight) rows this reads no
-// weights and gathers each parent point fewer times; perf/RESULTS.md has the measurements. Also the
+// weights and gathers each parent point fewer times; perf/notes/subdivide.md has the measurements. Also the
 // one-call subdivide().
 #include <algorithm>
 #include <cstring>

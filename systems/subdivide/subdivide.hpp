@@ -12,7 +12,7 @@
 // evaluate() applies them level by level, so moving the base points re-evaluates every level without
 // touching topology. stencil_table() writes the same stencils out as explicit (source, weight) rows and
 // factorize() composes them into last-level-from-base rows (for solvers that need the matrix); applying
-// those is slower than evaluate() (perf/RESULTS.md has the figures).
+// those is slower than evaluate() (perf/notes/subdivide.md has the figures).
 //
 // Child components follow OpenSubdiv's uniform ordering (Vtr::Refinement with
 // orderVerticesFromFacesFirst = false), so level l of a Refinement has the same vertex, edge and
@@ -116,7 +116,7 @@ inline constexpr int kMaxRefinementLevels = 10;
 //
 // Where a refinement has regular patches, its last level is numbered in the order evaluate() writes
 // it, so that every write is sequential (with OpenSubdiv's numbering the points of one patch are spread
-// over the whole level, and those scattered writes cost more than the arithmetic; perf/RESULTS.md):
+// over the whole level, and those scattered writes cost more than the arithmetic; perf/notes/subdivide.md):
 // patch after patch, each patch's grid points row by row, leaving out the points on its sides and
 // corners that an earlier patch has; then the points only the rest mesh has, in rest_sources order.
 inline constexpr int kMinPatchLevels = 3, kMaxPatchLevels = 6;

@@ -225,7 +225,7 @@ TimeOffsetEstimate search_time_offset(std::span<const MovingBlob> moving, const 
 struct PenTrackOptions {
   TriangulationMethod method = TriangulationMethod::Optimal;
   double max_reprojection_px = 2.0;
-  // Tuned on the simulated rig (perf/RESULTS.md): the static error falls, the error at 0.5 m/s
+  // Tuned on the simulated rig (perf/notes/tracking.md): the static error falls, the error at 0.5 m/s
   // grows by a few tenths of a millimetre of lag.
   OneEuroParams filter{.min_cutoff_hz = 1.0, .beta = 300.0, .derivative_cutoff_hz = 2.0};
   // The pen stays down through losses of the LED by both cameras up to max_gap_us (a hand or the object

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The live path's accuracy on the simulated rig against the batch tracker it replaced (perf/RESULTS.md,
+# The live path's accuracy on the simulated rig against the batch tracker it replaced (perf/notes/tracking.md,
 # "Tracking accuracy", defaults, seed 1, optimal: static_rms_mm 0.340, dynamic_rms_mm 0.978, 12 strokes,
 # measured 2026-11-24 with the whole-log frame clock and time offset): fire track now runs the
 # triangulation system frame by frame, and must stay within 5 % of those figures.
