@@ -13,6 +13,8 @@
 namespace fire {
 
 inline constexpr int kIrSlots = 4;
+// A Wii Remote streams its reports at 100 Hz (measured 98.3 +- 4.0 Hz: shared/wiimote-protocol.md).
+inline constexpr int64_t kReportPeriodUs = 10'000;
 // Report lengths including the report id byte.
 inline constexpr size_t kReport33Size = 18;  // id, 2 buttons, 3 accelerometer, 4 x 3 IR
 inline constexpr size_t kReport36Size = 22;  // id, 2 buttons, 10 IR, 9 extension

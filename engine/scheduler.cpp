@@ -41,19 +41,19 @@ Result<Scheduler> Scheduler::build(std::vector<SystemSpec> systems, Clock clock)
   for (size_t i = 0; i < systems.size(); ++i) {
     const SystemSpec& s = systems[i];
     for (size_t j = 0; j < i; ++j)
-      if (systems[j].name == s.name) return Result<Scheduler>::failure("two systems are named '" + s.name + "'");
-    for (const std::string& data : s.reads) {
+      if (systems[j].name() == s.name()) return Result<Scheduler>::failure("two systems are named '" + s.name() + "'");
+    for (const std::string& data : s.reads()) {
       for (size_t j = i + 1; j < systems.size(); ++j)
-        if (contains(systems[j].writes, data))
-          return Result<Scheduler>::failure("system '" + s.name + "' reads '" + data + "', which the later system '" +
-                                            systems[j].name +
+        if (contains(systems[j].writes(), data))
+          return Result<Scheduler>::failure("system '" + s.name() + "' reads '" + data + "', which the later system '" +
+                                            systems[j].name() +
                                             "' writes; run it after, or declare it a read of the previous frame");
     }
-    for (const std::string& data : s.reads_previous_frame) {
+    for (const std::string& data : s.reads_previous_frame()) {
       bool written_later = false;
-      for (size_t j = i + 1; j < systems.size(); ++j) written_later = written_later || contains(systems[j].writes, data);
+      for (size_t j = i + 1; j < systems.size(); ++j) written_later = written_later || contains(systems[j].writes(), data);
       if (!written_later)
-        return Result<Scheduler>::failure("system '" + s.name + "' declares a previous-frame read of '" + data +
+        return Result<Scheduler>::failure("system '" + s.name() + "' declares a previous-frame read of '" + data +
                                           "', but no later system writes it");
     }
   }
@@ -63,7 +63,7 @@ Result<Scheduler> Scheduler::build(std::vector<SystemSpec> systems, Clock clock)
 Scheduler::Scheduler(std::vector<SystemSpec> systems, Clock clock) : systems_(std::move(systems)), clock_(clock) {
   for (const SystemSpec& s : systems_) {
     SystemTiming& t = timings_.emplace_back();
-    t.name = s.name;
+    t.name = s.name();
   }
 }
 
@@ -81,9 +81,9 @@ void Scheduler::run_frame() {
 std::string Scheduler::describe() const {
   std::string out;
   for (const SystemSpec& s : systems_) {
-    out += s.name + ": reads " + joined(s.reads);
-    if (!s.reads_previous_frame.empty()) out += "; reads last frame's " + joined(s.reads_previous_frame);
-    out += "; writes " + joined(s.writes) + "\n";
+    out += s.name() + ": reads " + joined(s.reads());
+    if (!s.reads_previous_frame().empty()) out += "; reads last frame's " + joined(s.reads_previous_frame());
+    out += "; writes " + joined(s.writes()) + "\n";
   }
   return out;
 }

@@ -2,18 +2,26 @@
 // The frame scheduler: runs the systems in their declared order once per fixed time step and records
 // how long each took. Timing uses a clock handed in by platform/; systems themselves never see it.
 //
-// Each system is declared with what it reads and writes, by the name of a piece of world data. The
-// order is checked when the schedule is built: a system may not read what a later system writes in the
-// same frame, unless it declares that it reads the previous frame's value (sketch snaps against the mesh
-// that split left last frame). Reads of data no system writes are inputs from outside the frame.
+// A system is declared with the members of the world it takes, by member pointer (declare_system):
+// Read<&World::m> hands it `const T&`, Write<&World::m> `T&`, and ReadPrevious<&World::m> `const T&` to
+// what a later system writes in the frame, as the previous frame left it (sketch snaps against the mesh
+// that split left last frame). Its function captures nothing, so it reaches only what it declared; a
+// function whose parameters do not match the declaration does not compile. The order is checked when the
+// schedule is built: a system may not read what a later system writes in the same frame unless it declares
+// the read as the previous frame's. Reads of members no system writes are inputs from outside the frame.
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "engine/common.hpp"
 
 namespace fire {
+
+// The frame step: 100 Hz, the Wii Remote's report rate.
+inline constexpr int64_t kFrameStepUs = 10'000;
 
 // The fixed step a frame covers on the input log's clock.
 struct FrameTime {
@@ -22,13 +30,97 @@ struct FrameTime {
   int64_t end_us = 0;
 };
 
-struct SystemSpec {
-  std::string name;
-  std::vector<std::string> reads;
-  std::vector<std::string> writes;
-  std::vector<std::string> reads_previous_frame;  // written later in the frame; this system sees last frame's
-  std::function<void()> run;
+// What a system takes from the world, by member pointer.
+template <auto Member> struct Read {};
+template <auto Member> struct Write {};
+template <auto Member> struct ReadPrevious {};
+
+// The name a member pointer's member has in its class ("mesh" for &World::mesh), as the compiler spells it.
+template <auto Member>
+std::string member_name() {
+  const std::string_view signature = __PRETTY_FUNCTION__;  // "... [with auto Member = &fire::World::mesh; ...]"
+  const size_t at = signature.find("Member = ");
+  std::string_view name = signature.substr(at == std::string_view::npos ? 0 : at);
+  name = name.substr(0, name.find_first_of(";]"));
+  return std::string(name.substr(name.rfind("::") + 2));
+}
+
+class SystemSpec {
+ public:
+  const std::string& name() const { return name_; }
+  const std::vector<std::string>& reads() const { return reads_; }
+  const std::vector<std::string>& writes() const { return writes_; }
+  // Written later in the frame: this system sees the previous frame's value.
+  const std::vector<std::string>& reads_previous_frame() const { return reads_previous_frame_; }
+  void run() const { run_(); }
+
+ private:
+  template <class... Access>
+  friend SystemSpec declared(std::string name, std::function<void()> run);
+  SystemSpec(std::string name, std::function<void()> run) : name_(std::move(name)), run_(std::move(run)) {}
+  std::string name_;
+  std::vector<std::string> reads_, writes_, reads_previous_frame_;
+  std::function<void()> run_;
 };
+
+namespace scheduling {
+
+template <class Access> struct Take;
+template <auto M> struct Take<Read<M>> {
+  template <class World> static const auto& from(World& w) { return w.*M; }
+  static void declare(std::vector<std::string>& reads, std::vector<std::string>&, std::vector<std::string>&) {
+    reads.push_back(member_name<M>());
+  }
+};
+template <auto M> struct Take<Write<M>> {
+  template <class World> static auto& from(World& w) { return w.*M; }
+  static void declare(std::vector<std::string>&, std::vector<std::string>& writes, std::vector<std::string>&) {
+    writes.push_back(member_name<M>());
+  }
+};
+template <auto M> struct Take<ReadPrevious<M>> {
+  template <class World> static const auto& from(World& w) { return w.*M; }
+  static void declare(std::vector<std::string>&, std::vector<std::string>&, std::vector<std::string>& previous) {
+    previous.push_back(member_name<M>());
+  }
+};
+
+}  // namespace scheduling
+
+// A system's function as a plain function pointer, which a lambda converts to only when it captures
+// nothing and takes exactly the parameters given.
+template <class Function, class Fn>
+Function system_function(Fn fn) {
+  static_assert(std::is_convertible_v<Fn, Function>,
+                "a system's function captures nothing and takes exactly its declared members: const T& for Read and "
+                "ReadPrevious, T& for Write, in declaration order");
+  return fn;
+}
+
+// The spec of a system whose function `run` reaches the members `Access` names.
+template <class... Access>
+SystemSpec declared(std::string name, std::function<void()> run) {
+  SystemSpec spec(std::move(name), std::move(run));
+  (scheduling::Take<Access>::declare(spec.reads_, spec.writes_, spec.reads_previous_frame_), ...);
+  return spec;
+}
+
+// Declares system `name` over `world`: `fn` is called every frame with each declared member in
+// declaration order (const T& for Read and ReadPrevious, T& for Write).
+template <class... Access, class World, class Fn>
+SystemSpec declare_system(World& world, std::string name, Fn fn) {
+  const auto call = system_function<void (*)(decltype(scheduling::Take<Access>::from(world))...)>(fn);
+  return declared<Access...>(std::move(name), [&world, call] { call(scheduling::Take<Access>::from(world)...); });
+}
+
+// The same for an observer that keeps state outside the world (a test's probe, the pictures of `fire render
+// --every`): `fn` takes `context` first.
+template <class... Access, class World, class Context, class Fn>
+SystemSpec declare_system(World& world, std::string name, Context& context, Fn fn) {
+  const auto call = system_function<void (*)(Context&, decltype(scheduling::Take<Access>::from(world))...)>(fn);
+  return declared<Access...>(std::move(name),
+                             [&world, &context, call] { call(context, scheduling::Take<Access>::from(world)...); });
+}
 
 // Samples a timing keeps: the app runs 100 frames a second for as long as a session lasts, so keeping
 // every one would grow without bound (an int64 a frame for each system and one for the whole frame: at 100
@@ -63,7 +155,8 @@ class Scheduler {
   const SystemTiming& frame_timing() const { return frame_timing_; }
   uint64_t frames() const { return frames_; }
   const std::vector<SystemSpec>& systems() const { return systems_; }
-  // One line per system: its name, reads and writes.
+  // The frame: one line per system, in order, with what it reads (this frame's and the previous frame's)
+  // and writes.
   std::string describe() const;
 
  private:

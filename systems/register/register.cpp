@@ -112,50 +112,55 @@ void release(RegistrationState& s, std::vector<InputEvent>& out) {
   s.held.clear();
 }
 
+// What one event of the frame does: see register_system.
+void take(const InputEvent& e, bool tracked, RegistrationState& s, std::vector<InputEvent>& out,
+          std::vector<Rejection>& rejections) {
+  const bool registering = e.kind == EventKind::Command && (e.command == CommandKind::Mark || e.command == CommandKind::Register);
+  if (registering && !tracked) {
+    rejections.push_back({e.t_us, e.line, std::string(e.command == CommandKind::Mark ? "mark" : "register") +
+                                            ": registration needs a tracked pen (a log of device reports, replayed with --rig)"});
+  } else if (registering) {
+    if (e.command == CommandKind::Mark)
+      touch_mark(e, s, rejections);
+    else
+      register_marks(e, s, rejections);
+  } else if (e.kind == EventKind::Hid || e.kind == EventKind::Truth || e.kind == EventKind::Meta) {
+    // the triangulation system's, or not for replay
+  } else if (!tracked || e.kind == EventKind::Command) {
+    out.push_back(e);
+  } else if (e.kind == EventKind::Pen) {
+    s.recent.emplace_back(e.t_us, e.p);
+    const int64_t oldest = e.t_us - kRestWindowUs;
+    std::erase_if(s.recent, [&](const auto& r) { return r.first <= oldest; });
+    if (!s.stroke_open || s.stroke_released) {
+      out.push_back(e);
+      out.back().p = mapped(s, e.p);
+      return;
+    }
+    const bool left = s.held.size() >= 2 && (e.p - s.held[1].p).norm() > kTouchRadius;  // held[0] is the Down
+    s.held.push_back(e);
+    if (left) release(s, out);
+  } else if (e.kind == EventKind::Down) {
+    s.stroke_open = true;
+    s.stroke_released = false;
+    s.held.assign(1, e);
+  } else {  // Up
+    if (s.stroke_open && !s.stroke_released)
+      ++s.touches_dropped;  // the pen never left its first sample's neighbourhood: a touch, not a curve
+    else
+      out.push_back(e);
+    s.stroke_open = s.stroke_released = false;
+    s.held.clear();
+  }
+}
+
 }  // namespace
 
-void register_system(const std::vector<InputEvent>& frame_events, bool tracked, RegistrationState& s,
-                     std::vector<InputEvent>& out, std::vector<Rejection>& rejections) {
+void register_system(const std::vector<InputEvent>& frame_events, const std::vector<InputEvent>& pen_events, bool tracked,
+                     RegistrationState& s, std::vector<InputEvent>& out, std::vector<Rejection>& rejections) {
   out.clear();
-  for (const InputEvent& e : frame_events) {
-    const bool registering = e.kind == EventKind::Command && (e.command == CommandKind::Mark || e.command == CommandKind::Register);
-    if (registering && !tracked) {
-        rejections.push_back({e.t_us, e.line, std::string(e.command == CommandKind::Mark ? "mark" : "register") +
-                                                ": registration needs a tracked pen (a log of device reports, replayed with --rig)"});
-    } else if (registering) {
-      if (e.command == CommandKind::Mark)
-        touch_mark(e, s, rejections);
-      else
-        register_marks(e, s, rejections);
-    } else if (e.kind == EventKind::Hid || e.kind == EventKind::Truth || e.kind == EventKind::Meta) {
-      // the triangulation system's, or not for replay
-    } else if (!tracked || e.kind == EventKind::Command) {
-      out.push_back(e);
-    } else if (e.kind == EventKind::Pen) {
-      s.recent.emplace_back(e.t_us, e.p);
-      const int64_t oldest = e.t_us - kRestWindowUs;
-      std::erase_if(s.recent, [&](const auto& r) { return r.first <= oldest; });
-      if (!s.stroke_open || s.stroke_released) {
-        out.push_back(e);
-        out.back().p = mapped(s, e.p);
-        continue;
-      }
-      const bool left = s.held.size() >= 2 && (e.p - s.held[1].p).norm() > kTouchRadius;  // held[0] is the Down
-      s.held.push_back(e);
-      if (left) release(s, out);
-    } else if (e.kind == EventKind::Down) {
-      s.stroke_open = true;
-      s.stroke_released = false;
-      s.held.assign(1, e);
-    } else {  // Up
-      if (s.stroke_open && !s.stroke_released)
-        ++s.touches_dropped;  // the pen never left its first sample's neighbourhood: a touch, not a curve
-      else
-        out.push_back(e);
-      s.stroke_open = s.stroke_released = false;
-      s.held.clear();
-    }
-  }
+  for (const InputEvent& e : frame_events) take(e, tracked, s, out, rejections);
+  for (const InputEvent& e : pen_events) take(e, tracked, s, out, rejections);
 }
 
 std::vector<std::string> describe_registration(const RegistrationState& s) {

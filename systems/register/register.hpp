@@ -56,11 +56,13 @@ struct RegistrationState {
 };
 
 // Writes to `object_events` (cleared first) what the person did in the frame, for the sketch system: the pen's
-// events, in the object's frame, and the commands other than mark and register, which it takes. `tracked`: the
-// pen comes from the rig (device reports); without it the pen is in the model's frame already, the events pass
-// unchanged and mark and register are rejected. A rejected command is appended to `rejections`.
-void register_system(const std::vector<InputEvent>& frame_events, bool tracked, RegistrationState& state,
-                     std::vector<InputEvent>& object_events, std::vector<Rejection>& rejections);
+// events, in the object's frame, and the commands other than mark and register, which it takes. The frame's
+// events are read first, then the pen's events the triangulation system made of them (`pen_events`, empty
+// without a rig). `tracked`: the pen comes from the rig (device reports); without it the pen is in the
+// model's frame already, the events pass unchanged and mark and register are rejected. A rejected command is
+// appended to `rejections`.
+void register_system(const std::vector<InputEvent>& frame_events, const std::vector<InputEvent>& pen_events, bool tracked,
+                     RegistrationState& state, std::vector<InputEvent>& object_events, std::vector<Rejection>& rejections);
 
 // What the registrations so far amount to, one sentence each (for fire replay).
 std::vector<std::string> describe_registration(const RegistrationState& state);

@@ -269,7 +269,7 @@ DeviceStreams decode_device_streams(std::span<const InputEvent> events) {
 
 namespace {
 
-constexpr double kNominalPeriodUs = 10'000;  // the remotes report at 100 Hz
+constexpr double kNominalPeriodUs = kReportPeriodUs;
 constexpr double kRateReports = 200;         // settled reports after which their own rate replaces the nominal one
 constexpr size_t kClockWindow = 400;         // trailing reports the line's position comes from (4 s)
 constexpr int kMaxLostInARow = 3;

@@ -12,7 +12,7 @@ using tracking::CameraReport;
 using tracking::Interpolated;
 using tracking::PenSample;
 
-constexpr double kNominalPeriodUs = 10'000;  // the remotes report at 100 Hz; the gaps say it better once seen
+constexpr double kNominalPeriodUs = kReportPeriodUs;  // the gaps say it better once seen
 constexpr size_t kPeriodGaps = 63;           // arrival gaps the period is the median of
 constexpr size_t kMinPeriodGaps = 8;
 constexpr double kRateTolerance = 1.25;        // a report rate outside 80 to 125 Hz is said in words
@@ -525,30 +525,28 @@ std::vector<std::string> describe_device_problems(const TriangulateState& s) {
   return out;
 }
 
-void triangulate_system(const FrameTime& frame, const TrackingRig& rig, TriangulateState& state,
-                        std::vector<InputEvent>& frame_events, std::vector<PenSample>* samples) {
-  const size_t logged = frame_events.size();
-  for (size_t i = 0; i < logged; ++i)
-    if (const std::optional<CameraReport> r = state.decoder.read(frame_events[i])) triangulate_report(rig, state, *r);
-  triangulate_advance(frame.end_us, rig, state, frame_events, samples);
+void triangulate_system(const FrameTime& frame, const TrackingRig& rig, const std::vector<InputEvent>& frame_events,
+                        TriangulateState& state, std::vector<InputEvent>& pen_events, std::vector<PenSample>* samples) {
+  pen_events.clear();
+  for (const InputEvent& e : frame_events)
+    if (const std::optional<CameraReport> r = state.decoder.read(e)) triangulate_report(rig, state, *r);
+  triangulate_advance(frame.end_us, rig, state, pen_events, samples);
 }
 
 std::vector<InputEvent> track_log(std::span<const InputEvent> events, const TrackingRig& rig, tracking::PenTrack& track,
                                   TriangulateState* final_state) {
-  constexpr int64_t kStepUs = 10'000;
   TriangulateState state;
-  std::vector<InputEvent> out, frame_events;
+  std::vector<InputEvent> out, frame_events, pen_events;
   track.samples.clear();
   if (events.empty()) return out;
-  FrameTime frame{0, events.front().t_us, events.front().t_us + kStepUs};
+  FrameTime frame{0, events.front().t_us, events.front().t_us + kFrameStepUs};
   size_t next = 0;
   while (next < events.size() || state.busy()) {
     frame_events.clear();
     while (next < events.size() && events[next].t_us < frame.end_us) frame_events.push_back(events[next++]);
-    const size_t logged = frame_events.size();
-    triangulate_system(frame, rig, state, frame_events, &track.samples);
-    out.insert(out.end(), frame_events.begin() + static_cast<std::ptrdiff_t>(logged), frame_events.end());
-    frame = {frame.index + 1, frame.end_us, frame.end_us + kStepUs};
+    triangulate_system(frame, rig, frame_events, state, pen_events, &track.samples);
+    out.insert(out.end(), pen_events.begin(), pen_events.end());
+    frame = {frame.index + 1, frame.end_us, frame.end_us + kFrameStepUs};
   }
   static_cast<tracking::PenCounts&>(track) = state.counts;
   if (final_state) *final_state = std::move(state);

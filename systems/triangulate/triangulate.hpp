@@ -46,7 +46,7 @@ struct CameraWindow {
   std::deque<tracking::CameraReport> waiting;
   // Frame clock: recent arrival gaps (for the period and the timeouts), the frame numbering.
   std::deque<double> gaps_us;
-  double period_us = 10'000;                  // their median once there are 8 (the nominal 100 Hz before)
+  double period_us = kReportPeriodUs;                // their median once there are 8 (the nominal 100 Hz before)
   int64_t origin_us = 0;                      // arrival time of the camera's first report
   tracking::FrameNumbering clock;             // on arrivals since origin_us
   int64_t last_arrival_us = 0;
@@ -90,11 +90,13 @@ struct TriangulateState {
   bool busy() const;
 };
 
-// Reads the frame's `hid` and `meta device` events from `frame_events` and appends the pen's Down, Pen and
-// Up events (filtered positions, the rig's frame, metres) to it, each stamped with its sample's instant.
-// `samples`, when given, receives every pen sample too (what `fire track --truth` measures).
-void triangulate_system(const FrameTime& frame, const TrackingRig& rig, TriangulateState& state,
-                        std::vector<InputEvent>& frame_events, std::vector<tracking::PenSample>* samples = nullptr);
+// Reads the frame's `hid` and `meta device` events from `frame_events` and writes to `pen_events` (cleared
+// first) the pen's Down, Pen and Up events (filtered positions, the rig's frame, metres), each stamped with
+// its sample's instant. `samples`, when given, receives every pen sample too (what `fire track --truth`
+// measures).
+void triangulate_system(const FrameTime& frame, const TrackingRig& rig, const std::vector<InputEvent>& frame_events,
+                        TriangulateState& state, std::vector<InputEvent>& pen_events,
+                        std::vector<tracking::PenSample>* samples = nullptr);
 
 // For snapshots (engine/SESSION.md): every field, so a reopened session triangulates its log's tail as the
 // run that wrote the snapshot would have. Loading fails on a state that cannot be (sizes that disagree).

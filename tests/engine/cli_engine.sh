@@ -79,5 +79,12 @@ sed -i '5s/pen/pne/' "$tmp/torn/input.log"
 expect_error "corruption before the last line is refused" "input.log:5: unknown event kind 'pne'" "$fire" open "$tmp/torn"
 rm "$tmp/torn/settings.json"
 expect_error "a session without settings" "settings.json: cannot open" "$fire" open "$tmp/torn"
+# The frame as the README shows it is the frame the code declares.
+awk '/^<!-- fire replay --schedule -->$/ { marked = 1; next } marked && /^```$/ { if (inside) exit; inside = 1; next } inside' \
+  "$src/README.md" >"$tmp/readme_schedule"
+"$fire" replay --schedule >"$tmp/schedule"
+check "fire replay --schedule prints the frame the README shows" "[ -s '$tmp/schedule' ] && cmp -s '$tmp/schedule' '$tmp/readme_schedule'"
+check "the frame names every system in order" "[ \"\$(cut -d: -f1 '$tmp/schedule' | tr '\\n' ' ')\" = 'input triangulate register sketch split refine subdivide snap ' ]"
+expect_error "fire replay without LOG says it is needed" "LOG is required" "$fire" replay
 expect_error "unknown subcommand" "" "$fire" frobnicate
 exit $fail

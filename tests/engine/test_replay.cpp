@@ -1,6 +1,7 @@
 // Replaying a log through the frame systems: deterministic, and bad strokes rejected without loss.
 #include <catch2/catch.hpp>
 
+#include <functional>
 #include <map>
 
 #include "systems/split/split_system.hpp"
@@ -203,16 +204,22 @@ TEST_CASE("the demo log exercises every split case, an undo, a redo and a delete
     return end.point == 0 || end.point + 1 == count ? std::string("vertex") : std::string("edge");
   };
   std::vector<SystemSpec> systems = session_systems(*w);
-  REQUIRE(systems[3].name == "sketch");
-  systems.insert(systems.begin() + 4, SystemSpec{"probe", {"requests"}, {}, {"mesh"}, [&] {
-                                                   for (const EditRequest& r : w->requests) {
-                                                     if (r.kind == RequestKind::Undo) ++seen["undo"];
-                                                     else if (r.kind == RequestKind::Redo) ++seen["redo"];
-                                                     else if (r.command.kind == EditKind::DeleteCurve) ++seen["delete"];
-                                                     else if (r.command.kind == EditKind::SplitFace)
-                                                       ++seen[end_kind(r.command.start) + "-" + end_kind(r.command.end)];
-                                                   }
-                                                 }});
+  REQUIRE(systems[3].name() == "sketch");
+  struct Probe {
+    std::map<std::string, int>& seen;
+    std::function<std::string(const CurveEnd&)> end_kind;
+  } probe{seen, end_kind};
+  systems.insert(systems.begin() + 4,
+                 declare_system<Read<&World::requests>, ReadPrevious<&World::mesh>>(
+                     *w, "probe", probe, [](Probe& p, const std::vector<EditRequest>& requests, const Mesh&) {
+                       for (const EditRequest& r : requests) {
+                         if (r.kind == RequestKind::Undo) ++p.seen["undo"];
+                         else if (r.kind == RequestKind::Redo) ++p.seen["redo"];
+                         else if (r.command.kind == EditKind::DeleteCurve) ++p.seen["delete"];
+                         else if (r.command.kind == EditKind::SplitFace)
+                           ++p.seen[p.end_kind(r.command.start) + "-" + p.end_kind(r.command.end)];
+                       }
+                     }));
   auto s = Scheduler::build(std::move(systems), fake_clock);
   REQUIRE(s.ok());
   w->build_surface = false;
@@ -224,49 +231,105 @@ TEST_CASE("the demo log exercises every split case, an undo, a redo and a delete
   }
 }
 
+namespace {
+
+// A world of three members, two of one type, for the scheduler's own cases.
+struct Toy {
+  int mesh = 0;
+  int requests = 0;
+  double surface = 0;
+};
+
+SystemSpec toy_sketch(Toy& t) {
+  return declare_system<Read<&Toy::mesh>, Write<&Toy::requests>>(t, "sketch", [](const int& mesh, int& requests) {
+    requests = mesh + 1;
+  });
+}
+SystemSpec toy_split(Toy& t) {
+  return declare_system<Read<&Toy::requests>, Write<&Toy::mesh>>(t, "split", [](const int& requests, int& mesh) {
+    mesh = requests;
+  });
+}
+
+}  // namespace
+
 TEST_CASE("the scheduler refuses a read of what a later system writes, unless it reads the previous frame",
           "[scheduler]") {
-  auto noop = [] {};
-  auto refused = Scheduler::build({{"sketch", {"mesh"}, {"requests"}, {}, noop}, {"split", {"requests"}, {"mesh"}, {}, noop}},
-                                  fake_clock);
+  Toy t;
+  std::vector<SystemSpec> systems;
+  systems.push_back(toy_sketch(t));
+  systems.push_back(toy_split(t));
+  auto refused = Scheduler::build(std::move(systems), fake_clock);
   REQUIRE_FALSE(refused.ok());
   CHECK_THAT(refused.error(), Catch::Contains("'sketch' reads 'mesh'") && Catch::Contains("'split'"));
-  auto declared = Scheduler::build(
-      {{"sketch", {}, {"requests"}, {"mesh"}, noop}, {"split", {"requests"}, {"mesh"}, {}, noop}}, fake_clock);
-  CHECK(declared.ok());
-  auto stale = Scheduler::build({{"sketch", {}, {"requests"}, {"surface"}, noop}, {"split", {"requests"}, {"mesh"}, {}, noop}},
-                                fake_clock);
-  REQUIRE_FALSE(stale.ok());
-  CHECK_THAT(stale.error(), Catch::Contains("no later system writes it"));
-  auto twice = Scheduler::build({{"a", {}, {}, {}, noop}, {"a", {}, {}, {}, noop}}, fake_clock);
-  CHECK_FALSE(twice.ok());
+
+  std::vector<SystemSpec> previous;
+  previous.push_back(declare_system<ReadPrevious<&Toy::mesh>, Write<&Toy::requests>>(
+      t, "sketch", [](const int& mesh, int& requests) { requests = mesh + 1; }));
+  previous.push_back(toy_split(t));
+  auto declared = Scheduler::build(std::move(previous), fake_clock);
+  REQUIRE(declared.ok());
+  // The members the functions were handed are the world's: two frames carry the value on.
+  declared->run_frame();
+  declared->run_frame();
+  CHECK(t.mesh == 2);
+  CHECK_THAT(declared->describe(), Catch::Contains("sketch: reads -; reads last frame's mesh; writes requests"));
+
+  std::vector<SystemSpec> stale;
+  stale.push_back(declare_system<ReadPrevious<&Toy::surface>, Write<&Toy::requests>>(
+      t, "sketch", [](const double&, int&) {}));
+  stale.push_back(toy_split(t));
+  auto refused_stale = Scheduler::build(std::move(stale), fake_clock);
+  REQUIRE_FALSE(refused_stale.ok());
+  CHECK_THAT(refused_stale.error(), Catch::Contains("'surface', but no later system writes it"));
+
+  std::vector<SystemSpec> twice;
+  twice.push_back(toy_split(t));
+  twice.push_back(toy_split(t));
+  CHECK_FALSE(Scheduler::build(std::move(twice), fake_clock).ok());
+}
+
+TEST_CASE("a system is declared by member pointers: two members of one type stay apart", "[scheduler]") {
+  Toy t;
+  const SystemSpec s = declare_system<Read<&Toy::mesh>, Write<&Toy::requests>>(t, "a", [](const int&, int&) {});
+  CHECK(s.reads() == std::vector<std::string>{"mesh"});
+  CHECK(s.writes() == std::vector<std::string>{"requests"});
+  CHECK(s.reads_previous_frame().empty());
+  CHECK(member_name<&World::object_events>() == "object_events");
+  CHECK(member_name<&World::frame_events>() == "frame_events");
 }
 
 TEST_CASE("the scheduler keeps per-system samples for mean, p99 and max", "[scheduler]") {
+  Toy t;
   int calls = 0;
-  auto s = Scheduler::build({{"count", {}, {"n"}, {}, [&] { ++calls; }}}, fake_clock);
+  std::vector<SystemSpec> systems;
+  systems.push_back(declare_system<Write<&Toy::requests>>(t, "count", calls, [](int& n, int&) { ++n; }));
+  auto s = Scheduler::build(std::move(systems), fake_clock);
   REQUIRE(s.ok());
   for (int i = 0; i < 100; ++i) s->run_frame();
   CHECK(calls == 100);
-  const SystemTiming& t = s->timings()[0];
-  REQUIRE(t.samples_ns.size() == 100);
-  CHECK(t.percentile_ns(99) <= t.max_ns);
-  CHECK(t.mean_ns() > 0);
+  const SystemTiming& timing = s->timings()[0];
+  REQUIRE(timing.samples_ns.size() == 100);
+  CHECK(timing.percentile_ns(99) <= timing.max_ns);
+  CHECK(timing.mean_ns() > 0);
   CHECK(s->frame_timing().samples_ns.size() == 100);
-  CHECK(s->frame_timing().max_ns >= t.max_ns);
-  CHECK_THAT(s->describe(), Catch::Contains("count: reads -; writes n"));
+  CHECK(s->frame_timing().max_ns >= timing.max_ns);
+  CHECK_THAT(s->describe(), Catch::Contains("count: reads -; writes requests"));
 }
 
 TEST_CASE("the scheduler's samples stay bounded over a long session, mean and max cover every frame", "[scheduler]") {
-  auto s = Scheduler::build({{"a", {}, {"n"}, {}, [] {}}}, fake_clock);
+  Toy t;
+  std::vector<SystemSpec> systems;
+  systems.push_back(declare_system<Write<&Toy::requests>>(t, "a", [](int&) {}));
+  auto s = Scheduler::build(std::move(systems), fake_clock);
   REQUIRE(s.ok());
   const size_t frames = 2 * kTimingWindow + 1;
   for (size_t i = 0; i < frames; ++i) s->run_frame();
-  for (const SystemTiming* t : {&s->timings()[0], &s->frame_timing()}) {
-    CHECK(t->frames == frames);
-    CHECK(t->samples_ns.size() == kTimingWindow + 1);  // the oldest window dropped when the next frame came
-    CHECK(t->mean_ns() == double(t->total_ns) / double(frames));
-    CHECK(t->percentile_ns(100) <= t->max_ns);
+  for (const SystemTiming* timing : {&s->timings()[0], &s->frame_timing()}) {
+    CHECK(timing->frames == frames);
+    CHECK(timing->samples_ns.size() == kTimingWindow + 1);  // the oldest window dropped when the next frame came
+    CHECK(timing->mean_ns() == double(timing->total_ns) / double(frames));
+    CHECK(timing->percentile_ns(100) <= timing->max_ns);
   }
 }
 
@@ -274,5 +337,7 @@ TEST_CASE("the session's frame order is accepted and the surface follows the net
   World w;
   auto s = Scheduler::build(session_systems(w), fake_clock);
   REQUIRE(s.ok());
-  CHECK_THAT(s->describe(), Catch::Contains("sketch: reads object_events, sketch_settings; reads last frame's mesh"));
+  CHECK_THAT(s->describe(), Catch::Contains("sketch: reads object_events, sketch_settings; reads last frame's mesh, snap; "
+                                            "writes sketch, requests, rejections, pen_feedback"));
+  CHECK_THAT(s->describe(), Catch::Contains("triangulate: reads frame, rig, frame_events; writes triangulate, pen_events"));
 }

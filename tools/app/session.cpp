@@ -11,31 +11,54 @@
 namespace fire {
 
 std::vector<SystemSpec> session_systems(World& w) {
+  using W = World;
   std::vector<SystemSpec> systems;
-  systems.push_back({"input", {"log", "frame"}, {"frame_events"}, {}, [&w] {
-                       input_system(w.log, w.frame, w.cursor, w.frame_events);
-                     }});
-  systems.push_back({"triangulate", {"frame_events", "rig"}, {"frame_events"}, {}, [&w] {
-                       if (w.rig) triangulate_system(w.frame, *w.rig, w.triangulate, w.frame_events);
-                     }});
-  systems.push_back({"register", {"frame_events", "rig"}, {"object_events", "rejections"}, {}, [&w] {
-                       register_system(w.frame_events, w.rig.has_value(), w.registration, w.object_events, w.rejections);
-                     }});
-  systems.push_back({"sketch", {"object_events", "sketch_settings"}, {"requests", "rejections", "pen_feedback"}, {"mesh", "snap"}, [&w] {
-                       sketch_system(w.object_events, w.mesh, w.snap, w.sketch_settings, w.sketch, w.requests,
-                                     w.rejections, w.pen_feedback);
-                     }});
-  systems.push_back({"split", {"requests"}, {"mesh", "rejections"}, {}, [&w] {
-                       split_system(w.requests, w.mesh, w.history, w.rejections);
-                     }});
-  systems.push_back({"refine", {"mesh", "surface_options"}, {"base_mesh"}, {}, [&w] {
-                       if (w.build_surface) refine_system(w.mesh, w.surface_options, w.surface_build);
-                     }});
-  systems.push_back({"subdivide", {"base_mesh", "surface_options", "frame"}, {"surface"}, {}, [&w] {
-                       if (w.build_surface) subdivide_system(w.surface_options, w.frame, w.surface_build, w.surface);
-                     }});
+  systems.push_back(declare_system<Read<&W::log>, Read<&W::frame>, Write<&W::cursor>, Write<&W::frame_events>>(
+      w, "input", [](const InputLog& log, const FrameTime& frame, InputCursor& cursor, std::vector<InputEvent>& events) {
+        input_system(log, frame, cursor, events);
+      }));
+  systems.push_back(declare_system<Read<&W::frame>, Read<&W::rig>, Read<&W::frame_events>, Write<&W::triangulate>,
+                                   Write<&W::pen_events>>(
+      w, "triangulate",
+      [](const FrameTime& frame, const std::optional<TrackingRig>& rig, const std::vector<InputEvent>& events,
+         TriangulateState& state, std::vector<InputEvent>& pen_events) {
+        if (rig) triangulate_system(frame, *rig, events, state, pen_events);
+      }));
+  systems.push_back(declare_system<Read<&W::frame_events>, Read<&W::pen_events>, Read<&W::rig>, Write<&W::registration>,
+                                   Write<&W::object_events>, Write<&W::rejections>>(
+      w, "register",
+      [](const std::vector<InputEvent>& events, const std::vector<InputEvent>& pen_events,
+         const std::optional<TrackingRig>& rig, RegistrationState& state, std::vector<InputEvent>& object_events,
+         std::vector<Rejection>& rejections) {
+        register_system(events, pen_events, rig.has_value(), state, object_events, rejections);
+      }));
+  systems.push_back(declare_system<Read<&W::object_events>, ReadPrevious<&W::mesh>, ReadPrevious<&W::snap>,
+                                   Read<&W::sketch_settings>, Write<&W::sketch>, Write<&W::requests>,
+                                   Write<&W::rejections>, Write<&W::pen_feedback>>(
+      w, "sketch",
+      [](const std::vector<InputEvent>& events, const Mesh& mesh, const SnapIndex& snap, const SketchSettings& settings,
+         SketchState& state, std::vector<EditRequest>& requests, std::vector<Rejection>& rejections,
+         PenFeedback& feedback) {
+        sketch_system(events, mesh, snap, settings, state, requests, rejections, feedback);
+      }));
+  systems.push_back(declare_system<Read<&W::requests>, Write<&W::mesh>, Write<&W::history>, Write<&W::rejections>>(
+      w, "split", [](const std::vector<EditRequest>& requests, Mesh& mesh, EditHistory& history,
+                     std::vector<Rejection>& rejections) { split_system(requests, mesh, history, rejections); }));
+  systems.push_back(declare_system<Read<&W::build_surface>, Read<&W::mesh>, Read<&W::surface_options>,
+                                   Write<&W::surface_build>>(
+      w, "refine", [](const bool& build, const Mesh& mesh, const reconstruct::Options& options,
+                      reconstruct::SurfaceBuild& surface_build) {
+        if (build) refine_system(mesh, options, surface_build);
+      }));
+  systems.push_back(declare_system<Read<&W::build_surface>, Read<&W::surface_options>, Read<&W::frame>,
+                                   Write<&W::surface_build>, Write<&W::surface>>(
+      w, "subdivide", [](const bool& build, const reconstruct::Options& options, const FrameTime& frame,
+                         reconstruct::SurfaceBuild& surface_build, SurfaceLevels& surface) {
+        if (build) subdivide_system(options, frame, surface_build, surface);
+      }));
   // The sync point: consumers of the frame's writes that later frames read.
-  systems.push_back({"snap", {"mesh"}, {"snap"}, {}, [&w] { w.snap.sync(w.mesh); }});
+  systems.push_back(declare_system<Read<&W::mesh>, Write<&W::snap>>(
+      w, "snap", [](const Mesh& mesh, SnapIndex& snap) { snap.sync(mesh); }));
   return systems;
 }
 

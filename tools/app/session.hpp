@@ -32,9 +32,10 @@ struct World {
   InputCursor cursor;
   FrameTime frame;
   std::vector<InputEvent> frame_events;
-  // triangulate: only with a rig (logs of device reports); it appends the pen's events to frame_events
+  // triangulate: only with a rig (logs of device reports): the pen's events from the frame's reports
   std::optional<TrackingRig> rig;
   TriangulateState triangulate;
+  std::vector<InputEvent> pen_events;
   // register: the pen's samples from the rig's frame to the object's (cmd mark, cmd register)
   RegistrationState registration;
   std::vector<InputEvent> object_events;  // the frame's pen events (object frame) and commands, for sketch
@@ -55,7 +56,6 @@ struct World {
   SurfaceLevels surface;
 };
 
-inline constexpr int64_t kFrameStepUs = 10'000;  // 100 Hz, the Wii Remote's report rate
 
 // The design card's systems over `world`, in frame order, with their declared reads and writes.
 std::vector<SystemSpec> session_systems(World& world);

@@ -22,7 +22,7 @@ struct ReplayOptions {
   std::string log_path, out_path, obj_path, session_dir, rig_path;
   std::vector<std::string> surface_paths;
   uint64_t snapshot_every = 0;
-  bool hash = false, timings = false, no_surface = false;
+  bool hash = false, timings = false, no_surface = false, schedule = false;
   bool settings_given = false;  // --snap, a surface option or --no-surface on the command line
   double snap = SketchSettings{}.snap_distance;
   SurfaceArgs surface_args;
@@ -203,12 +203,15 @@ int run_replay(const ReplayOptions& o) {
 void add_network_commands(CLI::App& app, Registry& registry) {
   auto o = std::make_shared<ReplayOptions>();
   CLI::App* replay = app.add_subcommand(
-      "replay", "Replay an input log headless through the frame systems (input, sketch, split, refine, subdivide, snap)");
+      "replay", "Replay an input log headless through the frame systems (input, triangulate, register, sketch, split, "
+                "refine, subdivide, snap)");
   replay->add_option("LOG", o->log_path,
                      "input log (format: engine/INPUT_LOG.md), or a session folder (engine/SESSION.md) to reopen: its "
                      "last good snapshot, then its log's tail, a torn last record dropped; a folder's settings.json "
-                     "fixes --snap, the surface options and --no-surface")
-      ->required();
+                     "fixes --snap, the surface options and --no-surface");
+  replay->add_flag("--schedule", o->schedule,
+                   "print the frame and exit: each system in order with the world members it reads (this frame's and "
+                   "the previous frame's) and writes, as the code declares them; needs no LOG");
   replay->add_option("--session", o->session_dir,
                      "write a session folder while replaying LOG: the input log, fsynced with a durability record at "
                      "every pen-up and command, and snapshots (a new or empty folder)");
@@ -236,6 +239,16 @@ void add_network_commands(CLI::App& app, Registry& registry) {
       ->capture_default_str();
   replay->footer("Pictures of the replay's frames: fire render LOG --every N --png-dir DIR.");
   replay->callback([o, replay, &registry] {
+    if (o->schedule) {
+      World world;
+      std::cout << make_scheduler(world, monotonic_ns).describe();
+      return;
+    }
+    if (o->log_path.empty()) {
+      std::cerr << "fire replay: LOG is required: an input log or a session folder (--help)\n";
+      registry.exit_code = 2;
+      return;
+    }
     o->settings_given =
         replay->count("--snap") + replay->count("--no-surface") > 0 || surface_options_given(*replay);
     auto surface = surface_options(o->surface_args, *replay);

@@ -115,7 +115,10 @@ int render_sequence(const RenderArgs& a, const reconstruct::Options& options, co
     pictured = true;
   };
   std::vector<SystemSpec> systems = session_systems(*world);
-  systems.push_back({"render", {"mesh", "surface"}, {"pictures"}, {}, [&] { picture(false); }});
+  // The renderer, last in the frame: it reads what the picture shows (the picture's own state is outside the world).
+  systems.push_back(declare_system<Read<&World::frame>, Read<&World::mesh>, Read<&World::surface>>(
+      *world, "render", picture,
+      [](decltype(picture)& draw, const FrameTime&, const Mesh&, const SurfaceLevels&) { draw(false); }));
   auto scheduler = Scheduler::build(std::move(systems), monotonic_ns);
   if (!scheduler) return fail("internal error: " + scheduler.error());
   replay_headless(*world, *scheduler);

@@ -17,7 +17,7 @@ Vec3 to_rig(const Vec3& object) { return kA.transpose() * (object - kB); }
 // One frame of the system with a tracked pen: what it passes on to the sketch system.
 std::vector<InputEvent> run(RegistrationState& s, std::vector<Rejection>& rejections, const std::vector<InputEvent>& frame) {
   std::vector<InputEvent> out;
-  register_system(frame, true, s, out, rejections);
+  register_system(frame, {}, true, s, out, rejections);
   return out;
 }
 
@@ -255,7 +255,7 @@ TEST_CASE("without a tracked pen the events pass unchanged and mark and register
   std::vector<InputEvent> out;
   register_system({event(0, EventKind::Down), pen(1, Vec3(1, 2, 3)), event(2, EventKind::Up), hid, mark(3, 0, kMarks[0], 7),
                    register_command(4, 8)},
-                  false, s, out, rejections);
+                  {}, false, s, out, rejections);
   REQUIRE(out.size() == 3);  // the device report is the triangulation system's
   CHECK(out[1].p == Vec3(1, 2, 3));
   REQUIRE(rejections.size() == 2);
