@@ -70,6 +70,7 @@ size_t Mesh::live_point_count() const {
 }
 
 std::vector<uint32_t> Mesh::vertex_edges(uint32_t v) const {
+  FIRE_ASSERT(vertex_alive(v), "a dead vertex's edge list is another vertex's");
   std::vector<uint32_t> out;
   for (uint32_t e = vertices.first_edge[v]; e != kNone;) {
     out.push_back(e);
@@ -79,12 +80,14 @@ std::vector<uint32_t> Mesh::vertex_edges(uint32_t v) const {
 }
 
 uint32_t Mesh::valence(uint32_t v) const {
+  FIRE_ASSERT(vertex_alive(v), "a dead vertex has no valence");
   uint32_t n = 0;
   for (uint32_t e = vertices.first_edge[v]; e != kNone; e = edges.next[e][edges.vertex[e][0] == v ? 0 : 1]) ++n;
   return n;
 }
 
 uint32_t Mesh::loop_position(uint32_t f, uint32_t e) const {
+  FIRE_ASSERT(face_alive(f), "a dead face's loop is stale");
   auto loop = face_loop(f);
   for (uint32_t k = 0; k < loop.size(); ++k)
     if (edge_of(loop[k]) == e) return k;
@@ -103,6 +106,7 @@ LoopPlane loop_plane(std::span<const Vec3> loop) {
 }
 
 std::vector<Vec3> Mesh::face_boundary(uint32_t f) const {
+  FIRE_ASSERT(face_alive(f), "a dead face's loop is stale");
   std::vector<Vec3> out;
   for (uint32_t oe : face_loop(f)) {
     auto line = polyline(edge_of(oe));
@@ -184,6 +188,8 @@ void Mesh::unlink_edge(uint32_t e) {
 }
 
 uint32_t Mesh::add_edge(uint32_t v0, uint32_t v1, std::span<const Vec3> polyline) {
+  FIRE_ASSERT(polyline.size() >= 2, "a polyline joins its two vertices: it has at least 2 points");
+  FIRE_ASSERT(vertex_alive(v0) && vertex_alive(v1), "an edge joins live vertices");
   bool fresh = edges.free_list.empty();
   uint32_t e = allocate(edges.free_list, edges.generation, edges.flags, edges.changes);
   uint32_t offset = static_cast<uint32_t>(points.size());
@@ -258,6 +264,7 @@ uint32_t Mesh::add_face(std::span<const uint32_t> loop) {
 }
 
 bool Mesh::set_face_loop(uint32_t f, std::span<const uint32_t> loop) {
+  FIRE_ASSERT(face_alive(f), "only a live face keeps its slot and handle");
   if (!loop_fits(loop, f)) return false;
   set_loop_sides(face_loop(f), kNone);
   faces.edge_offset.set(f, append_loop(loop, f));
@@ -267,26 +274,34 @@ bool Mesh::set_face_loop(uint32_t f, std::span<const uint32_t> loop) {
 }
 
 void Mesh::remove_face(uint32_t f) {
+  FIRE_ASSERT(face_alive(f), "a face is removed once");
   set_loop_sides(face_loop(f), kNone);
   release(f, faces.free_list, faces.generation, faces.flags, faces.changes);
 }
 
 void Mesh::remove_edge(uint32_t e) {
+  FIRE_ASSERT(edge_alive(e), "an edge is removed once");
+  FIRE_ASSERT(edges.face[e][0] == kNone && edges.face[e][1] == kNone, "the faces of an edge go before it");
   unlink_edge(e);
   release(e, edges.free_list, edges.generation, edges.flags, edges.changes);
 }
 
 void Mesh::remove_vertex(uint32_t v) {
+  FIRE_ASSERT(vertex_alive(v), "a vertex is removed once");
+  FIRE_ASSERT(vertices.first_edge[v] == kNone, "the edges of a vertex go before it");
   release(v, vertices.free_list, vertices.generation, vertices.flags, vertices.changes);
 }
 
 void Mesh::set_edge_flag(uint32_t e, uint8_t flag, bool on) {
+  FIRE_ASSERT(edge_alive(e), "a dead edge's flags hold its liveness");
+  FIRE_ASSERT(!(flag & kAlive), "liveness is the pools' to set");
   uint8_t f = edges.flags[e];
   edges.flags.set(e, static_cast<uint8_t>(on ? (f | flag) : (f & ~flag)));
   edges.changes.touch(e, frame_);
 }
 
 void Mesh::move_vertex(uint32_t v, const Vec3& p) {
+  FIRE_ASSERT(vertex_alive(v), "a dead vertex's slot may be reused");
   vertices.position.set(v, p);
   vertices.changes.touch(v, frame_);
   for (uint32_t e : vertex_edges(v)) {
@@ -308,6 +323,7 @@ void Mesh::end_transaction() {
 }
 
 void Mesh::rollback(const MeshMark& m) {
+  FIRE_ASSERT(m.columns.size() == journal_marks().columns.size(), "a mark names every column of these pools");
   size_t k = 0;
   for_each_stamped_column([&](auto& column, ChangeStamps* stamps, bool per_slot) {
     column.end();

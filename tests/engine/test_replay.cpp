@@ -334,10 +334,22 @@ TEST_CASE("the scheduler's samples stay bounded over a long session, mean and ma
 }
 
 TEST_CASE("the session's frame order is accepted and the surface follows the network", "[scheduler][surface]") {
-  World w;
-  auto s = Scheduler::build(session_systems(w), fake_clock);
+  auto log = read_input_log(FIRE_SOURCE_DIR "/tools/demo/sketch.log");
+  REQUIRE(log.ok());
+  auto w = std::make_unique<World>();
+  w->log = std::move(*log);
+  auto s = Scheduler::build(session_systems(*w), fake_clock);
   REQUIRE(s.ok());
   CHECK_THAT(s->describe(), Catch::Contains("sketch: reads object_events, sketch_settings; reads last frame's mesh, snap; "
                                             "writes sketch, requests, rejections, pen_feedback"));
   CHECK_THAT(s->describe(), Catch::Contains("triangulate: reads frame, rig, frame_events; writes triangulate, pen_events"));
+  replay_headless(*w, *s);
+  // The surface the frame's refine and subdivide left is the network's, as a reconstruction from scratch makes it.
+  REQUIRE(w->mesh.face_count() > 0);
+  REQUIRE(w->surface.settled);
+  auto rebuilt = reconstruct::reconstruct_surface(w->mesh, w->surface_options);
+  REQUIRE(rebuilt.ok());
+  const SurfaceMesh framed = to_surface_mesh(w->surface);
+  CHECK(framed.face_vertices == rebuilt->face_vertices);
+  CHECK(framed.positions == rebuilt->positions);
 }
