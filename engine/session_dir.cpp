@@ -100,28 +100,31 @@ Result<SnapshotReader> SnapshotReader::open(std::string_view file, const std::st
   return SnapshotReader(payload);
 }
 
+namespace {
+
+// The surface's fields as the file holds them, one list for the writer and the reader; `settled` follows as a byte.
+template <class Surface, class Field>
+void for_each_surface_field(Surface& s, Field&& field) {
+  field(s.level);
+  field(s.positions);
+  field(s.normals);
+  field(s.quads);
+  field(s.topology_version);
+  field(s.frame);
+  field(s.changed.begin);
+  field(s.changed.end);
+}
+
+}  // namespace
+
 void save_surface(SnapshotWriter& out, const SurfaceLevels& s) {
-  out.put(s.level);
-  out.put(s.positions);
-  out.put(s.normals);
-  out.put(s.quads);
-  out.put(s.topology_version);
-  out.put(s.frame);
-  out.put(s.changed.begin);
-  out.put(s.changed.end);
+  for_each_surface_field(s, [&](const auto& value) { out.put(value); });
   out.put(uint8_t(s.settled));
 }
 
 bool load_surface(SnapshotReader& in, SurfaceLevels& s) {
   uint8_t settled = 0;
-  in.get(s.level);
-  in.get(s.positions);
-  in.get(s.normals);
-  in.get(s.quads);
-  in.get(s.topology_version);
-  in.get(s.frame);
-  in.get(s.changed.begin);
-  in.get(s.changed.end);
+  for_each_surface_field(s, [&](auto& value) { in.get(value); });
   in.get(settled);
   s.settled = settled != 0;
   const size_t n = s.positions.size();

@@ -91,6 +91,17 @@ void init_point(double* p, size_t i) {
   p[2] = double(i) + 0.25;
 }
 
+// s5 and s6: n VECs pointing into one malloc'ed double[3n], which `coords` receives.
+void point_into(VEC* vecs, double*& coords, size_t n) {
+  coords = static_cast<double*>(std::malloc(sizeof(double) * 3 * n));
+  for (size_t i = 0; i < n; i++) {
+    vecs[i].dim = 3;
+    vecs[i].max_dim = 3;
+    vecs[i].ve = &coords[i * 3];
+    init_point(vecs[i].ve, i);
+  }
+}
+
 void setup(Variant v, size_t n) {
   std::mt19937 rng(2026);
   switch (v) {
@@ -118,24 +129,10 @@ void setup(Variant v, size_t n) {
         init_point(s4[i]->ve, i);
       }
       break;
-    case S5:
-      s5_p = static_cast<double*>(std::malloc(sizeof(double) * 3 * n));
-      for (size_t i = 0; i < n; i++) {
-        s5[i].dim = 3;
-        s5[i].max_dim = 3;
-        s5[i].ve = &s5_p[i * 3];
-        init_point(s5[i].ve, i);
-      }
-      break;
+    case S5: point_into(s5, s5_p, n); break;
     case S6:
       s6 = static_cast<VEC*>(std::malloc(sizeof(VEC) * n));
-      s6_p = static_cast<double*>(std::malloc(sizeof(double) * 3 * n));
-      for (size_t i = 0; i < n; i++) {
-        s6[i].dim = 3;
-        s6[i].max_dim = 3;
-        s6[i].ve = &s6_p[i * 3];
-        init_point(s6[i].ve, i);
-      }
+      point_into(s6, s6_p, n);
       break;
     case FIRE_POOL:
       for (size_t i = 0; i < n; i++) {

@@ -182,22 +182,6 @@ bool has_device_extension(VkPhysicalDevice device, const char* name) {
 }
 }  // namespace
 
-VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageAspectFlags aspect, VkImageLayout from, VkImageLayout to,
-                                    VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
-                                    VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) {
-  VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-  b.srcStageMask = src_stage;
-  b.srcAccessMask = src_access;
-  b.dstStageMask = dst_stage;
-  b.dstAccessMask = dst_access;
-  b.oldLayout = from;
-  b.newLayout = to;
-  b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  b.image = image;
-  b.subresourceRange = {aspect, 0, 1, 0, 1};
-  return b;
-}
-
 Status Context::create_commands(VkCommandPool& pool, VkCommandBuffer& buffer, VkFence& fence, bool signaled) const {
   VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
@@ -273,6 +257,34 @@ Result<uint32_t> Context::memory_type(uint32_t type_bits, VkMemoryPropertyFlags 
   for (uint32_t i = 0; i < memory_.memoryTypeCount; ++i)
     if ((type_bits & (1u << i)) && (memory_.memoryTypes[i].propertyFlags & flags) == flags) return i;
   return Result<uint32_t>::failure("no Vulkan memory type with the needed properties");
+}
+
+Status Context::allocate(const VkMemoryRequirements& req, VkMemoryPropertyFlags preferred,
+                         VkMemoryPropertyFlags fallback, VkDeviceMemory& memory) const {
+  auto type = memory_type(req.memoryTypeBits, preferred);
+  if (!type) type = memory_type(req.memoryTypeBits, fallback);
+  if (!type) return Status::failure(type.error());
+  VkMemoryAllocateInfo info{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  info.allocationSize = req.size;
+  info.memoryTypeIndex = *type;
+  FIRE_VK_TRY(vkAllocateMemory(device_, &info, nullptr, &memory));
+  return Status::success();
+}
+
+Status Context::create_mapped_buffer(VkDeviceSize bytes, VkBufferUsageFlags usage, VkMemoryPropertyFlags extra,
+                                     VkBuffer& buffer, VkDeviceMemory& memory, void*& mapped) const {
+  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.size = bytes;
+  info.usage = usage;
+  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  FIRE_VK_TRY(vkCreateBuffer(device_, &info, nullptr, &buffer));
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(device_, buffer, &req);
+  constexpr VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  FIRE_TRY(allocate(req, host | extra, host, memory));
+  FIRE_VK_TRY(vkBindBufferMemory(device_, buffer, memory, 0));
+  FIRE_VK_TRY(vkMapMemory(device_, memory, 0, VK_WHOLE_SIZE, 0, &mapped));
+  return Status::success();
 }
 
 void Context::record_message(std::string message) {

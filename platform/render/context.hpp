@@ -76,6 +76,13 @@ class Context {
 
   // A memory type among `type_bits` with all of `flags`.
   Result<uint32_t> memory_type(uint32_t type_bits, VkMemoryPropertyFlags flags) const;
+  // Memory for `req` of a type with all of `preferred`, else of one with all of `fallback`.
+  Status allocate(const VkMemoryRequirements& req, VkMemoryPropertyFlags preferred, VkMemoryPropertyFlags fallback,
+                  VkDeviceMemory& memory) const;
+  // An exclusive buffer of `bytes` in host-visible, coherent memory (of a type with all of `extra` too where
+  // there is one), mapped whole until its memory is freed. What was made before a failure is in the outputs.
+  Status create_mapped_buffer(VkDeviceSize bytes, VkBufferUsageFlags usage, VkMemoryPropertyFlags extra,
+                              VkBuffer& buffer, VkDeviceMemory& memory, void*& mapped) const;
 
   // Validation warnings and errors reported so far (0 when validation is off).
   size_t validation_message_count() const;
@@ -100,10 +107,5 @@ class Context {
   mutable std::mutex messages_mutex_;  // the layer may report from any thread that calls Vulkan
   std::vector<std::string> messages_;
 };
-
-// A layout transition of one image's first mip and layer, on one queue family.
-VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageAspectFlags aspect, VkImageLayout from, VkImageLayout to,
-                                    VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
-                                    VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access);
 
 }  // namespace fire::render

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstring>
 
+#include "platform/render/barriers.hpp"
+
 namespace fire::render {
 
 namespace {
@@ -10,13 +12,6 @@ namespace {
 constexpr uint64_t kWaitNs = 60'000'000'000ull;  // a frame on lavapipe takes well under a second
 
 bool is_bgra(VkFormat f) { return f == VK_FORMAT_B8G8R8A8_SRGB || f == VK_FORMAT_B8G8R8A8_UNORM; }
-
-void barrier(VkCommandBuffer cmd, const VkImageMemoryBarrier2& b) {
-  VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-  dependency.imageMemoryBarrierCount = 1;
-  dependency.pImageMemoryBarriers = &b;
-  vkCmdPipelineBarrier2(cmd, &dependency);
-}
 
 }  // namespace
 
@@ -211,44 +206,14 @@ Status Presenter::record_capture(VkCommandBuffer cmd, VkImage image) {
     capture_buffer_ = VK_NULL_HANDLE;
     capture_memory_ = VK_NULL_HANDLE;
     capture_capacity_ = 0;
-    VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-    info.size = bytes;
-    info.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-    FIRE_VK_TRY(vkCreateBuffer(device, &info, nullptr, &capture_buffer_));
-    VkMemoryRequirements req;
-    vkGetBufferMemoryRequirements(device, capture_buffer_, &req);
-    auto type = context_.memory_type(req.memoryTypeBits,
-                                     VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
-    if (!type) return Status::failure(type.error());
-    VkMemoryAllocateInfo mem{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-    mem.allocationSize = req.size;
-    mem.memoryTypeIndex = *type;
-    FIRE_VK_TRY(vkAllocateMemory(device, &mem, nullptr, &capture_memory_));
-    FIRE_VK_TRY(vkBindBufferMemory(device, capture_buffer_, capture_memory_, 0));
-    FIRE_VK_TRY(vkMapMemory(device, capture_memory_, 0, VK_WHOLE_SIZE, 0, &capture_mapped_));
+    FIRE_TRY(context_.create_mapped_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, 0, capture_buffer_, capture_memory_,
+                                           capture_mapped_));
     capture_capacity_ = bytes;
   }
-  barrier(cmd, image_barrier(image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                             VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-                             VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT));
-  VkBufferImageCopy region{};
-  region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-  region.imageExtent = {extent_.width, extent_.height, 1};
-  vkCmdCopyImageToBuffer(cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, capture_buffer_, 1, &region);
-  barrier(cmd, image_barrier(image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
-                             VK_PIPELINE_STAGE_2_COPY_BIT, 0, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0));
-  VkBufferMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
-  to_host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-  to_host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-  to_host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
-  to_host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
-  to_host.srcQueueFamilyIndex = to_host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  to_host.buffer = capture_buffer_;
-  to_host.size = VK_WHOLE_SIZE;
-  VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-  dependency.bufferMemoryBarrierCount = 1;
-  dependency.pBufferMemoryBarriers = &to_host;
-  vkCmdPipelineBarrier2(cmd, &dependency);
+  record_readback(cmd, image, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, extent_, capture_buffer_);
+  record_barrier(cmd, image_barrier(image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                    VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_PIPELINE_STAGE_2_COPY_BIT, 0,
+                                    VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0));
   return Status::success();
 }
 

@@ -7,6 +7,8 @@
 #include <string>
 #include <unordered_map>
 
+#include "platform/render/barriers.hpp"
+
 // SPIR-V compiled from shaders/ at build time (platform/render/CMakeLists.txt).
 #include "shaders/curve_vert.h"
 #include "shaders/flat_frag.h"
@@ -135,13 +137,7 @@ Status Renderer::create_target(Target& target, VkFormat format, VkImageUsageFlag
   FIRE_VK_TRY(vkCreateImage(device, &info, nullptr, &target.image));
   VkMemoryRequirements req;
   vkGetImageMemoryRequirements(device, target.image, &req);
-  auto type = context_.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  if (!type) type = context_.memory_type(req.memoryTypeBits, 0);
-  if (!type) return Status::failure(type.error());
-  VkMemoryAllocateInfo mem{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-  mem.allocationSize = req.size;
-  mem.memoryTypeIndex = *type;
-  FIRE_VK_TRY(vkAllocateMemory(device, &mem, nullptr, &target.memory));
+  FIRE_TRY(context_.allocate(req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0, target.memory));
   FIRE_VK_TRY(vkBindImageMemory(device, target.image, target.memory, 0));
   VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
   view.image = target.image;
@@ -160,27 +156,10 @@ Status Renderer::reserve(Buffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags 
   const VkDeviceSize capacity = std::max(bytes, buffer.capacity * 2);
   // The GPU reads buffers only inside draw(), which waits for its frame to finish.
   destroy(buffer);
-  VkDevice device = context_.device();
-  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-  info.size = capacity;
-  info.usage = usage;
-  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-  FIRE_VK_TRY(vkCreateBuffer(device, &info, nullptr, &buffer.buffer));
-  VkMemoryRequirements req;
-  vkGetBufferMemoryRequirements(device, buffer.buffer, &req);
-  constexpr VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
   // Readback is read by the CPU: cached memory where there is such.
-  auto type = context_.memory_type(req.memoryTypeBits, usage == VK_BUFFER_USAGE_TRANSFER_DST_BIT
-                                                           ? host | VK_MEMORY_PROPERTY_HOST_CACHED_BIT
-                                                           : host | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  if (!type) type = context_.memory_type(req.memoryTypeBits, host);
-  if (!type) return Status::failure(type.error());
-  VkMemoryAllocateInfo mem{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-  mem.allocationSize = req.size;
-  mem.memoryTypeIndex = *type;
-  FIRE_VK_TRY(vkAllocateMemory(device, &mem, nullptr, &buffer.memory));
-  FIRE_VK_TRY(vkBindBufferMemory(device, buffer.buffer, buffer.memory, 0));
-  FIRE_VK_TRY(vkMapMemory(device, buffer.memory, 0, VK_WHOLE_SIZE, 0, &buffer.mapped));
+  const VkMemoryPropertyFlags extra =
+      usage == VK_BUFFER_USAGE_TRANSFER_DST_BIT ? VK_MEMORY_PROPERTY_HOST_CACHED_BIT : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+  FIRE_TRY(context_.create_mapped_buffer(capacity, usage, extra, buffer.buffer, buffer.memory, buffer.mapped));
   buffer.capacity = capacity;
   return Status::success();
 }
@@ -721,21 +700,22 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
   auto push = [&] {
     vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof pc, &pc);
   };
-  const VkDeviceSize zero = 0;
+  // For `pipeline`'s draws: it, the push constants as they are now, and `vertices` from `offset` on.
+  auto bind = [&](VkPipeline pipeline, VkBuffer vertices, VkDeviceSize offset = 0) {
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
+    push();
+    vkCmdBindVertexBuffers(cmd, 0, 1, &vertices, &offset);
+  };
 
   if (!surface_draws_.empty() && options.surface) {
     pc.color = linear(surface_settled_ ? Palette::surface : Palette::provisional_surface);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, surface_);
-    push();
-    vkCmdBindVertexBuffers(cmd, 0, 1, &surface_vertices_.buffer, &zero);
+    bind(surface_, surface_vertices_.buffer);
     vkCmdBindIndexBuffer(cmd, surface_indices_.buffer, 0, VK_INDEX_TYPE_UINT32);
     for (const auto& [first, count] : surface_draws_) vkCmdDrawIndexed(cmd, count, 1, first, 0, 0);
   }
   if (!surface_draws_.empty() && options.wireframe && wireframe_) {
     pc.color = linear(Palette::wireframe);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, wireframe_);
-    push();
-    vkCmdBindVertexBuffers(cmd, 0, 1, &surface_vertices_.buffer, &zero);
+    bind(wireframe_, surface_vertices_.buffer);
     vkCmdBindIndexBuffer(cmd, surface_indices_.buffer, 0, VK_INDEX_TYPE_UINT32);
     for (const auto& [first, count] : surface_draws_) vkCmdDrawIndexed(cmd, count, 1, first, 0, 0);
   }
@@ -743,42 +723,32 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
     pc.color = linear(Palette::curve);
     pc.params.x = std::max(1.0f, 1.6f * scale);
     pc.params.w = camera.line_depth_pull;
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, curves_);
-    push();
-    vkCmdBindVertexBuffers(cmd, 0, 1, &points_.buffer, &zero);
+    bind(curves_, points_.buffer);
     for (const auto& [first, count] : curve_draws_) vkCmdDraw(cmd, 6, count - 1, 0, first);
   }
   if (!marker_draws_.empty() && options.curves) {
     pc.color = linear(Palette::marker);
     pc.params.x = std::max(2.5f, 4.5f * scale);
     pc.params.w = camera.line_depth_pull * 2.0f;
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, markers_);
-    push();
-    vkCmdBindVertexBuffers(cmd, 0, 1, &vertices_.buffer, &zero);
+    bind(markers_, vertices_.buffer);
     for (const auto& [first, count] : marker_draws_) vkCmdDraw(cmd, 6, count, 0, first);
   }
   if (reference_index_count_) {
     pc.color = linear(Palette::reference, 0.35f);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, reference_pipeline_);
-    push();
-    vkCmdBindVertexBuffers(cmd, 0, 1, &reference_vertices_.buffer, &zero);
+    bind(reference_pipeline_, reference_vertices_.buffer);
     vkCmdBindIndexBuffer(cmd, reference_indices_.buffer, 0, VK_INDEX_TYPE_UINT32);
     vkCmdDrawIndexed(cmd, reference_index_count_, 1, 0, 0, 0);
   }
   if (pen_face_vertices_) {  // over the see-through reference, which would wash it out
     pc.color = linear(Palette::pen_face, Palette::pen_face_alpha);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pen_face_);
-    push();
-    vkCmdBindVertexBuffers(cmd, 0, 1, &pen_.buffer, &zero);
+    bind(pen_face_, pen_.buffer);
     vkCmdDraw(cmd, pen_face_vertices_, 1, 0, 0);
   }
   if (stroke_count_) {  // after the see-through reference, so the pen's trace shows in full
     pc.color = linear(Palette::stroke);
     pc.params.x = std::max(1.0f, 2.0f * scale);
     pc.params.w = camera.line_depth_pull * 2.0f;
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, curves_);
-    push();
-    vkCmdBindVertexBuffers(cmd, 0, 1, &stroke_.buffer, &zero);
+    bind(curves_, stroke_.buffer);
     vkCmdDraw(cmd, 6, stroke_count_ - 1, 0, 0);
   }
   if (!marks_copy_.empty()) {  // over the surface, so a mark under it still shows where to touch
@@ -786,9 +756,7 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
     pc.color = linear(Palette::mark);
     pc.params.x = std::max(3.0f, 6.0f * scale);
     pc.params.w = camera.line_depth_pull * 3.0f;
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, markers_);
-    push();
-    vkCmdBindVertexBuffers(cmd, 0, 1, &marks_.buffer, &zero);
+    bind(markers_, marks_.buffer);
     vkCmdDraw(cmd, 6, count, 0, 0);
     if (next_mark_ < count) {
       pc.color = linear(Palette::next_mark);
@@ -801,10 +769,7 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
     pc.color = linear(pen_closes_ ? Palette::close_border : Palette::snap_target);
     pc.params.x = std::max(4.0f, (pen_closes_ ? 10.0f : 7.5f) * scale);
     pc.params.w = camera.line_depth_pull * 3.0f;
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, markers_);
-    push();
-    const VkDeviceSize at = VkDeviceSize(2 * pen_face_vertices_) * sizeof(glm::vec3);
-    vkCmdBindVertexBuffers(cmd, 0, 1, &pen_.buffer, &at);
+    bind(markers_, pen_.buffer, VkDeviceSize(2 * pen_face_vertices_) * sizeof(glm::vec3));
     vkCmdDraw(cmd, 6, 1, 0, 0);
   }
   vkCmdEndRendering(cmd);
@@ -819,36 +784,8 @@ Status Renderer::draw(const Camera& camera, const DrawOptions& options) {
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   FIRE_VK_TRY(vkBeginCommandBuffer(cmd, &begin));
   record(cmd, camera, options, resolve_.image, resolve_.view);
-  VkImageMemoryBarrier2 to_copy{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-  to_copy.srcStageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-  to_copy.srcAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
-  to_copy.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-  to_copy.dstAccessMask = VK_ACCESS_2_TRANSFER_READ_BIT;
-  to_copy.oldLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-  to_copy.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-  to_copy.srcQueueFamilyIndex = to_copy.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  to_copy.image = resolve_.image;
-  to_copy.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-  VkDependencyInfo to_copy_dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-  to_copy_dependency.imageMemoryBarrierCount = 1;
-  to_copy_dependency.pImageMemoryBarriers = &to_copy;
-  vkCmdPipelineBarrier2(cmd, &to_copy_dependency);
-  VkBufferImageCopy region{};
-  region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-  region.imageExtent = {settings_.width, settings_.height, 1};
-  vkCmdCopyImageToBuffer(cmd, resolve_.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_.buffer, 1, &region);
-  VkBufferMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
-  to_host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-  to_host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-  to_host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
-  to_host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
-  to_host.srcQueueFamilyIndex = to_host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  to_host.buffer = readback_.buffer;
-  to_host.size = VK_WHOLE_SIZE;
-  VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-  dependency.bufferMemoryBarrierCount = 1;
-  dependency.pBufferMemoryBarriers = &to_host;
-  vkCmdPipelineBarrier2(cmd, &dependency);
+  record_readback(cmd, resolve_.image, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, {settings_.width, settings_.height},
+                  readback_.buffer);
   FIRE_VK_TRY(vkEndCommandBuffer(cmd));
 
   VkCommandBufferSubmitInfo command{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};

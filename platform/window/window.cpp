@@ -27,13 +27,16 @@ int from_button(Button b) {
   return b == Button::Right ? GLFW_MOUSE_BUTTON_RIGHT : b == Button::Middle ? GLFW_MOUSE_BUTTON_MIDDLE : GLFW_MOUSE_BUTTON_LEFT;
 }
 
-void on_cursor(GLFWwindow* w, double x, double y) {
+// The events that carry two numbers and nothing else: a cursor position, a scroll offset.
+void push_xy(GLFWwindow* w, EventKind kind, double x, double y) {
   WindowEvent e;
-  e.kind = EventKind::CursorMove;
+  e.kind = kind;
   e.x = x;
   e.y = y;
   owner(w)->events().push_back(e);
 }
+
+void on_cursor(GLFWwindow* w, double x, double y) { push_xy(w, EventKind::CursorMove, x, y); }
 
 void on_button(GLFWwindow* w, int button, int action, int mods) {
   if (action != GLFW_PRESS && action != GLFW_RELEASE) return;
@@ -45,13 +48,7 @@ void on_button(GLFWwindow* w, int button, int action, int mods) {
   owner(w)->events().push_back(e);
 }
 
-void on_scroll(GLFWwindow* w, double dx, double dy) {
-  WindowEvent e;
-  e.kind = EventKind::Scroll;
-  e.x = dx;
-  e.y = dy;
-  owner(w)->events().push_back(e);
-}
+void on_scroll(GLFWwindow* w, double dx, double dy) { push_xy(w, EventKind::Scroll, dx, dy); }
 
 void on_key(GLFWwindow* w, int key, int, int action, int mods) {
   if (action != GLFW_PRESS && action != GLFW_REPEAT) return;

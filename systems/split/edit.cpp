@@ -44,6 +44,13 @@ BorderChain open_border(const Mesh& m) {
   return chain;
 }
 
+// What append and close ask before the curve goes on from the open border's last vertex.
+EditOutcome check_continues_border(const Mesh& m, const EditCommand& c) {
+  if (has_faces(m)) return EditOutcome::reject("the border polygon is already closed");
+  if (m.edge_count() == 0) return EditOutcome::reject("no border polygon has been started");
+  return check_points(c.points);
+}
+
 EditOutcome start_border(Mesh& m, const EditCommand& c) {
   if (m.edge_count() > 0) return EditOutcome::reject("a border polygon already exists");
   if (auto ok = check_points(c.points); !ok.ok) return ok;
@@ -55,9 +62,7 @@ EditOutcome start_border(Mesh& m, const EditCommand& c) {
 }
 
 EditOutcome append_border(Mesh& m, const EditCommand& c) {
-  if (has_faces(m)) return EditOutcome::reject("the border polygon is already closed");
-  if (m.edge_count() == 0) return EditOutcome::reject("no border polygon has been started");
-  if (auto ok = check_points(c.points); !ok.ok) return ok;
+  if (auto ok = check_continues_border(m, c); !ok.ok) return ok;
   BorderChain chain = open_border(m);
   if (c.points.back() == m.vertices.position[chain.last])
     return EditOutcome::reject("the border curve ends where it starts (at the last border vertex)");
@@ -70,9 +75,7 @@ EditOutcome append_border(Mesh& m, const EditCommand& c) {
 }
 
 EditOutcome close_border(Mesh& m, const EditCommand& c) {
-  if (has_faces(m)) return EditOutcome::reject("the border polygon is already closed");
-  if (m.edge_count() == 0) return EditOutcome::reject("no border polygon has been started");
-  if (auto ok = check_points(c.points); !ok.ok) return ok;
+  if (auto ok = check_continues_border(m, c); !ok.ok) return ok;
   BorderChain chain = open_border(m);
   double gap = (c.points.back() - m.vertices.position[chain.first]).norm();
   if (!(gap <= c.snap_distance))
@@ -309,29 +312,28 @@ EditOutcome EditHistory::redo(Mesh& mesh) {
 
 namespace {
 
+// A command's fields after its kind (a byte), as the snapshot holds them: one list for the writer and the reader.
+template <class Command, class Field>
+void for_each_command_field(Command& c, Field&& field) {
+  field(c.points);
+  field(c.face);
+  field(c.start.edge);
+  field(c.start.point);
+  field(c.end.edge);
+  field(c.end.point);
+  field(c.edge);
+  field(c.snap_distance);
+}
+
 void save_command(SnapshotWriter& out, const EditCommand& c) {
   out.put(uint8_t(c.kind));
-  out.put(c.points);
-  out.put(c.face);
-  out.put(c.start.edge);
-  out.put(c.start.point);
-  out.put(c.end.edge);
-  out.put(c.end.point);
-  out.put(c.edge);
-  out.put(c.snap_distance);
+  for_each_command_field(c, [&](const auto& value) { out.put(value); });
 }
 
 bool load_command(SnapshotReader& in, EditCommand& c) {
   uint8_t kind = 0;
   in.get(kind);
-  in.get(c.points);
-  in.get(c.face);
-  in.get(c.start.edge);
-  in.get(c.start.point);
-  in.get(c.end.edge);
-  in.get(c.end.point);
-  in.get(c.edge);
-  in.get(c.snap_distance);
+  for_each_command_field(c, [&](auto& value) { in.get(value); });
   if (kind > uint8_t(EditKind::ToggleSharp)) in.fail();
   c.kind = EditKind(kind);
   return in.ok();
