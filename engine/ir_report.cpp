@@ -24,7 +24,7 @@ bool is_non_ir_report(uint8_t id) {
 // it is a fresh remote's zeros.
 void set_slot(IrSlot& slot, uint16_t x, uint16_t y, uint8_t size, int& out_of_range) {
   if (y == kUnseenCoordinate || (x == 0 && y == 0 && size == 0)) return;
-  if (y >= 768) {
+  if (y >= kWiimoteHeight) {
     ++out_of_range;
     return;
   }

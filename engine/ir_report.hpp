@@ -13,6 +13,9 @@
 namespace fire {
 
 inline constexpr int kIrSlots = 4;
+// Image size of the Wii Remote camera as reported (128 x 96 sensor with 8x sub-pixel interpolation).
+inline constexpr int kWiimoteWidth = 1024;
+inline constexpr int kWiimoteHeight = 768;
 // A Wii Remote streams its reports at 100 Hz (measured 98.3 +- 4.0 Hz: shared/wiimote-protocol.md).
 inline constexpr int64_t kReportPeriodUs = 10'000;
 // Report lengths including the report id byte.

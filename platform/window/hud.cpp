@@ -1,3 +1,4 @@
+#include "engine/ir_report.hpp"
 #include "platform/window/hud.hpp"
 
 #include <imgui.h>
@@ -91,7 +92,7 @@ namespace {
 // The camera's 1024 x 768 image at an eighth of its size, its blobs as discs that grow with their size;
 // framed green while it sees the pen, red while it does not.
 void draw_camera(int camera, const CameraView& view) {
-  constexpr float kScale = 1.0f / 8.0f, kWidth = 1024 * kScale, kHeight = 768 * kScale;
+  constexpr float kScale = 1.0f / 8.0f, kWidth = kWiimoteWidth * kScale, kHeight = kWiimoteHeight * kScale;
   ImGui::BeginGroup();
   ImGui::Text("camera %d: %s", camera, view.pen_seen ? "pen seen" : "no light");
   const ImVec2 corner = ImGui::GetCursorScreenPos();

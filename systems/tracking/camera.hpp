@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 
 #include "engine/common.hpp"
+#include "engine/ir_report.hpp"
 
 namespace fire::tracking {
 
@@ -12,10 +13,6 @@ using Vec2 = Eigen::Vector2d;
 struct Intrinsics {
   double fx, fy, cx, cy, k1 = 0, k2 = 0;
 };
-
-// Image size of the Wii Remote camera as reported (128 x 96 sensor with 8x sub-pixel interpolation).
-inline constexpr int kWiimoteWidth = 1024;
-inline constexpr int kWiimoteHeight = 768;
 
 // 1024 x 768, about 41 x 31 degrees field of view: fx = fy = 1330, centre (512, 384), no distortion.
 Intrinsics wiimote_nominal_intrinsics();

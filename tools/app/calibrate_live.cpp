@@ -39,8 +39,8 @@ class WandCoverage {
     for (const IrSlot& s : d.report.slots) {
       if (!s.seen) continue;
       ++seen;
-      const int col = std::min(kColumns - 1, s.x * kColumns / tracking::kWiimoteWidth);
-      const int row = std::min(kRows - 1, s.y * kRows / tracking::kWiimoteHeight);
+      const int col = std::min(kColumns - 1, s.x * kColumns / kWiimoteWidth);
+      const int row = std::min(kRows - 1, s.y * kRows / kWiimoteHeight);
       c.cells[size_t(row * kColumns + col)] = true;
     }
     c.samples += seen == 2;
