@@ -26,13 +26,6 @@ struct EditCommand {
   double snap_distance = 0;  // CloseBorder: how far the last point may lie from the first vertex
 };
 
-struct EditOutcome {
-  bool ok = false;
-  std::string reason;  // why a command was rejected
-  static EditOutcome success() { return {true, {}}; }
-  static EditOutcome reject(std::string why) { return {false, std::move(why)}; }
-};
-
 // A request from the sketch system to the split system.
 enum class RequestKind : uint8_t { Edit, Undo, Redo };
 

@@ -83,7 +83,7 @@ Mesh build_by_splitting(bool history, double& seconds) {
     c.kind = side == 0 ? EditKind::StartBorder : side == 3 ? EditKind::CloseBorder : EditKind::AppendBorder;
     c.points = straight(corner[side], corner[(side + 1) % 4], kBorderPoints);
     c.snap_distance = 1e-9;
-    if (auto r = apply(c); !r.ok) die("border: " + r.reason);
+    if (auto r = apply(c); !r.ok()) die("border: " + r.error);
   }
   // Faces are convex (the square cut by straight chords), so every chord stays inside its face. Ends
   // are interior points of the face's two longest polylines: no 2-gons or doubled edges, which OpenMesh
@@ -107,7 +107,7 @@ Mesh build_by_splitting(bool history, double& seconds) {
     c.start = {edges[0], mesh.edges.point_count[edges[0]] / 2};
     c.end = {edges[1], mesh.edges.point_count[edges[1]] / 2};
     c.points = straight(mesh.polyline(edges[0])[c.start.point], mesh.polyline(edges[1])[c.end.point], kCurvePoints);
-    if (auto r = apply(c); !r.ok) die("split: " + r.reason);
+    if (auto r = apply(c); !r.ok()) die("split: " + r.error);
   }
   seconds = cpu_now() - t0;
   if (auto why = mesh.validate(); !why.empty()) die("invalid network: " + why);

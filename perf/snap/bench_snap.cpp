@@ -101,7 +101,7 @@ Mesh draw_network(size_t target, SnapIndex* index) {
     c.kind = side == 0 ? EditKind::StartBorder : side == 3 ? EditKind::CloseBorder : EditKind::AppendBorder;
     c.points = stroke(corner[side], corner[(side + 1) % 4], side_points, 0, 0);
     c.snap_distance = 1e-9;
-    if (auto r = execute_edit(mesh, c); !r.ok) die("border: " + r.reason);
+    if (auto r = execute_edit(mesh, c); !r.ok()) die("border: " + r.error);
     sync();
   }
   std::mt19937_64 rng(kSeed);
@@ -127,7 +127,7 @@ Mesh draw_network(size_t target, SnapIndex* index) {
     c.end = inner(edges[1]);
     c.points = stroke(mesh.polyline(c.start.edge)[c.start.point], mesh.polyline(c.end.edge)[c.end.point], kCurvePoints,
                       0.05 * unit(rng), 0.002 * unit(rng));
-    if (auto r = execute_edit(mesh, c); !r.ok) die("split: " + r.reason);
+    if (auto r = execute_edit(mesh, c); !r.ok()) die("split: " + r.error);
     sync();
     points += kCurvePoints + 2;  // the curve, and the two points its ends add to the edges they split
   }

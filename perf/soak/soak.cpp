@@ -64,8 +64,8 @@ bool draw_border(Mesh& mesh, EditHistory& history, std::mt19937_64& rng, std::st
       const double s = k / 11.0;
       c.points.push_back(a + (b - a) * s + Vec3(0, 0, 0.3 * std::sin(M_PI * s)));
     }
-    if (auto r = history.apply(mesh, c); !r.ok) {
-      why = "border side " + std::to_string(side) + ": " + r.reason;
+    if (auto r = history.apply(mesh, c); !r.ok()) {
+      why = "border side " + std::to_string(side) + ": " + r.error;
       return false;
     }
   }
@@ -123,8 +123,7 @@ int main(int argc, char** argv) {
   for (uint64_t op = 1; op <= s.operations; ++op) {
     mesh.begin_frame(op);
     const uint64_t dice = rng() % 1000;
-    EditOutcome r;
-    r.ok = true;
+    Status r;  // success unless an operation below says otherwise
     if (dice == 0) {
       // A new drawing: everything forgotten, a fresh border.
       mesh = Mesh();
@@ -150,7 +149,7 @@ int main(int argc, char** argv) {
     } else {
       r = history.redo(mesh);
     }
-    (r.ok ? applied : rejected) += 1;
+    (r.ok() ? applied : rejected) += 1;
     if (auto bad = mesh.validate(); !bad.empty()) return fail(op, "pools: " + bad);
     snap.sync(mesh);
     if (op % s.surface_every == 0) {

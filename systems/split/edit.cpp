@@ -10,11 +10,11 @@ namespace {
 
 std::string str(uint32_t x) { return std::to_string(x); }
 
-EditOutcome check_points(const std::vector<Vec3>& points) {
-  if (points.size() < 2) return EditOutcome::reject("a curve needs at least 2 points, got " + str(uint32_t(points.size())));
+Status check_points(const std::vector<Vec3>& points) {
+  if (points.size() < 2) return Status::failure("a curve needs at least 2 points, got " + str(uint32_t(points.size())));
   for (size_t i = 0; i < points.size(); ++i)
-    if (!is_finite(points[i])) return EditOutcome::reject("curve point " + str(uint32_t(i)) + " is not finite (NaN or infinity)");
-  return EditOutcome::success();
+    if (!is_finite(points[i])) return Status::failure("curve point " + str(uint32_t(i)) + " is not finite (NaN or infinity)");
+  return Status::success();
 }
 
 bool has_faces(const Mesh& m) { return m.face_count() > 0; }
@@ -45,47 +45,47 @@ BorderChain open_border(const Mesh& m) {
 }
 
 // What append and close ask before the curve goes on from the open border's last vertex.
-EditOutcome check_continues_border(const Mesh& m, const EditCommand& c) {
-  if (has_faces(m)) return EditOutcome::reject("the border polygon is already closed");
-  if (m.edge_count() == 0) return EditOutcome::reject("no border polygon has been started");
+Status check_continues_border(const Mesh& m, const EditCommand& c) {
+  if (has_faces(m)) return Status::failure("the border polygon is already closed");
+  if (m.edge_count() == 0) return Status::failure("no border polygon has been started");
   return check_points(c.points);
 }
 
-EditOutcome start_border(Mesh& m, const EditCommand& c) {
-  if (m.edge_count() > 0) return EditOutcome::reject("a border polygon already exists");
-  if (auto ok = check_points(c.points); !ok.ok) return ok;
-  if (c.points.front() == c.points.back()) return EditOutcome::reject("the first border curve ends where it starts");
+Status start_border(Mesh& m, const EditCommand& c) {
+  if (m.edge_count() > 0) return Status::failure("a border polygon already exists");
+  if (auto ok = check_points(c.points); !ok.ok()) return ok;
+  if (c.points.front() == c.points.back()) return Status::failure("the first border curve ends where it starts");
   uint32_t a = m.add_vertex(c.points.front());
   uint32_t b = m.add_vertex(c.points.back());
   m.add_edge(a, b, c.points);
-  return EditOutcome::success();
+  return Status::success();
 }
 
-EditOutcome append_border(Mesh& m, const EditCommand& c) {
-  if (auto ok = check_continues_border(m, c); !ok.ok) return ok;
+Status append_border(Mesh& m, const EditCommand& c) {
+  if (auto ok = check_continues_border(m, c); !ok.ok()) return ok;
   BorderChain chain = open_border(m);
   if (c.points.back() == m.vertices.position[chain.last])
-    return EditOutcome::reject("the border curve ends where it starts (at the last border vertex)");
+    return Status::failure("the border curve ends where it starts (at the last border vertex)");
   for (uint32_t v = 0; v < m.vertex_slots(); ++v)
     if (m.vertex_alive(v) && m.vertices.position[v] == c.points.back())
-      return EditOutcome::reject("the border curve ends on existing vertex " + str(v) + "; close the border instead");
+      return Status::failure("the border curve ends on existing vertex " + str(v) + "; close the border instead");
   uint32_t b = m.add_vertex(c.points.back());
   m.add_edge(chain.last, b, c.points);
-  return EditOutcome::success();
+  return Status::success();
 }
 
-EditOutcome close_border(Mesh& m, const EditCommand& c) {
-  if (auto ok = check_continues_border(m, c); !ok.ok) return ok;
+Status close_border(Mesh& m, const EditCommand& c) {
+  if (auto ok = check_continues_border(m, c); !ok.ok()) return ok;
   BorderChain chain = open_border(m);
   double gap = (c.points.back() - m.vertices.position[chain.first]).norm();
   if (!(gap <= c.snap_distance))
-    return EditOutcome::reject("the closing curve ends " + std::to_string(gap) + " from the first border vertex, farther than the snap distance " + std::to_string(c.snap_distance));
+    return Status::failure("the closing curve ends " + std::to_string(gap) + " from the first border vertex, farther than the snap distance " + std::to_string(c.snap_distance));
   uint32_t e = m.add_edge(chain.last, chain.first, c.points);
   std::vector<uint32_t> loop;
   for (uint32_t x : chain.edges) loop.push_back(make_oriented(x, false));
   loop.push_back(make_oriented(e, false));
-  if (m.add_face(loop) == kNone) return EditOutcome::reject("internal: the border does not form a closed loop");
-  return EditOutcome::success();
+  if (m.add_face(loop) == kNone) return Status::failure("internal: the border does not form a closed loop");
+  return Status::success();
 }
 
 // Replaces the oriented edge `old` in f's loop by `with` (already oriented in f's walking direction).
@@ -105,12 +105,12 @@ struct ResolvedEnd {
   uint32_t point = 0;
 };
 
-EditOutcome resolve_end(const Mesh& m, uint32_t f, const CurveEnd& end, const char* which, ResolvedEnd& out) {
-  if (!m.edge_alive(end.edge)) return EditOutcome::reject(std::string("the curve's ") + which + " names edge " + str(end.edge) + ", which does not exist");
+Status resolve_end(const Mesh& m, uint32_t f, const CurveEnd& end, const char* which, ResolvedEnd& out) {
+  if (!m.edge_alive(end.edge)) return Status::failure(std::string("the curve's ") + which + " names edge " + str(end.edge) + ", which does not exist");
   if (m.loop_position(f, end.edge) == kNone)
-    return EditOutcome::reject(std::string("the curve's ") + which + " lies on edge " + str(end.edge) + ", which is not on face " + str(f) + ": a curve must start and end on the same face");
+    return Status::failure(std::string("the curve's ") + which + " lies on edge " + str(end.edge) + ", which is not on face " + str(f) + ": a curve must start and end on the same face");
   uint32_t count = m.edges.point_count[end.edge];
-  if (end.point >= count) return EditOutcome::reject(std::string("the curve's ") + which + " names point " + str(end.point) + " of edge " + str(end.edge) + ", which has " + str(count));
+  if (end.point >= count) return Status::failure(std::string("the curve's ") + which + " names point " + str(end.point) + " of edge " + str(end.edge) + ", which has " + str(count));
   out = {};
   if (end.point == 0) out.vertex = m.edges.vertex[end.edge][0];
   else if (end.point == count - 1) out.vertex = m.edges.vertex[end.edge][1];
@@ -118,20 +118,20 @@ EditOutcome resolve_end(const Mesh& m, uint32_t f, const CurveEnd& end, const ch
     out.edge = end.edge;
     out.point = end.point;
   }
-  return EditOutcome::success();
+  return Status::success();
 }
 
-EditOutcome split_face(Mesh& m, const EditCommand& c) {
-  if (!has_faces(m)) return EditOutcome::reject("close the border polygon before splitting faces");
-  if (!m.face_alive(c.face)) return EditOutcome::reject("face " + str(c.face) + " does not exist");
-  if (auto ok = check_points(c.points); !ok.ok) return ok;
+Status split_face(Mesh& m, const EditCommand& c) {
+  if (!has_faces(m)) return Status::failure("close the border polygon before splitting faces");
+  if (!m.face_alive(c.face)) return Status::failure("face " + str(c.face) + " does not exist");
+  if (auto ok = check_points(c.points); !ok.ok()) return ok;
   ResolvedEnd a, b;
-  if (auto ok = resolve_end(m, c.face, c.start, "start", a); !ok.ok) return ok;
-  if (auto ok = resolve_end(m, c.face, c.end, "end", b); !ok.ok) return ok;
+  if (auto ok = resolve_end(m, c.face, c.start, "start", a); !ok.ok()) return ok;
+  if (auto ok = resolve_end(m, c.face, c.end, "end", b); !ok.ok()) return ok;
   if (a.vertex != kNone && a.vertex == b.vertex)
-    return EditOutcome::reject("the curve starts and ends on vertex " + str(a.vertex) + ": it would make a face with fewer than 2 edges");
+    return Status::failure("the curve starts and ends on vertex " + str(a.vertex) + ": it would make a face with fewer than 2 edges");
   if (a.edge != kNone && a.edge == b.edge)
-    return EditOutcome::reject("the curve starts and ends on the same edge " + str(a.edge) + ": it must join two different edges of the face");
+    return Status::failure("the curve starts and ends on the same edge " + str(a.edge) + ": it must join two different edges of the face");
 
   // Steps 1-2 of thesis 5.4.2: split the edges the curve ends on; faces on both sides are updated.
   uint32_t va = a.vertex != kNone ? a.vertex : split_edge(m, a.edge, a.point);
@@ -152,7 +152,7 @@ EditOutcome split_face(Mesh& m, const EditCommand& c) {
   second.push_back(make_oriented(e, false));
   m.set_face_loop(c.face, first);
   m.add_face(second);
-  return EditOutcome::success();
+  return Status::success();
 }
 
 // Joins the two edges at a split vertex that no curve needs any more (valence 2), undoing an edge split.
@@ -192,12 +192,12 @@ void join_at(Mesh& m, uint32_t v) {
   m.remove_vertex(v);
 }
 
-EditOutcome delete_curve(Mesh& m, const EditCommand& c) {
+Status delete_curve(Mesh& m, const EditCommand& c) {
   uint32_t e = c.edge;
-  if (!m.edge_alive(e)) return EditOutcome::reject("edge " + str(e) + " does not exist");
-  if (!has_faces(m)) return EditOutcome::reject("curves can be deleted once the border polygon is closed");
+  if (!m.edge_alive(e)) return Status::failure("edge " + str(e) + " does not exist");
+  if (!has_faces(m)) return Status::failure("curves can be deleted once the border polygon is closed");
   uint32_t f0 = m.edges.face[e][0], f1 = m.edges.face[e][1];
-  if (f0 == kNone || f1 == kNone) return EditOutcome::reject("edge " + str(e) + " is on the border polygon; only curves inside it can be deleted");
+  if (f0 == kNone || f1 == kNone) return Status::failure("edge " + str(e) + " is on the border polygon; only curves inside it can be deleted");
   // The merged face walks f0 after e, then f1 after e: it must stay a simple loop.
   std::vector<uint32_t> merged;
   auto append_after = [&](uint32_t f) {
@@ -214,28 +214,28 @@ EditOutcome delete_curve(Mesh& m, const EditCommand& c) {
   }
   std::sort(seen_edges.begin(), seen_edges.end());
   if (std::adjacent_find(seen_edges.begin(), seen_edges.end()) != seen_edges.end())
-    return EditOutcome::reject("faces " + str(f0) + " and " + str(f1) + " share another edge besides " + str(e) + "; deleting it would make a face that touches itself");
+    return Status::failure("faces " + str(f0) + " and " + str(f1) + " share another edge besides " + str(e) + "; deleting it would make a face that touches itself");
   std::sort(seen_vertices.begin(), seen_vertices.end());
   if (std::adjacent_find(seen_vertices.begin(), seen_vertices.end()) != seen_vertices.end())
-    return EditOutcome::reject("faces " + str(f0) + " and " + str(f1) + " also meet at a vertex; deleting edge " + str(e) + " would pinch the merged face");
-  if (merged.size() < 2) return EditOutcome::reject("deleting edge " + str(e) + " would leave a face with fewer than 2 edges");
+    return Status::failure("faces " + str(f0) + " and " + str(f1) + " also meet at a vertex; deleting edge " + str(e) + " would pinch the merged face");
+  if (merged.size() < 2) return Status::failure("deleting edge " + str(e) + " would leave a face with fewer than 2 edges");
   const auto ends = m.edges.vertex[e];
   m.remove_face(f1);
   m.set_face_loop(f0, merged);
   m.remove_edge(e);
   join_at(m, ends[0]);
   join_at(m, ends[1]);
-  return EditOutcome::success();
+  return Status::success();
 }
 
 // A crease for subdivision along an inner curve; the border is a crease already.
-EditOutcome toggle_sharp(Mesh& m, const EditCommand& c) {
+Status toggle_sharp(Mesh& m, const EditCommand& c) {
   const uint32_t e = c.edge;
-  if (!m.edge_alive(e)) return EditOutcome::reject("edge " + str(e) + " does not exist");
+  if (!m.edge_alive(e)) return Status::failure("edge " + str(e) + " does not exist");
   if (m.is_border_edge(e))
-    return EditOutcome::reject("edge " + str(e) + " is on the border polygon, which is always a crease; only curves inside it can be marked sharp");
+    return Status::failure("edge " + str(e) + " is on the border polygon, which is always a crease; only curves inside it can be marked sharp");
   m.set_edge_flag(e, kSharpEdge, !(m.edges.flags[e] & kSharpEdge));
-  return EditOutcome::success();
+  return Status::success();
 }
 
 }  // namespace
@@ -260,7 +260,7 @@ uint32_t split_edge(Mesh& m, uint32_t e, uint32_t point) {
   return v;
 }
 
-EditOutcome execute_edit(Mesh& mesh, const EditCommand& c) {
+Status execute_edit(Mesh& mesh, const EditCommand& c) {
   switch (c.kind) {
     case EditKind::StartBorder: return start_border(mesh, c);
     case EditKind::AppendBorder: return append_border(mesh, c);
@@ -269,21 +269,21 @@ EditOutcome execute_edit(Mesh& mesh, const EditCommand& c) {
     case EditKind::DeleteCurve: return delete_curve(mesh, c);
     case EditKind::ToggleSharp: return toggle_sharp(mesh, c);
   }
-  return EditOutcome::reject("unknown edit command");
+  return Status::failure("unknown edit command");
 }
 
-EditOutcome EditHistory::run(Mesh& mesh, const EditCommand& command) {
+Status EditHistory::run(Mesh& mesh, const EditCommand& command) {
   MeshMark mark = mesh.begin_transaction();
-  EditOutcome outcome = execute_edit(mesh, command);
+  Status outcome = execute_edit(mesh, command);
   mesh.end_transaction();
-  if (outcome.ok) undo_.push_back({command, std::move(mark)});
+  if (outcome.ok()) undo_.push_back({command, std::move(mark)});
   else mesh.rollback(mark);  // commands check before they write, so this only guards against surprises
   return outcome;
 }
 
-EditOutcome EditHistory::apply(Mesh& mesh, const EditCommand& command) {
-  EditOutcome outcome = run(mesh, command);
-  if (outcome.ok) redo_.clear();
+Status EditHistory::apply(Mesh& mesh, const EditCommand& command) {
+  Status outcome = run(mesh, command);
+  if (outcome.ok()) redo_.clear();
   return outcome;
 }
 
@@ -293,20 +293,20 @@ const EditCommand* EditHistory::last_drawn() const {
   return nullptr;
 }
 
-EditOutcome EditHistory::undo(Mesh& mesh) {
-  if (undo_.empty()) return EditOutcome::reject("nothing to undo");
+Status EditHistory::undo(Mesh& mesh) {
+  if (undo_.empty()) return Status::failure("nothing to undo");
   mesh.rollback(undo_.back().mark);
   redo_.push_back(std::move(undo_.back().command));
   undo_.pop_back();
-  return EditOutcome::success();
+  return Status::success();
 }
 
-EditOutcome EditHistory::redo(Mesh& mesh) {
-  if (redo_.empty()) return EditOutcome::reject("nothing to redo");
+Status EditHistory::redo(Mesh& mesh) {
+  if (redo_.empty()) return Status::failure("nothing to redo");
   EditCommand command = std::move(redo_.back());
   redo_.pop_back();
-  EditOutcome outcome = run(mesh, command);
-  if (!outcome.ok) redo_.push_back(std::move(command));
+  Status outcome = run(mesh, command);
+  if (!outcome.ok()) redo_.push_back(std::move(command));
   return outcome;
 }
 

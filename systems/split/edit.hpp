@@ -17,7 +17,7 @@ namespace fire {
 // snap_distance of the first vertex, and creates the first face. SplitFace and DeleteCurve need a
 // closed border. ToggleSharp flips an inner curve's sharp flag (a crease of the surface); border curves are
 // creases already and are refused.
-EditOutcome execute_edit(Mesh& mesh, const EditCommand& command);
+Status execute_edit(Mesh& mesh, const EditCommand& command);
 
 // Splits edge e at interior polyline point `point` (0 < point < count-1): a new vertex and two edges
 // replace e in every face that uses it. Returns the new vertex. Exposed for tools and tests.
@@ -27,9 +27,9 @@ uint32_t split_edge(Mesh& mesh, uint32_t e, uint32_t point);
 // deterministic from the restored state.
 class EditHistory {
  public:
-  EditOutcome apply(Mesh& mesh, const EditCommand& command);
-  EditOutcome undo(Mesh& mesh);
-  EditOutcome redo(Mesh& mesh);
+  Status apply(Mesh& mesh, const EditCommand& command);
+  Status undo(Mesh& mesh);
+  Status redo(Mesh& mesh);
   size_t undo_depth() const { return undo_.size(); }
   size_t redo_depth() const { return redo_.size(); }
   // The newest command on the undo stack that drew a curve (a border or split kind); nullptr when none:
@@ -44,7 +44,7 @@ class EditHistory {
   bool load(SnapshotReader& in, const Mesh& mesh);
 
  private:
-  EditOutcome run(Mesh& mesh, const EditCommand& command);
+  Status run(Mesh& mesh, const EditCommand& command);
   struct Entry {
     EditCommand command;
     MeshMark mark;

@@ -13,7 +13,7 @@ using Catch::Matchers::Contains;
 TEST_CASE("network file round-trips exactly", "[files]") {
   EditHistory h;
   Mesh m = square(&h);
-  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, {{0.5, 0, 0}, {0.1 + 0.2, 0.3333333333333333, 1e-300}, {0.5, 1, 0}})).ok);
+  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, {{0.5, 0, 0}, {0.1 + 0.2, 0.3333333333333333, 1e-300}, {0.5, 1, 0}})).ok());
   m.compact();
   std::string text = network_to_json(m);
   auto back = network_from_json(text, "net.json");

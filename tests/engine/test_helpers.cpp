@@ -16,8 +16,8 @@ Mesh square(EditHistory* history) {
   Mesh m;
   const Vec3 c[4] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
   auto run = [&](EditCommand cmd) {
-    EditOutcome r = history ? history->apply(m, cmd) : execute_edit(m, cmd);
-    REQUIRE(r.ok);
+    Status r = history ? history->apply(m, cmd) : execute_edit(m, cmd);
+    REQUIRE(r.ok());
     REQUIRE(m.validate() == "");
   };
   run(make(EditKind::StartBorder, line(c[0], c[1])));

@@ -27,10 +27,10 @@ TEST_CASE("10,000 random edits keep every invariant", "[random]") {
   for (int step = 0; step < 10000; ++step) {
     uint64_t dice = rng() % 100;
     uint64_t before = m.hash();
-    EditOutcome r;
+    Status r;
     if (dice < 55) {
       r = h.apply(m, random_split(m, rng, 8));
-      s.splits += r.ok;
+      s.splits += r.ok();
     } else if (dice < 70) {
       std::vector<uint32_t> interior;
       for (uint32_t e = 0; e < m.edge_slots(); ++e)
@@ -38,24 +38,24 @@ TEST_CASE("10,000 random edits keep every invariant", "[random]") {
       EditCommand del = make(EditKind::DeleteCurve);
       del.edge = interior.empty() ? 0 : interior[rng() % interior.size()];
       r = h.apply(m, del);
-      s.deletes += r.ok;
+      s.deletes += r.ok();
     } else if (dice < 88) {
       r = h.undo(m);
-      s.undos += r.ok;
+      s.undos += r.ok();
     } else {
       r = h.redo(m);
-      s.redos += r.ok;
+      s.redos += r.ok();
     }
-    if (!r.ok) {
+    if (!r.ok()) {
       ++s.rejected;
       REQUIRE(m.hash() == before);
     }
-    INFO("step " << step << ": " << r.reason);
+    INFO("step " << step << ": " << r.error);
     REQUIRE(m.validate() == "");
     if (step % 500 == 0 && h.undo_depth() > 0) {
       Mesh snapshot = m;
-      REQUIRE(h.undo(m).ok);
-      REQUIRE(h.redo(m).ok);
+      REQUIRE(h.undo(m).ok());
+      REQUIRE(h.redo(m).ok());
       REQUIRE(m.same_pools(snapshot));
     }
   }

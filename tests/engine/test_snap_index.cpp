@@ -127,7 +127,7 @@ TEST_CASE("the index follows explicit lists of changed slots", "[snap]") {
 
   // Split the square: edge 0 is replaced, new edges appear; hand over exactly what changed.
   Mesh before = m;
-  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line(at(m, 0, 2), at(m, 2, 2), 11))).ok);
+  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line(at(m, 0, 2), at(m, 2, 2), 11))).ok());
   const std::vector<uint32_t> changed = diff_slots(before, m);
   CHECK(!changed.empty());
   index.update(m, changed);
@@ -138,7 +138,7 @@ TEST_CASE("the index follows explicit lists of changed slots", "[snap]") {
 
   // Undo truncates the pools: the slots past the end go even if the list does not name them.
   before = m;
-  REQUIRE(h.undo(m).ok);
+  REQUIRE(h.undo(m).ok());
   CHECK(m.edge_slots() < before.edge_slots());
   index.update(m, std::vector<uint32_t>{});
   CHECK(index.validate(m) != "");  // edge 0's restored polyline is not handed over yet
@@ -147,14 +147,14 @@ TEST_CASE("the index follows explicit lists of changed slots", "[snap]") {
 
   // Compaction relabels; the index follows without touching geometry.
   before = m;
-  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line(at(m, 0, 2), at(m, 2, 2), 11))).ok);
+  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line(at(m, 0, 2), at(m, 2, 2), 11))).ok());
   index.update(m, diff_slots(before, m));
   uint32_t interior = kNone;
   for (uint32_t e = 0; e < m.edge_slots(); ++e)
     if (m.edge_alive(e) && !m.is_border_edge(e)) interior = e;
   REQUIRE(interior != kNone);
   before = m;
-  REQUIRE(h.apply(m, remove(interior)).ok);
+  REQUIRE(h.apply(m, remove(interior)).ok());
   index.update(m, diff_slots(before, m));
   REQUIRE(index.validate(m) == "");
   h.clear(m);

@@ -14,20 +14,20 @@ namespace {
 // Runs `cmd` through a history and checks undo gives back the pools before it, and redo the pools after it.
 void apply_undo_redo(Mesh& m, EditHistory& h, const EditCommand& cmd) {
   Mesh before = m;
-  REQUIRE(h.apply(m, cmd).ok);
+  REQUIRE(h.apply(m, cmd).ok());
   REQUIRE(m.validate() == "");
   Mesh after = m;
-  REQUIRE(h.undo(m).ok);
+  REQUIRE(h.undo(m).ok());
   REQUIRE(m.validate() == "");
   CHECK(m.same_pools(before));
   CHECK(m.hash() == before.hash());
-  REQUIRE(h.redo(m).ok);
+  REQUIRE(h.redo(m).ok());
   CHECK(m.same_pools(after));
 }
 
 // The square split in half by a vertical curve (through `h`); returns that curve's edge.
 uint32_t split_square(Mesh& m, EditHistory& h) {
-  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok);
+  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok());
   uint32_t middle = kNone;
   for (uint32_t e = 0; e < m.edge_slots(); ++e)
     if (m.edge_alive(e) && !m.is_border_edge(e)) middle = e;
@@ -136,7 +136,7 @@ TEST_CASE("split between adjacent vertices makes a two-sided face", "[split]") {
 TEST_CASE("splitting an interior edge updates the face on its other side", "[split]") {
   EditHistory h;
   Mesh m = square(&h);
-  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}, 5))).ok);
+  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}, 5))).ok());
   uint32_t middle = kNone, right = kNone;
   for (uint32_t e = 0; e < m.edge_slots(); ++e) {
     if (!m.edge_alive(e)) continue;
@@ -158,7 +158,7 @@ TEST_CASE("splitting an interior edge updates the face on its other side", "[spl
 TEST_CASE("every bad edit is rejected with a reason and changes nothing", "[split][reject]") {
   EditHistory h;
   Mesh m = square(&h);
-  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok);
+  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok());
   const uint32_t left = m.edges.face[3][0];
   const uint32_t right = m.edges.face[1][0];
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -187,9 +187,9 @@ TEST_CASE("every bad edit is rejected with a reason and changes nothing", "[spli
   for (const Case& c : cases) {
     INFO(c.name);
     Mesh before = m;
-    EditOutcome r = h.apply(m, c.cmd);
-    CHECK_FALSE(r.ok);
-    CHECK_THAT(r.reason, Catch::Matchers::Contains(c.reason_part));
+    Status r = h.apply(m, c.cmd);
+    CHECK_FALSE(r.ok());
+    CHECK_THAT(r.error, Catch::Matchers::Contains(c.reason_part));
     CHECK(m.same_pools(before));
     CHECK(m.validate() == "");
   }
@@ -197,22 +197,22 @@ TEST_CASE("every bad edit is rejected with a reason and changes nothing", "[spli
 
 TEST_CASE("border rejections", "[split][reject]") {
   Mesh m;
-  CHECK_FALSE(execute_edit(m, make(EditKind::AppendBorder, line({0, 0, 0}, {1, 0, 0}))).ok);
-  CHECK_FALSE(execute_edit(m, split(0, {0, 0}, {0, 1}, line({0, 0, 0}, {1, 0, 0}))).ok);
-  CHECK_FALSE(execute_edit(m, make(EditKind::StartBorder, {{0, 0, 0}, {0, 0, 0}})).ok);
-  REQUIRE(execute_edit(m, make(EditKind::StartBorder, line({0, 0, 0}, {1, 0, 0}))).ok);
-  REQUIRE(execute_edit(m, make(EditKind::AppendBorder, line({1, 0, 0}, {1, 1, 0}))).ok);
+  CHECK_FALSE(execute_edit(m, make(EditKind::AppendBorder, line({0, 0, 0}, {1, 0, 0}))).ok());
+  CHECK_FALSE(execute_edit(m, split(0, {0, 0}, {0, 1}, line({0, 0, 0}, {1, 0, 0}))).ok());
+  CHECK_FALSE(execute_edit(m, make(EditKind::StartBorder, {{0, 0, 0}, {0, 0, 0}})).ok());
+  REQUIRE(execute_edit(m, make(EditKind::StartBorder, line({0, 0, 0}, {1, 0, 0}))).ok());
+  REQUIRE(execute_edit(m, make(EditKind::AppendBorder, line({1, 0, 0}, {1, 1, 0}))).ok());
   EditCommand far = make(EditKind::CloseBorder, line({1, 1, 0}, {0.2, 0, 0}));
   far.snap_distance = 0.01;
   Mesh before = m;
-  EditOutcome r = execute_edit(m, far);
-  CHECK_FALSE(r.ok);
-  CHECK_THAT(r.reason, Catch::Matchers::Contains("snap distance"));
+  Status r = execute_edit(m, far);
+  CHECK_FALSE(r.ok());
+  CHECK_THAT(r.error, Catch::Matchers::Contains("snap distance"));
   CHECK(m.same_pools(before));
   CHECK(m.face_count() == 0);
   EditCommand near = make(EditKind::CloseBorder, line({1, 1, 0}, {0.005, 0, 0}));
   near.snap_distance = 0.01;
-  REQUIRE(execute_edit(m, near).ok);
+  REQUIRE(execute_edit(m, near).ok());
   CHECK(face_sizes(m) == std::vector<uint32_t>{3});
   CHECK(m.validate() == "");
 }
@@ -240,7 +240,7 @@ TEST_CASE("deleting a curve merges its faces and joins the edge splits it needed
 TEST_CASE("deleting a curve keeps a vertex other curves still need", "[split][delete]") {
   EditHistory h;
   Mesh m = square(&h);
-  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok);
+  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok());
   // A second curve from the bottom split vertex to the top-right corner.
   uint32_t a = kNone;
   for (uint32_t v = 0; v < m.vertex_slots(); ++v)
@@ -248,7 +248,7 @@ TEST_CASE("deleting a curve keeps a vertex other curves still need", "[split][de
   uint32_t right_edge_half = edge_between(m, a, 1);
   uint32_t f = m.edges.face[right_edge_half][0] != kNone ? m.edges.face[right_edge_half][0] : m.edges.face[right_edge_half][1];
   uint32_t at_a = m.edges.vertex[right_edge_half][0] == a ? 0 : m.edges.point_count[right_edge_half] - 1;
-  REQUIRE(h.apply(m, split(f, {right_edge_half, at_a}, {1, 4}, line({0.5, 0, 0}, {1, 1, 0}))).ok);
+  REQUIRE(h.apply(m, split(f, {right_edge_half, at_a}, {1, 4}, line({0.5, 0, 0}, {1, 1, 0}))).ok());
   uint32_t middle = kNone;
   for (uint32_t e = 0; e < m.edge_slots(); ++e)
     if (m.edge_alive(e) && !m.is_border_edge(e) && m.edges.point_count[e] == 5 &&
@@ -257,7 +257,7 @@ TEST_CASE("deleting a curve keeps a vertex other curves still need", "[split][de
   REQUIRE(middle != kNone);
   EditCommand del = make(EditKind::DeleteCurve);
   del.edge = middle;
-  REQUIRE(h.apply(m, del).ok);
+  REQUIRE(h.apply(m, del).ok());
   CHECK(m.validate() == "");
   CHECK(m.vertex_alive(a));  // still holds the second curve
   CHECK(m.valence(a) == 3);
@@ -284,12 +284,12 @@ TEST_CASE("marking a curve sharp flips its flag, undoes and redoes bit for bit, 
   EditCommand border = make(EditKind::ToggleSharp);
   border.edge = edge_between(m, 1, 2);
   REQUIRE(border.edge != kNone);
-  const EditOutcome refused = h.apply(m, border);
-  CHECK_FALSE(refused.ok);
-  CHECK_THAT(refused.reason, Catch::Contains("border"));
+  const Status refused = h.apply(m, border);
+  CHECK_FALSE(refused.ok());
+  CHECK_THAT(refused.error, Catch::Contains("border"));
   EditCommand missing = make(EditKind::ToggleSharp);
   missing.edge = 999;
-  CHECK_THAT(h.apply(m, missing).reason, Catch::Contains("does not exist"));
+  CHECK_THAT(h.apply(m, missing).error, Catch::Contains("does not exist"));
   CHECK(m.same_pools(before));
   CHECK(h.undo_depth() == depth + 2);
 }
@@ -297,11 +297,11 @@ TEST_CASE("marking a curve sharp flips its flag, undoes and redoes bit for bit, 
 TEST_CASE("compaction squeezes tombstones and keeps the network", "[pools]") {
   EditHistory h;
   Mesh m = square(&h);
-  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok);
+  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok());
   EditCommand del = remove(kNone);
   for (uint32_t e = 0; e < m.edge_slots(); ++e)
     if (m.edge_alive(e) && !m.is_border_edge(e)) del.edge = e;
-  REQUIRE(h.apply(m, del).ok);  // leaves tombstones: the joined edges' slots
+  REQUIRE(h.apply(m, del).ok());  // leaves tombstones: the joined edges' slots
   REQUIRE(m.edges.free_list.size() > 0);
   size_t v = m.vertex_count(), e = m.edge_count(), f = m.face_count(), p = m.live_point_count();
   CompactionMap map = m.compact();
@@ -326,9 +326,9 @@ TEST_CASE("handles carry generations", "[pools]") {
   Mesh m = square(&h);
   EdgeId bottom = m.edge_id(0);
   CHECK(m.valid(bottom));
-  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok);
+  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok());
   CHECK_FALSE(m.valid(bottom));
-  REQUIRE(h.undo(m).ok);
+  REQUIRE(h.undo(m).ok());
   CHECK(m.valid(bottom));
 }
 
@@ -347,7 +347,7 @@ TEST_CASE("change stamps mark what an edit touched", "[pools][stamps]") {
   Mesh m = square();
   m.begin_frame(1);
   const uint32_t points_before = static_cast<uint32_t>(m.points.size());
-  REQUIRE(execute_edit(m, split(0, {0, 0}, {2, 0}, line({0, 0, 0}, {1, 1, 0}))).ok);
+  REQUIRE(execute_edit(m, split(0, {0, 0}, {2, 0}, line({0, 0, 0}, {1, 1, 0}))).ok());
   CHECK(m.faces.changes.since(0) == std::vector<uint32_t>{0, 1});
   CHECK(m.edges.changes.changed_since(1, 0));  // now walked by the new face
   CHECK_FALSE(m.vertices.changes.changed_since(1, 0));  // untouched corner
@@ -366,23 +366,23 @@ TEST_CASE("border edits undo and redo like every other edit", "[split][undo]") {
   Mesh m = square(&h);
   Mesh closed = m;
   REQUIRE(h.undo_depth() == 4);
-  REQUIRE(h.undo(m).ok);  // reopens the border
+  REQUIRE(h.undo(m).ok());  // reopens the border
   CHECK(m.face_count() == 0);
   CHECK(m.edge_count() == 3);
   CHECK(m.validate() == "");
-  while (h.undo_depth() > 0) REQUIRE(h.undo(m).ok);
+  while (h.undo_depth() > 0) REQUIRE(h.undo(m).ok());
   CHECK(m.same_pools(empty));
-  CHECK_FALSE(h.undo(m).ok);
-  while (h.redo_depth() > 0) REQUIRE(h.redo(m).ok);
+  CHECK_FALSE(h.undo(m).ok());
+  while (h.redo_depth() > 0) REQUIRE(h.redo(m).ok());
   CHECK(m.same_pools(closed));
-  CHECK_FALSE(h.redo(m).ok);
+  CHECK_FALSE(h.redo(m).ok());
   // A new edit after undo drops what could have been redone.
-  REQUIRE(h.undo(m).ok);
-  REQUIRE(h.apply(m, split(0, {0, 0}, {1, 4}, line({0, 0, 0}, {1, 1, 0}))).ok == false);  // border still open
+  REQUIRE(h.undo(m).ok());
+  REQUIRE(h.apply(m, split(0, {0, 0}, {1, 4}, line({0, 0, 0}, {1, 1, 0}))).ok() == false);  // border still open
   REQUIRE(h.redo_depth() == 1);
   EditCommand close = make(EditKind::CloseBorder, line({0, 1, 0}, {0, 0, 0}));
   close.snap_distance = 0.01;
-  REQUIRE(h.apply(m, close).ok);
+  REQUIRE(h.apply(m, close).ok());
   CHECK(h.redo_depth() == 0);
 }
 
@@ -390,12 +390,12 @@ TEST_CASE("a rejected edit leaves the stamps alone, undo stamps exactly what it 
   EditHistory h;
   Mesh m = square(&h);
   m.begin_frame(1);
-  REQUIRE_FALSE(h.apply(m, split(0, {0, 0}, {0, 0}, line({0, 0, 0}, {0, 0, 1}))).ok);
+  REQUIRE_FALSE(h.apply(m, split(0, {0, 0}, {0, 0}, line({0, 0, 0}, {0, 0, 1}))).ok());
   CHECK(m.faces.changes.since(0).empty());
   CHECK(m.edges.changes.since(0).empty());
   CHECK(m.vertices.changes.since(0).empty());
   m.begin_frame(2);
-  REQUIRE(h.undo(m).ok);  // reopens the border: removes the closing edge and the face
+  REQUIRE(h.undo(m).ok());  // reopens the border: removes the closing edge and the face
   // The face and the closing edge (slot 3) are gone, and every edge that named the face is restored.
   CHECK(m.faces.changes.since(1) == std::vector<uint32_t>{0});
   CHECK(m.edges.changes.since(1) == std::vector<uint32_t>{0, 1, 2, 3});
@@ -408,7 +408,7 @@ TEST_CASE("compaction keeps the survivors' stamps and records its map", "[pools]
   EditHistory h;
   Mesh m = square(&h);
   m.begin_frame(1);
-  REQUIRE(execute_edit(m, split(0, {0, 0}, {2, 0}, line({0, 0, 0}, {1, 1, 0}))).ok);
+  REQUIRE(execute_edit(m, split(0, {0, 0}, {2, 0}, line({0, 0, 0}, {1, 1, 0}))).ok());
   m.begin_frame(2);
   uint32_t curve = kNone;
   for (uint32_t e = 0; e < m.edge_slots(); ++e)
@@ -417,7 +417,7 @@ TEST_CASE("compaction keeps the survivors' stamps and records its map", "[pools]
   EditCommand del;
   del.kind = EditKind::DeleteCurve;
   del.edge = curve;
-  REQUIRE(execute_edit(m, del).ok);
+  REQUIRE(execute_edit(m, del).ok());
   const std::vector<uint32_t> changed_in_2 = m.edges.changes.since(1);
   m.begin_frame(3);
   CHECK(m.last_compaction().count == 0);

@@ -89,7 +89,7 @@ TEST_CASE("random edits through the frame: shown in the commit frame, settled wi
     net.begin_frame(++frame);
     const Frame edit_frame = frame;
     const uint64_t dice = rng() % 100;
-    EditOutcome r;
+    Status r;
     // Splits add faces and deletes remove them; the band keeps the network between about 10 and 40 faces.
     const bool grow = net.face_count() < 10 || (net.face_count() < 40 && dice < 55);
     if (grow) {
@@ -103,8 +103,8 @@ TEST_CASE("random edits through the frame: shown in the commit frame, settled wi
     } else {
       r = history.redo(net);
     }
-    applied += r.ok;
-    INFO("operation " << op << " (" << (r.ok ? "applied" : r.reason) << "), " << net.face_count() << " faces");
+    applied += r.ok();
+    INFO("operation " << op << " (" << (r.ok() ? "applied" : r.error) << "), " << net.face_count() << " faces");
     REQUIRE(net.validate() == "");
 
     const SurfaceLevels before = surface;
@@ -122,7 +122,7 @@ TEST_CASE("random edits through the frame: shown in the commit frame, settled wi
       continue;
     }
     REQUIRE(full.ok());
-    if (r.ok) {
+    if (r.ok()) {
       // The commit frame: the new faces shown (the final quads), provisional, the fit running.
       CHECK(surface.frame == edit_frame);
       CHECK_FALSE(surface.settled);
@@ -147,7 +147,7 @@ TEST_CASE("random edits through the frame: shown in the commit frame, settled wi
     CHECK_FALSE(build.state.fitting());
     if (rebuilt_from_scratch) {
       rebuilt_from_scratch = false;
-    } else if (r.ok) {
+    } else if (r.ok()) {
       // Faces near the edit, and those of short noisy curves the edit's change of the noise rescaled, of
       // sides whose joined vertices it changed, or of long sides split anew.
       const size_t bound =

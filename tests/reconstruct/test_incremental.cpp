@@ -74,7 +74,7 @@ TEST_CASE("adding, moving and deleting a curve on a 200-face network", "[reconst
     add.start = {j * nx + i, 4};
     add.end = {(j + 1) * nx + i, 4};
     for (int k = 0; k <= 8; ++k) add.points.emplace_back(i + 0.5, j + k / 8.0, height(i + 0.5, j + k / 8.0));
-    REQUIRE(execute_edit(net, add).ok);
+    REQUIRE(execute_edit(net, add).ok());
     REQUIRE(net.face_count() == 201);
     update(net, options, state, surface);
     // Touched: the split face's two halves and the faces below and above it, whose edges were split (4).
@@ -111,7 +111,7 @@ TEST_CASE("adding, moving and deleting a curve on a 200-face network", "[reconst
     EditCommand remove;
     remove.kind = EditKind::DeleteCurve;
     remove.edge = curve;
-    REQUIRE(execute_edit(net, remove).ok);
+    REQUIRE(execute_edit(net, remove).ok());
     REQUIRE(net.face_count() == 200);
     update(net, options, state, surface);
     // The merged face and the two faces whose split edges were joined again (3), and across their

@@ -44,7 +44,7 @@ TEST_CASE("random edits: incremental reconstruction equals a rebuild after every
   int applied = 0, thesis_refused = 0, compared = 0;
   for (int step = 0; step < 120; ++step) {
     const uint64_t dice = rng() % 100;
-    EditOutcome r;
+    Status r;
     if (dice < 60) {
       r = history.apply(net, random_split(net, rng));
     } else if (dice < 75) {
@@ -56,8 +56,8 @@ TEST_CASE("random edits: incremental reconstruction equals a rebuild after every
     } else {
       r = history.redo(net);
     }
-    applied += r.ok;
-    INFO("step " << step << " (" << (r.ok ? "applied" : r.reason) << "), " << net.face_count() << " faces");
+    applied += r.ok();
+    INFO("step " << step << " (" << (r.ok() ? "applied" : r.error) << "), " << net.face_count() << " faces");
     REQUIRE(net.validate() == "");
 
     const Status fire_status = reconstruct_update(net, fire_options, fire_state, fire_surface);

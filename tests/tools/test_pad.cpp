@@ -72,17 +72,17 @@ TEST_CASE("pad: the curve drawn last is the newest undoable curve, not an undone
   EditCommand border;
   border.kind = EditKind::StartBorder;
   border.points = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0)};
-  REQUIRE(history.apply(mesh, border).ok);
+  REQUIRE(history.apply(mesh, border).ok());
   REQUIRE(last_curve_point(history));
   CHECK(*last_curve_point(history) == Vec3(1, 0, 0));
   EditCommand next;
   next.kind = EditKind::AppendBorder;
   next.points = {Vec3(2, 0, 0), Vec3(2, 1, 0), Vec3(2, 2, 0), Vec3(2, 3, 0)};
-  REQUIRE(history.apply(mesh, next).ok);
+  REQUIRE(history.apply(mesh, next).ok());
   CHECK(*last_curve_point(history) == Vec3(2, 2, 0));
-  REQUIRE(history.undo(mesh).ok);
+  REQUIRE(history.undo(mesh).ok());
   CHECK(*last_curve_point(history) == Vec3(1, 0, 0));
-  REQUIRE(history.undo(mesh).ok);
+  REQUIRE(history.undo(mesh).ok());
   CHECK_FALSE(last_curve_point(history));
 }
 
