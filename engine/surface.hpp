@@ -1,7 +1,7 @@
 #pragma once
 // Surfaces as engine data.
 //
-// SurfaceMesh: a polygon surface, what export writes and the file readers return.
+// SurfaceMesh: a polygon surface with per-vertex normals, what export writes and the file readers return.
 // SurfaceLevels: the live surface that refine and subdivide write and the renderer, the exporters and
 // `fire eval` read: the last subdivision level's limit positions and normals, its quads as one flat
 // index array, the quads grouped by the network face they come from, a topology version, the range
@@ -12,16 +12,12 @@
 #include "engine/change.hpp"
 #include "engine/common.hpp"
 #include "engine/hash.hpp"
+#include "engine/polygon_mesh.hpp"
 
 namespace fire {
 
-struct SurfaceMesh {
-  std::vector<Vec3> positions;
-  std::vector<Vec3> normals;              // per vertex; empty when not computed
-  std::vector<uint32_t> face_offsets{0};  // face f: face_vertices[face_offsets[f] .. face_offsets[f+1])
-  std::vector<uint32_t> face_vertices;
-  size_t face_count() const { return face_offsets.size() - 1; }
-  uint32_t face_size(size_t f) const { return face_offsets[f + 1] - face_offsets[f]; }
+struct SurfaceMesh : PolygonMesh {
+  std::vector<Vec3> normals;  // per vertex; empty when not computed
 };
 
 struct SurfaceLevels {

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "engine/mesh.hpp"
+#include "engine/polygon_mesh.hpp"
 #include "engine/surface.hpp"
 #include "systems/reconstruct/face.hpp"
 
@@ -81,10 +82,7 @@ struct Options {
 
 // The base mesh handed to subdivision, and the polylines the fit follows along its edges: quads, and
 // (FIRE) polygons beside sides split more finely than the Coons steps (kLongSideRatio).
-struct BaseMesh {
-  std::vector<Vec3> positions;
-  std::vector<uint32_t> face_offsets{0};
-  std::vector<uint32_t> face_vertices;
+struct BaseMesh : PolygonMesh {
   // Per base face, the slot of the network face it was made from; a network face's base faces are
   // consecutive (the subdivide system groups the surface's quads into patches by it).
   std::vector<uint32_t> face_source;
@@ -104,7 +102,6 @@ struct BaseMesh {
   // side_curve_offsets[s] to side_curve_offsets[s + 1] - 1.
   std::vector<uint32_t> side_curve_offsets{0};
   uint32_t vertex_count() const { return static_cast<uint32_t>(positions.size()); }
-  uint32_t face_count() const { return static_cast<uint32_t>(face_offsets.size() - 1); }
   uint32_t curve_count() const { return static_cast<uint32_t>(curve_offsets.size() - 1); }
   uint32_t side_count() const { return static_cast<uint32_t>(side_curve_offsets.size() - 1); }
   std::span<const Vec3> curve(uint32_t c) const {

@@ -5,21 +5,13 @@
 // sides, which the thesis's reconstruction cannot take) and add seeded Gaussian noise to the polylines.
 #include <cstdint>
 #include <span>
-#include <string_view>
 #include <vector>
 
 #include "engine/common.hpp"
 #include "engine/mesh.hpp"
+#include "engine/polygon_mesh.hpp"
 
 namespace fire {
-
-// A polygon mesh as flat arrays (the layout of platform's PolygonMesh, which systems may not include).
-struct PolygonMeshView {
-  std::span<const Vec3> positions;
-  std::span<const uint32_t> face_offsets;   // face f uses face_vertices[face_offsets[f] .. face_offsets[f+1])
-  std::span<const uint32_t> face_vertices;  // 0-based vertex indices
-  std::string_view source;                  // names the mesh in error messages (a file name)
-};
 
 struct UnrefineOptions {
   uint32_t unrefine = 1;          // keep every K-th edge loop; 1 keeps every edge

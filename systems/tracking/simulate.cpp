@@ -393,7 +393,7 @@ struct PlacedMesh {
   Vec3 base_centre = Vec3::Zero();  // on the object's axis at its lowest point
 };
 
-Result<PlacedMesh> place_mesh(const MeshView& mesh, double height_m, double distance_m) {
+Result<PlacedMesh> place_mesh(const PolygonMeshView& mesh, double height_m, double distance_m) {
   using R = Result<PlacedMesh>;
   if (mesh.positions.empty() || mesh.face_offsets.size() < 2) return R::failure("the mesh has no faces");
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
@@ -642,7 +642,7 @@ Result<SimulatedSession> simulate_wand(const RigOptions& o, const WandOptions& w
   return run_session(o, kWandScenario, *rig, w.duration_s, scene, {}, std::move(header));
 }
 
-Result<SimulatedSession> simulate_sketch(const RigOptions& o, const SketchOptions& sk, const MeshView& mesh) {
+Result<SimulatedSession> simulate_sketch(const RigOptions& o, const SketchOptions& sk, const PolygonMeshView& mesh) {
   using R = Result<SimulatedSession>;
   Result<SimulatedRig> rig = make_simulated_rig(o);
   if (!rig) return R::failure(rig.error());
@@ -792,7 +792,7 @@ struct Step {
   std::vector<Vec3> points;  // Stroke: object frame
 };
 
-Status check_drawing(const DrawingOptions& d, const MeshView& object, const DrawingNetwork& net) {
+Status check_drawing(const DrawingOptions& d, const PolygonMeshView& object, const DrawingNetwork& net) {
   const std::pair<const char*, double> named[] = {{"speed", d.speed_m_s}, {"hold", d.hold_s}, {"mark hold", d.mark_hold_s},
                                                    {"tilt", d.tilt_deg}, {"height", d.height_m}};
   for (const auto& [name, value] : named)
@@ -858,7 +858,7 @@ Chain reversed(const DrawingNetwork&, const Chain& c) {
 
 }  // namespace
 
-Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOptions& d, const MeshView& object,
+Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOptions& d, const PolygonMeshView& object,
                                           const DrawingNetwork& net) {
   using R = Result<SimulatedDrawing>;
   Result<SimulatedRig> rig = make_simulated_rig(o);

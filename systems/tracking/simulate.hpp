@@ -28,6 +28,7 @@
 #include "engine/common.hpp"
 #include "engine/input_log.hpp"
 #include "engine/mesh.hpp"
+#include "engine/polygon_mesh.hpp"
 #include "systems/tracking/calibration.hpp"
 #include "systems/tracking/camera.hpp"
 #include "systems/tracking/track.hpp"
@@ -66,13 +67,6 @@ struct SketchOptions {
   double hold_s = 1.0;    // the pen rests this long, lit, at both ends of every stroke
   double height_m = 0.2;  // the object is scaled to this height (its +z axis is up)
   std::string mesh_name = "pawn.obj";  // recorded in the log's meta
-};
-
-// A polygon mesh passed in by the caller (systems read no files).
-struct MeshView {
-  std::span<const Vec3> positions;
-  std::span<const uint32_t> face_offsets;   // face f: face_vertices[face_offsets[f] .. face_offsets[f+1])
-  std::span<const uint32_t> face_vertices;  // 0-based
 };
 
 struct SimulationStats {
@@ -145,7 +139,7 @@ Result<std::vector<Vec3>> object_frame(std::span<const Vec3> positions, double h
 // no stroke left is seen whole by both cameras in the current pose, the object is turned to the pose that
 // sees one and registered again on the marks visible there. One split stroke is undone and drawn again. The
 // LED sits at the pen's tip, on the limit surface, where the network's points are.
-Result<SimulatedDrawing> simulate_drawing(const RigOptions& rig, const DrawingOptions& drawing, const MeshView& object,
+Result<SimulatedDrawing> simulate_drawing(const RigOptions& rig, const DrawingOptions& drawing, const PolygonMeshView& object,
                                           const DrawingNetwork& network);
 // The network to draw from a curve network (the object's K-unrefined one on its limit surface, systems/synth).
 DrawingNetwork drawing_network(const Mesh& network);
@@ -161,7 +155,7 @@ Result<SimulatedRig> make_simulated_rig(const RigOptions& rig);
 Result<std::string> true_rig_json(const RigOptions& rig);
 
 Result<SimulatedSession> simulate_wand(const RigOptions& rig, const WandOptions& wand);
-Result<SimulatedSession> simulate_sketch(const RigOptions& rig, const SketchOptions& sketch, const MeshView& mesh);
+Result<SimulatedSession> simulate_sketch(const RigOptions& rig, const SketchOptions& sketch, const PolygonMeshView& mesh);
 
 // What a simulated log says about itself, read back from its truth and meta lines.
 struct PenTruth {

@@ -24,10 +24,6 @@ PolygonMesh load(const std::string& name) {
   return *pm;
 }
 
-PolygonMeshView view_of(const PolygonMesh& pm, std::string_view source) {
-  return {pm.positions, pm.face_offsets, pm.face_vertices, source};
-}
-
 Result<Mesh> network(const PolygonMesh& pm, uint32_t k, double noise = 0, uint64_t seed = 0,
                      uint32_t samples = kMinSamplesPerEdge) {
   UnrefineOptions o;
@@ -35,7 +31,7 @@ Result<Mesh> network(const PolygonMesh& pm, uint32_t k, double noise = 0, uint64
   o.noise_percent = noise;
   o.seed = seed;
   o.samples_per_edge = samples;
-  return network_from_mesh(view_of(pm, "test.obj"), o);
+  return network_from_mesh(pm.view("test.obj"), o);
 }
 
 std::map<uint32_t, size_t> face_sizes(const Mesh& m) {
@@ -290,7 +286,7 @@ TEST_CASE("correlated noise keeps its deviation and varies smoothly along each p
     o.noise_correlation_percent = correlation;
     o.seed = 42;
     o.samples_per_edge = 32;
-    return network_from_mesh(view_of(torus, "torus.obj"), o);
+    return network_from_mesh(torus.view("torus.obj"), o);
   };
   auto clean = network(torus, 2, 0.0, 0, 32);
   auto independent = noisy(0.0), correlated = noisy(50.0);
@@ -327,12 +323,12 @@ TEST_CASE("correlated noise keeps its deviation and varies smoothly along each p
   CHECK(correlated_lag1 > 0.9);
   UnrefineOptions bad;
   bad.noise_correlation_percent = -1;
-  CHECK_THAT(network_from_mesh(view_of(torus, "torus.obj"), bad).error(), Catch::Contains("noise correlation length"));
+  CHECK_THAT(network_from_mesh(torus.view("torus.obj"), bad).error(), Catch::Contains("noise correlation length"));
 }
 
 TEST_CASE("fan.obj is non-manifold: the error names an edge shared by 3 faces", "[synth]") {
   PolygonMesh fan = load("fan.obj");
-  auto net = network_from_mesh(view_of(fan, "fan.obj"), UnrefineOptions{});
+  auto net = network_from_mesh(fan.view("fan.obj"), UnrefineOptions{});
   REQUIRE_FALSE(net.ok());
   CHECK(net.error() ==
         "fan.obj: edge between vertices 8 and 9 (OBJ numbering) is shared by 3 faces; a polyline mesh needs a manifold mesh");
@@ -351,7 +347,7 @@ TEST_CASE("faces walking an edge the same way are rejected", "[synth]") {
 TEST_CASE("an unrefinement too coarse for the mesh is refused with the reason", "[synth]") {
   // The torus has 4 loops around its tube: K=4 keeps one, which cannot bound disks.
   PolygonMesh torus = load("torus.obj");
-  auto net = network_from_mesh(view_of(torus, "torus.obj"), UnrefineOptions{4});
+  auto net = network_from_mesh(torus.view("torus.obj"), UnrefineOptions{4});
   REQUIRE_FALSE(net.ok());
   CHECK_THAT(net.error(), Catch::StartsWith("unrefine 4 too coarse for torus.obj: the region merged from") &&
                               Catch::Contains("is not a disk"));
@@ -428,7 +424,7 @@ TEST_CASE("limit sampling: every polyline point lies on the control mesh's Catmu
     UnrefineOptions o;
     o.unrefine = 2;
     o.limit = true;
-    auto net = network_from_mesh(view_of(pm, name), o);
+    auto net = network_from_mesh(pm.view(name), o);
     REQUIRE(net.ok());
     REQUIRE(net->validate() == "");
     // The same topology as the linear network, only the points move.

@@ -25,7 +25,6 @@ const PolygonMesh& pawn() {
   return mesh;
 }
 
-MeshView pawn_view() { return MeshView{pawn().positions, pawn().face_offsets, pawn().face_vertices}; }
 
 SketchOptions short_sketch() {
   SketchOptions s;
@@ -79,8 +78,8 @@ TEST_CASE("a simulated session is byte-identical for the same seed and options")
   const std::string a = format_input_log(simulate_wand(rig, wand)->events);
   const std::string b = format_input_log(simulate_wand(rig, wand)->events);
   CHECK(a == b);
-  const std::string s1 = format_input_log(simulate_sketch(rig, short_sketch(), pawn_view())->events);
-  const std::string s2 = format_input_log(simulate_sketch(rig, short_sketch(), pawn_view())->events);
+  const std::string s1 = format_input_log(simulate_sketch(rig, short_sketch(), pawn().view())->events);
+  const std::string s2 = format_input_log(simulate_sketch(rig, short_sketch(), pawn().view())->events);
   CHECK(s1 == s2);
   RigOptions other = rig;
   other.seed = 4;
@@ -137,7 +136,7 @@ TEST_CASE("options no rig can have are refused with a reason") {
   CHECK_FALSE(simulate_wand(RigOptions{}, WandOptions{.duration_s = 0, .length_m = 0.3}).ok());
   const std::vector<Vec3> flat{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
   const std::vector<uint32_t> offsets{0, 3}, faces{0, 1, 2};
-  const Result<SimulatedSession> s = simulate_sketch(RigOptions{}, short_sketch(), MeshView{flat, offsets, faces});
+  const Result<SimulatedSession> s = simulate_sketch(RigOptions{}, short_sketch(), PolygonMeshView{flat, offsets, faces});
   REQUIRE_FALSE(s.ok());
   CHECK(s.error().find("flat") != std::string::npos);
 }
@@ -187,7 +186,7 @@ TEST_CASE("a wand session with Bluetooth bursts calibrates as well as one withou
 
 TEST_CASE("a short sketch session tracks within a millimetre or two") {
   const Calibrated& c = calibrated();
-  Result<SimulatedSession> sketch = simulate_sketch(c.rig, short_sketch(), pawn_view());
+  Result<SimulatedSession> sketch = simulate_sketch(c.rig, short_sketch(), pawn().view());
   REQUIRE(sketch.ok());
   CHECK(sketch->stats.strokes == 3);
   const InputLog log = through_text(sketch->events);
@@ -216,7 +215,7 @@ TEST_CASE("a short sketch session tracks within a millimetre or two") {
 
 TEST_CASE("a damaged log: bad reports and NaN lines are counted, the rest still tracks") {
   const Calibrated& c = calibrated();
-  Result<SimulatedSession> sketch = simulate_sketch(c.rig, short_sketch(), pawn_view());
+  Result<SimulatedSession> sketch = simulate_sketch(c.rig, short_sketch(), pawn().view());
   REQUIRE(sketch.ok());
   // Damage the text the way a failing device or disk would: every 40th report garbled, truncated,
   // with an unknown id, with an impossible y, or from a device that does not exist.

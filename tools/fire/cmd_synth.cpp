@@ -24,9 +24,7 @@ int run_network_from_mesh(const SynthArgs& a) {
     std::cerr << "fire network-from-mesh: " << polygons.error() << "\n";
     return 1;
   }
-  const PolygonMesh& pm = *polygons;
-  PolygonMeshView view{pm.positions, pm.face_offsets, pm.face_vertices, a.mesh_path};
-  auto net = network_from_mesh(view, a.options);
+  auto net = network_from_mesh(polygons->view(a.mesh_path), a.options);
   if (!net) {
     std::cerr << "fire network-from-mesh: " << net.error() << "\n";
     return 1;

@@ -167,8 +167,7 @@ int run_simulate_sketch(const SimulateArgs& a) {
   if (!mesh) return fail("simulate sketch", mesh.error() + " (choose the object with --mesh)");
   SketchOptions sketch = a.sketch;
   sketch.mesh_name = a.mesh_path.substr(a.mesh_path.find_last_of('/') + 1);
-  const MeshView view{mesh->positions, mesh->face_offsets, mesh->face_vertices};
-  return write_simulation("sketch", a, simulate_sketch(a.rig, sketch, view));
+  return write_simulation("sketch", a, simulate_sketch(a.rig, sketch, mesh->view()));
 }
 
 std::string obj_text(const std::vector<Vec3>& positions, const PolygonMesh& mesh, const std::string& comment) {
@@ -176,7 +175,7 @@ std::string obj_text(const std::vector<Vec3>& positions, const PolygonMesh& mesh
   for (const Vec3& p : positions) out += "v " + format_double(p.x()) + ' ' + format_double(p.y()) + ' ' + format_double(p.z()) + '\n';
   for (size_t f = 0; f < mesh.face_count(); ++f) {
     out += 'f';
-    for (uint32_t k = mesh.face_offsets[f]; k < mesh.face_offsets[f + 1]; ++k) out += ' ' + std::to_string(mesh.face_vertices[k] + 1);
+    for (uint32_t v : mesh.face(f)) out += ' ' + std::to_string(v + 1);
     out += '\n';
   }
   return out;
@@ -195,8 +194,7 @@ int run_simulate_drawing(const SimulateArgs& a) {
   if (!network) return fail(command, network.error());
   DrawingOptions options = a.drawing;
   options.mesh_name = a.mesh_path.substr(a.mesh_path.find_last_of('/') + 1);
-  const MeshView view{*placed, mesh->face_offsets, mesh->face_vertices};
-  Result<SimulatedDrawing> drawing = simulate_drawing(a.rig, options, view, drawing_network(*network));
+  Result<SimulatedDrawing> drawing = simulate_drawing(a.rig, options, control, drawing_network(*network));
   if (!drawing) return fail(command, a.mesh_path + ": " + drawing.error());
 
   const std::string marks = marks_to_json(drawing->marks);

@@ -335,8 +335,7 @@ SimulatedBlobs simulated_blobs() {
   sketch.strokes = 2;
   sketch.hold_s = 0.2;
   sketch.duration_s = 3;
-  Result<tracking::SimulatedSession> sim = tracking::simulate_sketch(
-      tracking::RigOptions{}, sketch, tracking::MeshView{mesh->positions, mesh->face_offsets, mesh->face_vertices});
+  Result<tracking::SimulatedSession> sim = tracking::simulate_sketch(tracking::RigOptions{}, sketch, mesh->view());
   REQUIRE(sim.ok());
   return simulated_blobs_of(sim->events);
 }
