@@ -17,7 +17,7 @@ inline constexpr uint32_t kNone = 0xFFFFFFFFu;
 // A value or the reason there is none. Used where input from outside can be wrong
 // (files, devices, user commands); inside the frame loop errors are data, not exceptions.
 template <class T>
-class Result {
+class [[nodiscard]] Result {
  public:
   Result(T value) : value_(std::move(value)) {}
   static Result failure(std::string why) {
@@ -42,7 +42,7 @@ class Result {
 };
 
 // A success carrying nothing, or an error message.
-struct Status {
+struct [[nodiscard]] Status {
   std::string error;
   bool ok() const { return error.empty(); }
   explicit operator bool() const { return ok(); }
