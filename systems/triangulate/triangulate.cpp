@@ -494,7 +494,7 @@ std::vector<std::string> describe_device_problems(const TriangulateState& s) {
     if (n > 0) out.push_back(std::to_string(n) + " " + what);
   };
   say(c.garbled, "device report(s) garbled (not hexadecimal, or empty): skipped");
-  say(c.bad_length, "device report(s) cut short or too long for their report id: skipped");
+  say(c.bad_length, "device report(s) cut short for their report id: skipped (longer ones are read for their layout's bytes)");
   say(c.unknown_id, "device report(s) with an unknown report id: skipped");
   say(c.unknown_device, "report(s) from a device the log names as no camera: skipped");
   say(c.out_of_range_slots, "IR blob(s) outside the camera's 1024 x 768 pixels: dropped");
