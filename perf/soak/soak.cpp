@@ -139,15 +139,9 @@ int main(int argc, char** argv) {
       history.clear(mesh);
       mesh.compact();
       ++compactions;
-    } else if (mesh.face_count() < s.min_faces || (mesh.face_count() < s.max_faces && dice < 550)) {
-      r = history.apply(mesh, test::random_split(mesh, rng));
-    } else if (dice < 750) {
-      const auto del = test::random_delete(mesh, rng);
-      if (del) r = history.apply(mesh, *del);
-    } else if (dice < 900) {
-      r = history.undo(mesh);
     } else {
-      r = history.redo(mesh);
+      const bool split = mesh.face_count() < s.min_faces || (mesh.face_count() < s.max_faces && dice < 550);
+      if (auto edit = test::random_edit(mesh, history, rng, split, dice, 750, 900)) r = std::move(*edit);
     }
     (r.ok() ? applied : rejected) += 1;
     if (auto bad = mesh.validate(); !bad.empty()) return fail(op, "pools: " + bad);

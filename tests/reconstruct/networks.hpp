@@ -7,6 +7,7 @@
 
 #include "engine/edit_command.hpp"
 #include "engine/mesh.hpp"
+#include "systems/split/edit.hpp"
 
 namespace fire::test {
 
@@ -41,5 +42,10 @@ Mesh limit_grid_network(uint32_t m, uint32_t levels, const Height& height);
 EditCommand random_split(const Mesh& m, std::mt19937_64& rng);
 // Deleting a random interior curve, or nothing when every curve is on the border.
 std::optional<EditCommand> random_delete(const Mesh& m, std::mt19937_64& rng);
+// One random edit through `history`, as the random-edit tests and the soak draw them: a random split when
+// `split`, else by `dice`: a random delete below `delete_below`, an undo below `undo_below`, else a redo.
+// Nothing (no edit made) when a delete was drawn and every curve is on the border.
+std::optional<Status> random_edit(Mesh& net, EditHistory& history, std::mt19937_64& rng, bool split, uint64_t dice,
+                                  uint64_t delete_below, uint64_t undo_below);
 
 }  // namespace fire::test

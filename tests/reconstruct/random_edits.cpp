@@ -43,4 +43,16 @@ std::optional<EditCommand> random_delete(const Mesh& m, std::mt19937_64& rng) {
   return del;
 }
 
+std::optional<Status> random_edit(Mesh& net, EditHistory& history, std::mt19937_64& rng, bool split, uint64_t dice,
+                                  uint64_t delete_below, uint64_t undo_below) {
+  if (split) return history.apply(net, random_split(net, rng));
+  if (dice < delete_below) {
+    const std::optional<EditCommand> del = random_delete(net, rng);
+    if (!del) return std::nullopt;
+    return history.apply(net, *del);
+  }
+  if (dice < undo_below) return history.undo(net);
+  return history.redo(net);
+}
+
 }  // namespace fire::test

@@ -89,20 +89,11 @@ TEST_CASE("random edits through the frame: shown in the commit frame, settled wi
     net.begin_frame(++frame);
     const Frame edit_frame = frame;
     const uint64_t dice = rng() % 100;
-    Status r;
     // Splits add faces and deletes remove them; the band keeps the network between about 10 and 40 faces.
     const bool grow = net.face_count() < 10 || (net.face_count() < 40 && dice < 55);
-    if (grow) {
-      r = history.apply(net, random_split(net, rng));
-    } else if (dice < 75) {
-      const std::optional<EditCommand> del = random_delete(net, rng);
-      if (!del) continue;
-      r = history.apply(net, *del);
-    } else if (dice < 90) {
-      r = history.undo(net);
-    } else {
-      r = history.redo(net);
-    }
+    const std::optional<Status> edit = random_edit(net, history, rng, grow, dice, 75, 90);
+    if (!edit) continue;
+    const Status& r = *edit;
     applied += r.ok();
     INFO("operation " << op << " (" << (r.ok() ? "applied" : r.error) << "), " << net.face_count() << " faces");
     REQUIRE(net.validate() == "");

@@ -44,18 +44,9 @@ TEST_CASE("random edits: incremental reconstruction equals a rebuild after every
   int applied = 0, thesis_refused = 0, compared = 0;
   for (int step = 0; step < 120; ++step) {
     const uint64_t dice = rng() % 100;
-    Status r;
-    if (dice < 60) {
-      r = history.apply(net, random_split(net, rng));
-    } else if (dice < 75) {
-      const std::optional<EditCommand> del = random_delete(net, rng);
-      if (!del) continue;
-      r = history.apply(net, *del);
-    } else if (dice < 90) {
-      r = history.undo(net);
-    } else {
-      r = history.redo(net);
-    }
+    const std::optional<Status> edit = random_edit(net, history, rng, dice < 60, dice, 75, 90);
+    if (!edit) continue;
+    const Status& r = *edit;
     applied += r.ok();
     INFO("step " << step << " (" << (r.ok() ? "applied" : r.error) << "), " << net.face_count() << " faces");
     REQUIRE(net.validate() == "");
