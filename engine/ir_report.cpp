@@ -99,9 +99,9 @@ DecodedReport decode_ir_report(std::span<const uint8_t> bytes) {
   return out;
 }
 
-int ir_blob_count(std::span<const uint8_t> bytes) {
+std::optional<int> ir_blob_count(std::span<const uint8_t> bytes) {
   const DecodedReport d = decode_ir_report(bytes);
-  if (d.status != ReportStatus::Ok) return 0;
+  if (d.status != ReportStatus::Ok) return std::nullopt;
   int n = 0;
   for (const IrSlot& s : d.report.slots) n += s.seen;
   return n;

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -62,8 +63,8 @@ size_t ir_report_size(uint8_t id);
 // counted as out of range and the slot dropped. A report longer than its layout is read for the
 // layout's bytes; a shorter one is BadLength.
 DecodedReport decode_ir_report(std::span<const uint8_t> bytes);
-// The blobs a report shows: its seen slots; 0 for anything that is not a readable IR report.
-int ir_blob_count(std::span<const uint8_t> bytes);
+// The blobs a report shows: its seen slots; nothing for bytes that are not a readable IR report.
+std::optional<int> ir_blob_count(std::span<const uint8_t> bytes);
 
 // The exact bytes the device sends for `report` in its report_id's layout (0x33, 0x36 or 0x37;
 // any other id gives an empty vector). Coordinates are clamped to the 10-bit fields; unseen slots

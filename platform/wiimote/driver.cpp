@@ -1,6 +1,5 @@
 #include "platform/wiimote/driver.hpp"
 
-#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <set>
@@ -243,12 +242,7 @@ bool Driver::step(Link& link, int read_timeout_ms) {
     log_.hid(device, r.report, now);
     link.machine.on_report(r.report, now, out);
     name_short_report(link, r.report, now);
-    if (is_camera(link.role) && link.machine.state() == MachineState::Running) {
-      const DecodedReport ir = decode_ir_report(r.report);
-      if (ir.status == ReportStatus::Ok)
-        objects = static_cast<int>(std::count_if(ir.report.slots.begin(), ir.report.slots.end(),
-                                                 [](const IrSlot& slot) { return slot.seen; }));
-    }
+    if (is_camera(link.role) && link.machine.state() == MachineState::Running) objects = ir_blob_count(r.report);
   }
   link.machine.tick(now, out);
   uint8_t leds = 0;

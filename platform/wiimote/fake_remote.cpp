@@ -28,6 +28,15 @@ class FakeHandle : public Device {
 
 }  // namespace
 
+// The strict reading of the notes: a memory write is always answered; 0x11-0x14, 0x19 and 0x1A only when
+// their first payload byte asks (0x02); nothing else.
+bool answered(uint8_t id, uint8_t flags) {
+  if (id == kOutWriteMemory) return true;
+  const bool may_ask = id == kOutLeds || id == kOutReportingMode || id == kOutIrPixelClock || id == 0x14 ||
+                       id == 0x19 || id == kOutIrLogic;
+  return may_ask && (flags & kAckRequestBit);
+}
+
 bool valid_data_mode(uint8_t mode) { return (mode >= 0x30 && mode <= 0x37) || (mode >= 0x3D && mode <= 0x3F); }
 
 uint64_t seed_of(const FakeRemoteOptions& o) {
@@ -266,12 +275,8 @@ Status FakeRemote::host_write(uint64_t generation, std::span<const uint8_t> r) {
   writes_.emplace_back(r.begin(), r.end());
   if (r.size() < 2) return Status::success();  // nothing a remote can act on
   const uint8_t id = r[0], flags = r[1];
-  const bool wants_ack = flags & kAckRequestBit;
   const FakeSchedule& f = options_.schedule;
-  const bool acknowledged = id == kOutWriteMemory || (wants_ack && (id == kOutLeds || id == kOutReportingMode ||
-                                                                     id == kOutIrPixelClock || id == 0x14 ||
-                                                                     id == 0x19 || id == kOutIrLogic));
-  if (acknowledged && f.busy > 0 && uniform_locked() < f.busy) {
+  if (answered(id, flags) && f.busy > 0 && uniform_locked() < f.busy) {
     ack_locked(id, kAckBusy);  // not acted on: the host must send it again
     return Status::success();
   }
@@ -322,12 +327,10 @@ Status FakeRemote::host_write(uint64_t generation, std::span<const uint8_t> r) {
       }
       ack_locked(id, 0);  // a memory write is always answered
       return Status::success();
-    case 0x14: case 0x19:
-      break;
     default:
-      return Status::success();  // not acknowledged by any reading of the notes
+      break;
   }
-  if (wants_ack) ack_locked(id, 0);
+  if (answered(id, flags)) ack_locked(id, 0);
   return Status::success();
 }
 

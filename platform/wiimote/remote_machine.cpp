@@ -278,7 +278,7 @@ void RemoteMachine::on_report(std::span<const uint8_t> report, int64_t now, std:
     }
     return;
   }
-  if (ir_blob_count(report) > 0) {
+  if (ir_blob_count(report).value_or(0) > 0) {
     if (!seen_object_ && dark_restarts_ >= options_.max_dark_restarts) warning_.clear();
     seen_object_ = true;
   }
