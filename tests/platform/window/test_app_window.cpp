@@ -359,7 +359,7 @@ TEST_CASE("fire app: with no reference, strokes draw on the view plane, then on 
 }
 
 TEST_CASE("fire app: the whole pawn drawn with the mouse, one split undone, replays bit for bit and measures within 1 percent",
-          "[app][window][sketch]") {
+          "[app][window][sketch][whole-drawing]") {
   REQUIRE(has_xvfb());
   const fs::path dir = scratch("pawn");
   auto pawn = fire::read_obj(FIRE_PAWN);
