@@ -28,6 +28,17 @@ struct TriangleMesh {
 Result<TriangleMesh> triangulate(std::span<const Vec3> positions, std::span<const uint32_t> face_offsets,
                                  std::span<const uint32_t> face_vertices);
 
+// A polygon mesh's topology after welding coincident vertices (equal coordinates): V, E and F, the Euler
+// characteristic V - E + F, the edges one face uses (border) or more than two (non-manifold), and the border
+// loops, counted as connected pieces of the border edges.
+struct Topology {
+  size_t vertices = 0, edges = 0, faces = 0;
+  int64_t euler_characteristic = 0;
+  size_t border_edges = 0, border_loops = 0, nonmanifold_edges = 0;
+};
+Topology topology(std::span<const Vec3> positions, std::span<const uint32_t> face_offsets,
+                  std::span<const uint32_t> face_vertices);
+
 // The exact closest point of triangle abc to p (all seven Voronoi regions: three vertices, three edges,
 // the face). A degenerate triangle is treated as its three edges.
 Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);

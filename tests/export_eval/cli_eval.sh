@@ -26,6 +26,17 @@ check "0.005 < rms < hausdorff < 0.2 (rms $rms, hausdorff $hausdorff)" \
   "awk -v r='$rms' -v h='$hausdorff' 'BEGIN { exit !(r > 0.005 && r < h && h < 0.2) }'"
 check "no network_max without --network" "! grep -q network_max '$tmp/out'"
 
+# Topology, counted on the surface after welding and on the reference: a vessel open at both ends and a mug
+# (genus 1, one border loop), reconstructed from networks of their control meshes, keep their references'.
+for shape in lampshade:0:2 mug:-1:1; do
+  IFS=: read -r name euler loops <<<"$shape"
+  "$fire" network-from-mesh "$meshes/$name.obj" -o "$tmp/$name.fnet" >/dev/null
+  "$fire" reconstruct "$tmp/$name.fnet" -o "$tmp/$name.obj" >/dev/null
+  "$fire" eval "$tmp/$name.obj" --reference "$meshes/$name.obj" --spacing 0.01 >"$tmp/out"
+  got="$(field euler_characteristic) $(field border_loops) $(field reference_euler_characteristic) $(field reference_border_loops)"
+  check "$name: Euler characteristic and border loops $euler $loops, the reference's too (got $got)" "[ '$got' = '$euler $loops $euler $loops' ]"
+done
+
 # A network sampled on the control mesh's edges lies on that mesh: network_max is 0 up to rounding.
 "$fire" network-from-mesh "$meshes/torus.obj" --unrefine 2 -o "$tmp/torus.fnet" >/dev/null
 "$fire" eval "$meshes/torus.obj" --reference "$meshes/torus.obj" --network "$tmp/torus.fnet" --spacing 0.01 >"$tmp/out"

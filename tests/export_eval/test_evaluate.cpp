@@ -322,3 +322,47 @@ TEST_CASE("the reference limit surface refuses what cannot be subdivided", "[eva
   REQUIRE_FALSE(out_of_range.ok());
   CHECK_THAT(out_of_range.error(), Contains("face 0 refers to vertex 9 of 4"));
 }
+
+TEST_CASE("topology: Euler characteristic and border loops of every shared mesh, welded seams count once", "[evaluate][topology]") {
+  struct Expected {
+    const char* mesh;
+    int64_t euler;
+    size_t border_loops, nonmanifold_edges;
+  };
+  // 2 - 2 genus - border loops, from the meshes' README.
+  const Expected expected[] = {{"pawn", 1, 1, 0},  {"rook", 1, 1, 0}, {"torus", 0, 0, 0}, {"cube", 2, 0, 0},
+                               {"lampshade", 0, 2, 0}, {"mug", -1, 1, 0}, {"egg", 2, 0, 0}, {"fan", 1, 1, 4}};
+  for (const Expected& e : expected) {
+    INFO(e.mesh);
+    auto mesh = read_obj(kMeshes + e.mesh + ".obj");
+    REQUIRE(mesh);
+    const Topology t = topology(mesh->positions, mesh->face_offsets, mesh->face_vertices);
+    CHECK(t.nonmanifold_edges == e.nonmanifold_edges);
+    if (e.nonmanifold_edges > 0) continue;
+    CHECK(t.euler_characteristic == e.euler);
+    CHECK(t.border_loops == e.border_loops);
+  }
+  // The cube written face by face, each face with its own four corners (as a patch-by-patch export writes
+  // seams twice): welded, the same closed surface.
+  auto cube = read_obj(kMeshes + "cube.obj");
+  REQUIRE(cube);
+  std::vector<Vec3> positions;
+  std::vector<uint32_t> offsets{0}, vertices;
+  for (size_t f = 0; f + 1 < cube->face_offsets.size(); ++f) {
+    for (uint32_t k = cube->face_offsets[f]; k < cube->face_offsets[f + 1]; ++k) {
+      vertices.push_back(uint32_t(positions.size()));
+      positions.push_back(cube->positions[cube->face_vertices[k]]);
+    }
+    offsets.push_back(uint32_t(vertices.size()));
+  }
+  const Topology apart = topology(positions, offsets, vertices);
+  CHECK(apart.vertices == 8);
+  CHECK(apart.euler_characteristic == 2);
+  CHECK(apart.border_loops == 0);
+  // One face left out opens one border loop.
+  offsets.pop_back();
+  const Topology open = topology(positions, offsets, vertices);
+  CHECK(open.euler_characteristic == 1);
+  CHECK(open.border_loops == 1);
+  CHECK(open.border_edges == 4);
+}

@@ -107,6 +107,13 @@ int run_eval(const EvalArgs& a) {
                              {"point", network_point_ids[network.max_index].second},
                              {"position", {worst.x(), worst.y(), worst.z()}}};
   }
+  // Counted on SURFACE's polygons and on the reference's control mesh, which has its limit surface's topology.
+  const evaluate::Topology topology = evaluate::topology(surface->positions, surface->face_offsets, surface->face_vertices);
+  const evaluate::Topology expected = evaluate::topology(control->positions, control->face_offsets, control->face_vertices);
+  out["euler_characteristic"] = topology.euler_characteristic;
+  out["border_loops"] = topology.border_loops;
+  out["reference_euler_characteristic"] = expected.euler_characteristic;
+  out["reference_border_loops"] = expected.border_loops;
   out["diagonal"] = diagonal;
   out["samples"] = d.a_to_b.samples + d.b_to_a.samples;
   std::cout << out.dump() << "\n";
@@ -126,8 +133,10 @@ void add_eval_commands(CLI::App& app, Registry& registry) {
       "hausdorff_at (the sample there), "
       "surface_rms and surface_max (the same from SURFACE's samples only: a drawing of part of the object is measured "
       "where it is), with --network network_max (largest distance from a polyline point to the surface), network_rms (their "
-      "root mean square) and network_max_at (that point: its network edge, its index in the edge's polyline, its position), diagonal, "
-      "samples.");
+      "root mean square) and network_max_at (that point: its network edge, its index in the edge's polyline, its position), "
+      "euler_characteristic and border_loops (SURFACE's, counted after welding coincident vertices; border loops are the "
+      "connected pieces of the edges one face uses), reference_euler_characteristic and reference_border_loops (the "
+      "control mesh's, which its limit surface has), diagonal, samples.");
   cmd->add_option("SURFACE", a->surface_path, "surface to measure: .obj, .ply, .stl or .glb as `fire reconstruct` writes")
       ->required();
   cmd->add_option("--reference", a->reference_path,
