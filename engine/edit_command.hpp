@@ -15,13 +15,15 @@ struct CurveEnd {
   uint32_t point = 0;
 };
 
-enum class EditKind : uint8_t { StartBorder, AppendBorder, CloseBorder, SplitFace, DeleteCurve, ToggleSharp };
+// Kinds are appended, never reordered: snapshots hold them as bytes.
+enum class EditKind : uint8_t { StartBorder, AppendBorder, CloseBorder, SplitFace, DeleteCurve, ToggleSharp, MakeHole, SplitHole };
 
 struct EditCommand {
   EditKind kind = EditKind::StartBorder;
   std::vector<Vec3> points;  // the new curve's polyline (the border and split kinds)
-  uint32_t face = kNone;     // SplitFace: the face the curve crosses
-  CurveEnd start, end;       // SplitFace: where the curve starts and ends on that face's boundary
+  uint32_t face = kNone;     // SplitFace: the face the curve crosses; MakeHole: the face that becomes a hole
+  CurveEnd start, end;       // SplitFace: where the curve starts and ends on that face's boundary; SplitHole: on
+                             // one border loop, whose hole the curve crosses
   uint32_t edge = kNone;     // DeleteCurve, ToggleSharp (sharp becomes smooth, smooth sharp)
   double snap_distance = 0;  // CloseBorder: how far the last point may lie from the first vertex
 };

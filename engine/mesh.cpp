@@ -94,6 +94,25 @@ uint32_t Mesh::loop_position(uint32_t f, uint32_t e) const {
   return kNone;
 }
 
+std::vector<uint32_t> Mesh::border_loop(uint32_t e) const {
+  auto one_face = [&](uint32_t g) { return edge_alive(g) && is_border_edge(g) && !is_loose_edge(g); };
+  if (!one_face(e)) return {};
+  std::vector<uint32_t> loop{hole_side(e)};
+  for (;;) {
+    const uint32_t v = head(loop.back());
+    uint32_t next = kNone, border_curves = 0;
+    for (uint32_t g : vertex_edges(v)) {
+      if (!one_face(g)) continue;
+      ++border_curves;
+      if (g != edge_of(loop.back())) next = hole_side(g);
+    }
+    if (border_curves != 2 || tail(next) != v) return {};
+    if (edge_of(next) == e) return loop;
+    if (loop.size() >= edge_count()) return {};
+    loop.push_back(next);
+  }
+}
+
 LoopPlane loop_plane(std::span<const Vec3> loop) {
   LoopPlane plane;
   for (size_t i = 0; i < loop.size(); ++i) {

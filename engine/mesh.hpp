@@ -147,6 +147,13 @@ class Mesh {
     return fs[0] == f ? fs[1] : fs[0];
   }
   bool is_border_edge(uint32_t e) const { return edges.face[e][0] == kNone || edges.face[e][1] == kNone; }
+  // An edge with no face on either side: a curve of a border polygon still being drawn.
+  bool is_loose_edge(uint32_t e) const { return edges.face[e][0] == kNone && edges.face[e][1] == kNone; }
+  // The oriented edge that walks border edge e as the hole beside it would: against its one face.
+  uint32_t hole_side(uint32_t e) const { return make_oriented(e, edges.face[e][1] == kNone); }
+  // The border loop through border edge e as the hole beside it walks it, starting with e; empty when e has
+  // not exactly one face, or the loop passes a vertex with more than two border curves (it pinches there).
+  std::vector<uint32_t> border_loop(uint32_t e) const;
   // Index of edge e in f's loop, or kNone.
   uint32_t loop_position(uint32_t f, uint32_t e) const;
   // Face f's boundary as one closed polyline in loop order, each corner once (the last point is not the first).

@@ -3,6 +3,8 @@
 #include "engine/session_dir.hpp"
 
 #include <algorithm>
+#include <span>
+#include <utility>
 
 namespace fire {
 
@@ -44,15 +46,22 @@ BorderChain open_border(const Mesh& m) {
   return chain;
 }
 
+// Whether a border polygon is being drawn: its curves have no face yet.
+bool border_in_progress(const Mesh& m) {
+  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e) && m.is_loose_edge(e)) return true;
+  return false;
+}
+
 // What append and close ask before the curve goes on from the open border's last vertex.
 Status check_continues_border(const Mesh& m, const EditCommand& c) {
-  if (has_faces(m)) return Status::failure("the border polygon is already closed");
   if (m.edge_count() == 0) return Status::failure("no border polygon has been started");
+  if (!border_in_progress(m)) return Status::failure("the border polygon is already closed");
   return check_points(c.points);
 }
 
 Status start_border(Mesh& m, const EditCommand& c) {
-  if (m.edge_count() > 0) return Status::failure("a border polygon already exists");
+  if (border_in_progress(m)) return Status::failure("a border polygon is being drawn; close it before starting another part");
   if (auto ok = check_points(c.points); !ok.ok()) return ok;
   if (c.points.front() == c.points.back()) return Status::failure("the first border curve ends where it starts");
   uint32_t a = m.add_vertex(c.points.front());
@@ -105,10 +114,7 @@ struct ResolvedEnd {
   uint32_t point = 0;
 };
 
-Status resolve_end(const Mesh& m, uint32_t f, const CurveEnd& end, const char* which, ResolvedEnd& out) {
-  if (!m.edge_alive(end.edge)) return Status::failure(std::string("the curve's ") + which + " names edge " + str(end.edge) + ", which does not exist");
-  if (m.loop_position(f, end.edge) == kNone)
-    return Status::failure(std::string("the curve's ") + which + " lies on edge " + str(end.edge) + ", which is not on face " + str(f) + ": a curve must start and end on the same face");
+Status resolve_point(const Mesh& m, const CurveEnd& end, const char* which, ResolvedEnd& out) {
   uint32_t count = m.edges.point_count[end.edge];
   if (end.point >= count) return Status::failure(std::string("the curve's ") + which + " names point " + str(end.point) + " of edge " + str(end.edge) + ", which has " + str(count));
   out = {};
@@ -119,6 +125,41 @@ Status resolve_end(const Mesh& m, uint32_t f, const CurveEnd& end, const char* w
     out.point = end.point;
   }
   return Status::success();
+}
+
+Status resolve_end(const Mesh& m, uint32_t f, const CurveEnd& end, const char* which, ResolvedEnd& out) {
+  if (!m.edge_alive(end.edge)) return Status::failure(std::string("the curve's ") + which + " names edge " + str(end.edge) + ", which does not exist");
+  if (m.loop_position(f, end.edge) == kNone)
+    return Status::failure(std::string("the curve's ") + which + " lies on edge " + str(end.edge) + ", which is not on face " + str(f) + ": a curve must start and end on the same face");
+  return resolve_point(m, end, which, out);
+}
+
+// The same ends checked against a hole: both on the border loop `loop` (a Mesh::border_loop).
+Status resolve_hole_end(const Mesh& m, const std::vector<uint32_t>& loop, const CurveEnd& end, const char* which, ResolvedEnd& out) {
+  if (!m.edge_alive(end.edge)) return Status::failure(std::string("the curve's ") + which + " names edge " + str(end.edge) + ", which does not exist");
+  if (std::none_of(loop.begin(), loop.end(), [&](uint32_t oe) { return edge_of(oe) == end.edge; }))
+    return Status::failure(std::string("the curve's ") + which + " lies on edge " + str(end.edge) +
+                           ", which is not on the border loop of its other end: a curve across a hole starts and ends on one border loop "
+                           "(joining two border loops, for a handle or two parts, is not supported yet)");
+  return resolve_point(m, end, which, out);
+}
+
+// Cuts `loop` (a closed walk through va and vb) at both vertices and closes each half with the new edge
+// e = va -> vb: the walk from va to vb comes back along e reversed, the walk from vb to va along e.
+std::pair<std::vector<uint32_t>, std::vector<uint32_t>> cut_loop(const Mesh& m, std::span<const uint32_t> loop, uint32_t va,
+                                                                 uint32_t vb, uint32_t e) {
+  const uint32_t n = static_cast<uint32_t>(loop.size());
+  uint32_t i = kNone, j = kNone;
+  for (uint32_t k = 0; k < n; ++k) {
+    if (m.tail(loop[k]) == va) i = k;
+    if (m.tail(loop[k]) == vb) j = k;
+  }
+  std::vector<uint32_t> first, second;
+  for (uint32_t k = i; k != j; k = (k + 1) % n) first.push_back(loop[k]);
+  first.push_back(make_oriented(e, true));
+  for (uint32_t k = j; k != i; k = (k + 1) % n) second.push_back(loop[k]);
+  second.push_back(make_oriented(e, false));
+  return {std::move(first), std::move(second)};
 }
 
 Status split_face(Mesh& m, const EditCommand& c) {
@@ -138,19 +179,61 @@ Status split_face(Mesh& m, const EditCommand& c) {
   uint32_t vb = b.vertex != kNone ? b.vertex : split_edge(m, b.edge, b.point);
 
   // Steps 3-6: the new edge, and the face replaced by the two loops on either side of it.
-  std::vector<uint32_t> loop(m.face_loop(c.face).begin(), m.face_loop(c.face).end());
-  uint32_t n = static_cast<uint32_t>(loop.size()), i = kNone, j = kNone;
-  for (uint32_t k = 0; k < n; ++k) {
-    if (m.tail(loop[k]) == va) i = k;
-    if (m.tail(loop[k]) == vb) j = k;
-  }
-  uint32_t e = m.add_edge(va, vb, c.points);
-  std::vector<uint32_t> first, second;
-  for (uint32_t k = i; k != j; k = (k + 1) % n) first.push_back(loop[k]);
-  first.push_back(make_oriented(e, true));
-  for (uint32_t k = j; k != i; k = (k + 1) % n) second.push_back(loop[k]);
-  second.push_back(make_oriented(e, false));
+  const std::vector<uint32_t> loop(m.face_loop(c.face).begin(), m.face_loop(c.face).end());
+  const uint32_t e = m.add_edge(va, vb, c.points);
+  auto [first, second] = cut_loop(m, loop, va, vb, e);
   m.set_face_loop(c.face, first);
+  m.add_face(second);
+  return Status::success();
+}
+
+// A face of the surface that should be open: it goes, and its curves become border. Only a face apart from
+// the border: one beside it would leave a curve with no face at all, one touching it at a corner would pinch
+// the surface to a point there.
+Status make_hole(Mesh& m, const EditCommand& c) {
+  const uint32_t f = c.face;
+  if (!m.face_alive(f)) return Status::failure("face " + str(f) + " does not exist");
+  for (uint32_t oe : m.face_loop(f))
+    if (m.is_border_edge(edge_of(oe)))
+      return Status::failure("face " + str(f) + " lies beside the border at curve " + str(edge_of(oe)) +
+                             ": a hole there would leave that curve with no surface on either side (delete curves to open the border instead)");
+  for (uint32_t oe : m.face_loop(f)) {
+    const uint32_t v = m.tail(oe);
+    for (uint32_t g : m.vertex_edges(v))
+      if (m.is_border_edge(g))
+        return Status::failure("face " + str(f) + " touches the border at vertex " + str(v) + ": a hole there would pinch the surface to a point");
+  }
+  m.remove_face(f);
+  return Status::success();
+}
+
+// A curve across a border loop's hole, drawn on the far side of the surface (an object turned over to draw
+// its underside): the hole is a disc like any face, and the curve splits it as split_face does.
+Status split_hole(Mesh& m, const EditCommand& c) {
+  if (!has_faces(m)) return Status::failure("close the border polygon before drawing across its hole");
+  if (border_in_progress(m)) return Status::failure("a border polygon is being drawn; close it first");
+  if (auto ok = check_points(c.points); !ok.ok()) return ok;
+  if (!m.edge_alive(c.start.edge)) return Status::failure("the curve's start names edge " + str(c.start.edge) + ", which does not exist");
+  if (!m.is_border_edge(c.start.edge)) return Status::failure("the curve's start lies on curve " + str(c.start.edge) + ", which is not on the border");
+  const std::vector<uint32_t> loop = m.border_loop(c.start.edge);
+  if (loop.empty())
+    return Status::failure("the border through curve " + str(c.start.edge) + " passes a vertex with more than two border curves; a hole there has no single rim");
+  ResolvedEnd a, b;
+  if (auto ok = resolve_hole_end(m, loop, c.start, "start", a); !ok.ok()) return ok;
+  if (auto ok = resolve_hole_end(m, loop, c.end, "end", b); !ok.ok()) return ok;
+  if (a.vertex != kNone && a.vertex == b.vertex)
+    return Status::failure("the curve starts and ends on vertex " + str(a.vertex) + ": it would make a face with fewer than 2 edges");
+  if (a.edge != kNone && a.edge == b.edge)
+    return Status::failure("the curve starts and ends on the same edge " + str(a.edge) + ": it must join two different border curves");
+  const uint32_t va = a.vertex != kNone ? a.vertex : split_edge(m, a.edge, a.point);
+  const uint32_t vb = b.vertex != kNone ? b.vertex : split_edge(m, b.edge, b.point);
+  // The split edges are new: the rim is walked again from one of va's border curves.
+  std::vector<uint32_t> rim;
+  for (uint32_t g : m.vertex_edges(va))
+    if (rim.empty() && m.is_border_edge(g)) rim = m.border_loop(g);
+  const uint32_t e = m.add_edge(va, vb, c.points);
+  auto [first, second] = cut_loop(m, rim, va, vb, e);
+  m.add_face(first);
   m.add_face(second);
   return Status::success();
 }
@@ -268,6 +351,8 @@ Status execute_edit(Mesh& mesh, const EditCommand& c) {
     case EditKind::SplitFace: return split_face(mesh, c);
     case EditKind::DeleteCurve: return delete_curve(mesh, c);
     case EditKind::ToggleSharp: return toggle_sharp(mesh, c);
+    case EditKind::MakeHole: return make_hole(mesh, c);
+    case EditKind::SplitHole: return split_hole(mesh, c);
   }
   return Status::failure("unknown edit command");
 }
@@ -334,7 +419,7 @@ bool load_command(SnapshotReader& in, EditCommand& c) {
   uint8_t kind = 0;
   in.get(kind);
   for_each_command_field(c, [&](auto& value) { in.get(value); });
-  if (kind > uint8_t(EditKind::ToggleSharp)) in.fail();
+  if (kind > uint8_t(EditKind::SplitHole)) in.fail();
   c.kind = EditKind(kind);
   return in.ok();
 }

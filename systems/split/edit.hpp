@@ -11,12 +11,14 @@
 
 namespace fire {
 
-// Runs one command on the mesh (no history). Border rules: StartBorder needs an empty mesh;
-// AppendBorder starts the new edge at the last vertex of the open border (its first point is moved
-// there, as thesis 5.4.1 prescribes); CloseBorder adds the last edge, whose last point must lie within
-// snap_distance of the first vertex, and creates the first face. SplitFace and DeleteCurve need a
-// closed border. ToggleSharp flips an inner curve's sharp flag (a crease of the surface); border curves are
-// creases already and are refused.
+// Runs one command on the mesh (no history). Border rules: StartBorder needs no border polygon open (on a
+// mesh with faces it starts a new part); AppendBorder starts the new edge at the last vertex of the open
+// border (its first point is moved there, as thesis 5.4.1 prescribes); CloseBorder adds the last edge, whose
+// last point must lie within snap_distance of the first vertex, and creates the part's first face. SplitFace
+// and DeleteCurve need a closed border. ToggleSharp flips an inner curve's sharp flag (a crease of the
+// surface); border curves are creases already and are refused. MakeHole removes a face that touches no border
+// (its curves become border). SplitHole draws a curve across the hole of one border loop, the far side of the
+// surface there: the hole becomes two faces, one each side of the curve, and that border is gone.
 Status execute_edit(Mesh& mesh, const EditCommand& command);
 
 // Splits edge e at interior polyline point `point` (0 < point < count-1): a new vertex and two edges

@@ -178,7 +178,6 @@ TEST_CASE("every bad edit is rejected with a reason and changes nothing", "[spli
       {"missing face", split(99, {3, 2}, {3, 0}, line({0, 0.5, 0}, {0, 1, 0})), "does not exist"},
       {"point index past the polyline", split(left, {3, 9}, {3, 0}, line({0, 0.5, 0}, {0, 1, 0})), "has 5"},
       {"edge past the pool", split(left, {500, 1}, {3, 0}, line({0, 0.5, 0}, {0, 1, 0})), "does not exist"},
-      {"second border", make(EditKind::StartBorder, line({0, 0, 1}, {1, 0, 1})), "already exists"},
       {"append after close", make(EditKind::AppendBorder, line({0, 0, 1}, {1, 0, 1})), "already closed"},
       {"delete a border edge", remove(1), "border"},
       {"delete a missing edge", remove(77), "does not exist"},
@@ -430,4 +429,178 @@ TEST_CASE("compaction keeps the survivors' stamps and records its map", "[pools]
     const bool was_changed = std::find(changed_in_2.begin(), changed_in_2.end(), e) != changed_in_2.end();
     CHECK(m.edges.changes.changed_since(map.edge[e], 1) == was_changed);
   }
+}
+
+namespace {
+
+// A curve across the square's hole from the middle of the bottom edge to the middle of the top edge, bowed
+// 0.3 below the square: the square's far side.
+EditCommand across_hole(const Mesh& m) {
+  EditCommand c = make(EditKind::SplitHole, {{0.5, 0, 0}, {0.5, 0.25, -0.25}, {0.5, 0.5, -0.3}, {0.5, 0.75, -0.25}, {0.5, 1, 0}});
+  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+    if (!m.edge_alive(e)) continue;
+    if (at(m, e, 2) == Vec3(0.5, 0, 0)) c.start = {e, 2};
+    if (at(m, e, 2) == Vec3(0.5, 1, 0)) c.end = {e, 2};
+  }
+  return c;
+}
+
+int64_t euler_characteristic(const Mesh& m) {
+  return int64_t(m.vertex_count()) - int64_t(m.edge_count()) + int64_t(m.face_count());
+}
+
+EditCommand hole(uint32_t face) {
+  EditCommand c = make(EditKind::MakeHole);
+  c.face = face;
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("a curve across a border loop's hole closes the object: two new faces, no border left", "[split][topology]") {
+  EditHistory h;
+  Mesh m = square(&h);
+  const EditCommand cmd = across_hole(m);
+  REQUIRE(cmd.start.edge != kNone);
+  REQUIRE(cmd.end.edge != kNone);
+  apply_undo_redo(m, h, cmd);
+  CHECK(m.face_count() == 3);
+  CHECK(border_edges(m) == 0);
+  CHECK(euler_characteristic(m) == 2);  // a sphere
+  CHECK(face_sizes(m) == std::vector<uint32_t>{4, 4, 6});
+  // The new faces walk the old border against the square: each rim curve is the square's on one side.
+  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e)) CHECK(m.edges.face[e][0] != m.edges.face[e][1]);
+}
+
+TEST_CASE("a hole and its undo: the face goes, its curves become border, undo brings it back", "[split][topology]") {
+  EditHistory h;
+  Mesh m = square(&h);
+  REQUIRE(h.apply(m, across_hole(m)).ok());
+  // The two faces under the square are apart from any border on a closed object.
+  uint32_t under = kNone;
+  for (uint32_t f = 0; f < m.face_slots(); ++f)
+    if (m.face_alive(f) && m.faces.edge_count[f] == 4) under = f;
+  REQUIRE(under != kNone);
+  apply_undo_redo(m, h, hole(under));
+  CHECK(m.face_count() == 2);
+  CHECK(border_edges(m) == 4);
+  CHECK(euler_characteristic(m) == 1);  // a disc again
+  // The other face under the square now lies beside the border: refused, nothing changes.
+  uint32_t other = kNone;
+  for (uint32_t f = 0; f < m.face_slots(); ++f)
+    if (m.face_alive(f) && m.faces.edge_count[f] == 4) other = f;
+  REQUIRE(other != kNone);
+  const Mesh before = m;
+  const Status beside = h.apply(m, hole(other));
+  CHECK_FALSE(beside.ok());
+  CHECK_THAT(beside.error, Catch::Matchers::Contains("beside the border"));
+  CHECK(m.same_pools(before));
+  const Status missing = h.apply(m, hole(99));
+  CHECK_THAT(missing.error, Catch::Matchers::Contains("does not exist"));
+  CHECK(m.same_pools(before));
+  // The hole's rim can be crossed again: the object closes once more.
+  uint32_t rim_edge = kNone;
+  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e) && m.is_border_edge(e) && m.edges.point_count[e] >= 3 && rim_edge == kNone) rim_edge = e;
+  REQUIRE(rim_edge != kNone);
+  const std::vector<uint32_t> rim = m.border_loop(rim_edge);
+  REQUIRE(rim.size() == 4);
+  EditCommand again = make(EditKind::SplitHole);
+  const uint32_t first = edge_of(rim[0]), third = edge_of(rim[2]);
+  again.start = {first, 1};
+  again.end = {third, 1};
+  again.points = line(at(m, first, 1), at(m, third, 1), 7);
+  again.points[3] += Vec3(0, 0, -0.2);
+  apply_undo_redo(m, h, again);
+  CHECK(border_edges(m) == 0);
+  CHECK(euler_characteristic(m) == 2);
+}
+
+TEST_CASE("a hole touching the border at a corner is refused: it would pinch the surface", "[split][topology][reject]") {
+  EditHistory h;
+  Mesh m = square(&h);
+  REQUIRE(h.apply(m, across_hole(m)).ok());
+  // The top split by a curve between the same two points as the one below: four faces meet at each end.
+  uint32_t top = kNone;
+  for (uint32_t f = 0; f < m.face_slots(); ++f)
+    if (m.face_alive(f) && m.faces.edge_count[f] == 6) top = f;
+  REQUIRE(top != kNone);
+  CurveEnd a, b;
+  for (uint32_t oe : m.face_loop(top)) {
+    const uint32_t e = edge_of(oe);
+    for (uint32_t k : {uint32_t(0), m.edges.point_count[e] - 1}) {
+      if (at(m, e, k) == Vec3(0.5, 0, 0)) a = {e, k};
+      if (at(m, e, k) == Vec3(0.5, 1, 0)) b = {e, k};
+    }
+  }
+  REQUIRE(a.edge != kNone);
+  REQUIRE(b.edge != kNone);
+  std::vector<Vec3> over = line({0.5, 0, 0}, {0.5, 1, 0}, 5);
+  over[2] += Vec3(0, 0, 0.2);
+  REQUIRE(h.apply(m, split(top, a, b, over)).ok());
+  REQUIRE(m.face_count() == 4);
+  // Hole one face below: the top face on the other side meets its rim only at the two corners.
+  // Faces below hold a point with z < 0; of those, the one with corner (0, 0); of the top, the one with (1, 0).
+  uint32_t below_left = kNone, top_right = kNone;
+  for (uint32_t f = 0; f < m.face_slots(); ++f) {
+    if (!m.face_alive(f)) continue;
+    bool below = false, left = false, right = false;
+    for (const Vec3& q : m.face_boundary(f)) {
+      below = below || q.z() < 0;
+      left = left || q == Vec3(0, 0, 0);
+      right = right || q == Vec3(1, 0, 0);
+    }
+    if (below && left) below_left = f;
+    if (!below && right) top_right = f;
+  }
+  REQUIRE(below_left != kNone);
+  REQUIRE(top_right != kNone);
+  REQUIRE(h.apply(m, hole(below_left)).ok());
+  const Mesh before = m;
+  const Status r = h.apply(m, hole(top_right));
+  CHECK_FALSE(r.ok());
+  CHECK_THAT(r.error, Catch::Matchers::Contains("pinch"));
+  CHECK(m.same_pools(before));
+}
+
+TEST_CASE("a border drawn apart from the network starts a second part", "[split][topology]") {
+  EditHistory h;
+  Mesh m = square(&h);
+  const Vec3 c[4] = {{3, 0, 0}, {4, 0, 0}, {4, 1, 0}, {3, 1, 0}};
+  REQUIRE(h.apply(m, make(EditKind::StartBorder, line(c[0], c[1]))).ok());
+  const Mesh open = m;
+  const Status second = h.apply(m, make(EditKind::StartBorder, line({6, 0, 0}, {7, 0, 0})));
+  CHECK_THAT(second.error, Catch::Matchers::Contains("being drawn"));
+  CHECK(m.same_pools(open));
+  REQUIRE(h.apply(m, make(EditKind::AppendBorder, line(c[1], c[2]))).ok());
+  REQUIRE(h.apply(m, make(EditKind::AppendBorder, line(c[2], c[3]))).ok());
+  EditCommand close = make(EditKind::CloseBorder, line(c[3], c[0]));
+  close.snap_distance = 0.01;
+  REQUIRE(h.apply(m, close).ok());
+  CHECK(m.validate() == "");
+  CHECK(m.face_count() == 2);
+  CHECK(border_edges(m) == 8);
+  // A curve from one part's rim to the other's would join two border loops: refused in words, nothing lost.
+  EditCommand join = make(EditKind::SplitHole, line({0.5, 0, 0}, {3.5, 0, 0}));
+  join.start = {0, 2};
+  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e) && at(m, e, 2) == Vec3(3.5, 0, 0)) join.end = {e, 2};
+  REQUIRE(join.end.edge != kNone);
+  const Mesh two = m;
+  const Status joined = h.apply(m, join);
+  CHECK_THAT(joined.error, Catch::Matchers::Contains("not supported yet"));
+  CHECK(m.same_pools(two));
+  // An inner curve is no rim.
+  REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok());
+  uint32_t inner = kNone;
+  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e) && !m.is_border_edge(e)) inner = e;
+  EditCommand off_rim = join;
+  off_rim.start = {inner, 2};
+  const Mesh split_once = m;
+  CHECK_THAT(h.apply(m, off_rim).error, Catch::Matchers::Contains("not on the border"));
+  CHECK(m.same_pools(split_once));
+  while (h.undo_depth() > 0) REQUIRE(h.undo(m).ok());
+  CHECK(m.same_pools(Mesh{}));
 }
