@@ -113,6 +113,24 @@ std::vector<uint32_t> Mesh::border_loop(uint32_t e) const {
   }
 }
 
+bool Mesh::border_in_progress() const {
+  for (uint32_t e = 0; e < edge_slots(); ++e)
+    if (edge_alive(e) && is_loose_edge(e)) return true;
+  return false;
+}
+
+size_t Mesh::border_loop_count() const {
+  std::vector<uint8_t> walked(edge_slots(), 0);
+  size_t loops = 0;
+  for (uint32_t e = 0; e < edge_slots(); ++e) {
+    if (walked[e] || !edge_alive(e) || !is_border_edge(e) || is_loose_edge(e)) continue;
+    const std::vector<uint32_t> loop = border_loop(e);
+    for (uint32_t oe : loop) walked[edge_of(oe)] = 1;
+    loops += loop.empty() ? 0 : 1;
+  }
+  return loops;
+}
+
 LoopPlane loop_plane(std::span<const Vec3> loop) {
   LoopPlane plane;
   for (size_t i = 0; i < loop.size(); ++i) {

@@ -154,6 +154,10 @@ class Mesh {
   // The border loop through border edge e as the hole beside it walks it, starting with e; empty when e has
   // not exactly one face, or the loop passes a vertex with more than two border curves (it pinches there).
   std::vector<uint32_t> border_loop(uint32_t e) const;
+  // Whether a border polygon is being drawn: some live edge has no face yet.
+  bool border_in_progress() const;
+  // The border loops of the faces (what Mesh::border_loop walks; a loop through a pinched vertex is not counted).
+  size_t border_loop_count() const;
   // Index of edge e in f's loop, or kNone.
   uint32_t loop_position(uint32_t f, uint32_t e) const;
   // Face f's boundary as one closed polyline in loop order, each corner once (the last point is not the first).

@@ -46,22 +46,15 @@ BorderChain open_border(const Mesh& m) {
   return chain;
 }
 
-// Whether a border polygon is being drawn: its curves have no face yet.
-bool border_in_progress(const Mesh& m) {
-  for (uint32_t e = 0; e < m.edge_slots(); ++e)
-    if (m.edge_alive(e) && m.is_loose_edge(e)) return true;
-  return false;
-}
-
 // What append and close ask before the curve goes on from the open border's last vertex.
 Status check_continues_border(const Mesh& m, const EditCommand& c) {
   if (m.edge_count() == 0) return Status::failure("no border polygon has been started");
-  if (!border_in_progress(m)) return Status::failure("the border polygon is already closed");
+  if (!m.border_in_progress()) return Status::failure("the border polygon is already closed");
   return check_points(c.points);
 }
 
 Status start_border(Mesh& m, const EditCommand& c) {
-  if (border_in_progress(m)) return Status::failure("a border polygon is being drawn; close it before starting another part");
+  if (m.border_in_progress()) return Status::failure("a border polygon is being drawn; close it before starting another part");
   if (auto ok = check_points(c.points); !ok.ok()) return ok;
   if (c.points.front() == c.points.back()) return Status::failure("the first border curve ends where it starts");
   uint32_t a = m.add_vertex(c.points.front());
@@ -211,7 +204,7 @@ Status make_hole(Mesh& m, const EditCommand& c) {
 // its underside): the hole is a disc like any face, and the curve splits it as split_face does.
 Status split_hole(Mesh& m, const EditCommand& c) {
   if (!has_faces(m)) return Status::failure("close the border polygon before drawing across its hole");
-  if (border_in_progress(m)) return Status::failure("a border polygon is being drawn; close it first");
+  if (m.border_in_progress()) return Status::failure("a border polygon is being drawn; close it first");
   if (auto ok = check_points(c.points); !ok.ok()) return ok;
   if (!m.edge_alive(c.start.edge)) return Status::failure("the curve's start names edge " + str(c.start.edge) + ", which does not exist");
   if (!m.is_border_edge(c.start.edge)) return Status::failure("the curve's start lies on curve " + str(c.start.edge) + ", which is not on the border");

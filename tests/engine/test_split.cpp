@@ -467,6 +467,7 @@ TEST_CASE("a curve across a border loop's hole closes the object: two new faces,
   CHECK(m.face_count() == 3);
   CHECK(border_edges(m) == 0);
   CHECK(euler_characteristic(m) == 2);  // a sphere
+  CHECK(m.border_loop_count() == 0);
   CHECK(face_sizes(m) == std::vector<uint32_t>{4, 4, 6});
   // The new faces walk the old border against the square: each rim curve is the square's on one side.
   for (uint32_t e = 0; e < m.edge_slots(); ++e)
@@ -486,6 +487,7 @@ TEST_CASE("a hole and its undo: the face goes, its curves become border, undo br
   CHECK(m.face_count() == 2);
   CHECK(border_edges(m) == 4);
   CHECK(euler_characteristic(m) == 1);  // a disc again
+  CHECK(m.border_loop_count() == 1);
   // The other face under the square now lies beside the border: refused, nothing changes.
   uint32_t other = kNone;
   for (uint32_t f = 0; f < m.face_slots(); ++f)
@@ -570,6 +572,7 @@ TEST_CASE("a border drawn apart from the network starts a second part", "[split]
   const Vec3 c[4] = {{3, 0, 0}, {4, 0, 0}, {4, 1, 0}, {3, 1, 0}};
   REQUIRE(h.apply(m, make(EditKind::StartBorder, line(c[0], c[1]))).ok());
   const Mesh open = m;
+  CHECK(m.border_in_progress());
   const Status second = h.apply(m, make(EditKind::StartBorder, line({6, 0, 0}, {7, 0, 0})));
   CHECK_THAT(second.error, Catch::Matchers::Contains("being drawn"));
   CHECK(m.same_pools(open));
@@ -581,6 +584,7 @@ TEST_CASE("a border drawn apart from the network starts a second part", "[split]
   CHECK(m.validate() == "");
   CHECK(m.face_count() == 2);
   CHECK(border_edges(m) == 8);
+  CHECK(m.border_loop_count() == 2);
   // A curve from one part's rim to the other's would join two border loops: refused in words, nothing lost.
   EditCommand join = make(EditKind::SplitHole, line({0.5, 0, 0}, {3.5, 0, 0}));
   join.start = {0, 2};
