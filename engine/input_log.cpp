@@ -73,8 +73,9 @@ Result<InputLog> parse_input_log(std::string_view text, const std::string& sourc
     if (line_no == 1) {
       if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
       if (line.substr(0, 9) == "FIRE-LOG ") {
-        if (line != kInputLogHeader)
-          return fail(1, "unknown input log version '" + std::string(line.substr(9)) + "' (this build reads version 1)");
+        if (line == "FIRE-LOG 1") log.version = 1;
+        else if (line != kInputLogHeader)
+          return fail(1, "unknown input log version '" + std::string(line.substr(9)) + "' (this build reads versions 1 and 2)");
         continue;
       }
       return fail(1, "not a FIRE input log (the first line must be '" + std::string(kInputLogHeader) + "')");
@@ -111,7 +112,7 @@ Result<InputLog> parse_input_log(std::string_view text, const std::string& sourc
     } else if (kind == "cmd") {
       e.kind = EventKind::Command;
       if (f.size() < 3)
-        return fail(line_no, "cmd needs a command: undo, redo, close, delete x y z, sharp x y z, mark N x y z or register");
+        return fail(line_no, "cmd needs a command: undo, redo, close, delete x y z, sharp x y z, hole x y z, mark N x y z or register");
       std::string_view c = f[2];
       if (c == "undo" || c == "redo" || c == "close" || c == "register") {
         e.command = c == "undo"   ? CommandKind::Undo
@@ -119,8 +120,8 @@ Result<InputLog> parse_input_log(std::string_view text, const std::string& sourc
                     : c == "close" ? CommandKind::Close
                                    : CommandKind::Register;
         if (f.size() != 3) return fail(line_no, "cmd " + std::string(c) + " takes no fields");
-      } else if (c == "delete" || c == "sharp") {
-        e.command = c == "delete" ? CommandKind::Delete : CommandKind::Sharp;
+      } else if (c == "delete" || c == "sharp" || c == "hole") {
+        e.command = c == "delete" ? CommandKind::Delete : c == "sharp" ? CommandKind::Sharp : CommandKind::Hole;
         if (!parse_point(f, 3, e.p)) return fail(line_no, "cmd " + std::string(c) + " needs three numbers x y z");
       } else if (c == "mark") {
         e.command = CommandKind::Mark;
@@ -197,6 +198,7 @@ std::string format_event(const InputEvent& e) {
         case CommandKind::Close: s += "cmd close"; break;
         case CommandKind::Delete: s += "cmd delete " + point(e.p); break;
         case CommandKind::Sharp: s += "cmd sharp " + point(e.p); break;
+        case CommandKind::Hole: s += "cmd hole " + point(e.p); break;
         case CommandKind::Mark: s += "cmd mark " + std::to_string(e.mark) + ' ' + point(e.p); break;
         case CommandKind::Register: s += "cmd register"; break;
       }

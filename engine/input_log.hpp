@@ -10,12 +10,12 @@
 namespace fire {
 
 enum class EventKind : uint8_t { Pen, Down, Up, Command, Hid, Truth, Meta };
-enum class CommandKind : uint8_t { Undo, Redo, Close, Delete, Sharp, Mark, Register };
+enum class CommandKind : uint8_t { Undo, Redo, Close, Delete, Sharp, Mark, Register, Hole };
 
 struct InputEvent {
   int64_t t_us = 0;
   EventKind kind = EventKind::Pen;
-  Vec3 p = Vec3::Zero();              // Pen sample; Delete and Sharp commands' pick point; Mark: the mark in the object's frame
+  Vec3 p = Vec3::Zero();              // Pen sample; Delete, Sharp and Hole commands' pick point; Mark: the mark in the object's frame
   double snap = 0;                    // Pen: snap radius for a stroke end at this sample; 0: the session's setting
   CommandKind command = CommandKind::Undo;
   uint32_t mark = 0;                  // Mark command: the mark's number
@@ -35,9 +35,12 @@ struct InputLog {
   uint64_t forgotten = 0;
   size_t rejected_hid_lines = 0;      // garbled hid payloads, kept as events with hid_ok = false
   size_t hid_back_in_time = 0;        // hid lines stamped before the line above them, kept
+  // The format version the log was written in (engine/INPUT_LOG.md): version 1 logs replay by the sketch
+  // rules they were drawn with (SketchSettings::topology_strokes off).
+  uint32_t version = 2;
 };
 
-inline constexpr std::string_view kInputLogHeader = "FIRE-LOG 1";
+inline constexpr std::string_view kInputLogHeader = "FIRE-LOG 2";
 
 // Parses a whole log held in memory; `source` names it in error messages.
 Result<InputLog> parse_input_log(std::string_view text, const std::string& source);

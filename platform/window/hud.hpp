@@ -31,7 +31,8 @@ struct HudData {
   const std::vector<SystemTiming>* timings = nullptr;
   const SystemTiming* frame_timing = nullptr;
   size_t vertices = 0, edges = 0, faces = 0, points = 0, surface_quads = 0;
-  bool border_mode = true;   // no face yet: strokes extend the border; else they split faces
+  bool border_mode = true;   // no face yet, or a new part's border open: strokes extend the border; else they split faces
+  size_t border_loops = 0;   // the surface's border loops: 0 once the object is closed
   std::string last_rejection; // the last edit refused, in words; empty if none
   std::string status;         // a line of news (saved to, nothing to undo...)
   render::DrawOptions view;

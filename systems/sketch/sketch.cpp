@@ -53,11 +53,11 @@ void drop_pauses(std::vector<Vec3>& stroke, const Vec3& start, double start_radi
 // The vertex of `face` nearest to p, or to the curve point p snapped to, if it lies within `radius`, as a
 // curve end; else `end` as it was. A curve point that close to a vertex is the vertex within the pen's error,
 // and a new vertex there would leave a curve piece shorter than the radius beside it.
-CurveEnd at_vertex(const Mesh& mesh, uint32_t face, const CurveEnd& end, const Vec3& p, double radius) {
+CurveEnd at_vertex(const Mesh& mesh, std::span<const uint32_t> loop, const CurveEnd& end, const Vec3& p, double radius) {
   CurveEnd best = end;
   double nearest = radius;
   const Vec3 snapped = mesh.polyline(end.edge)[end.point];
-  for (uint32_t oriented : mesh.face_loop(face)) {
+  for (uint32_t oriented : loop) {
     const uint32_t e = edge_of(oriented);
     const std::span<const Vec3> line = mesh.polyline(e);
     for (uint32_t k : {uint32_t(0), uint32_t(line.size() - 1)})
@@ -69,7 +69,38 @@ CurveEnd at_vertex(const Mesh& mesh, uint32_t face, const CurveEnd& end, const V
   return best;
 }
 
-bool border_open(const Mesh& m) { return m.edge_count() > 0 && m.face_count() == 0; }
+
+// Where a stroke across a hole lands: both ends on one border loop (the nearest border point to each end
+// within `limit`, the end's on the start's loop).
+struct HoleSnap {
+  std::vector<uint32_t> rim;  // the border loop, as Mesh::border_loop walks it; empty when there is none
+  CurveEnd start, end;
+};
+
+HoleSnap snap_to_hole(const Mesh& m, const SnapIndex& index, const Vec3& start, const Vec3& end, double limit) {
+  std::vector<SnapHit> hits;
+  auto nearest_border = [&](const Vec3& p, const std::vector<uint32_t>* on_rim) {
+    index.nearest_per_edge(p, limit, hits);
+    SnapHit best;
+    for (const SnapHit& h : hits) {
+      if (!m.is_border_edge(h.edge) || m.is_loose_edge(h.edge)) continue;
+      if (on_rim && std::none_of(on_rim->begin(), on_rim->end(), [&](uint32_t oe) { return edge_of(oe) == h.edge; })) continue;
+      if (!best.found() || h.distance < best.distance || (h.distance == best.distance && h.edge < best.edge)) best = h;
+    }
+    return best;
+  };
+  HoleSnap out;
+  const SnapHit a = nearest_border(start, nullptr);
+  if (!a.found()) return out;
+  std::vector<uint32_t> rim = m.border_loop(a.edge);
+  if (rim.empty()) return out;
+  const SnapHit b = nearest_border(end, &rim);
+  if (!b.found()) return out;
+  out.rim = std::move(rim);
+  out.start = {a.edge, a.point};
+  out.end = {b.edge, b.point};
+  return out;
+}
 
 // The open border's first and last vertices (the first is the start of the first edge drawn).
 std::pair<uint32_t, uint32_t> border_ends(const Mesh& m) {
@@ -161,7 +192,7 @@ void publish_feedback(const Mesh& mesh, const SnapIndex& snap, const SketchState
   fb.first_vertex = {};
   fb.closes_border = false;
   if (!fb.pen_seen || mesh.edge_count() == 0) return;
-  if (border_open(mesh)) {
+  if (mesh.border_in_progress()) {
     const uint32_t first = border_ends(mesh).first;
     if (first == kNone) return;
     fb.first_vertex = mesh.vertex_id(first);
@@ -172,7 +203,7 @@ void publish_feedback(const Mesh& mesh, const SnapIndex& snap, const SketchState
   if (state.pen_down && !state.stroke.empty()) {  // where the stroke would end, as the pen going up would place it
     const Snap s = snap_to_face(mesh, snap, state.stroke.front(), fb.pen, std::max(start_radius, fb.radius));
     if (s.face != kNone) {
-      const CurveEnd end = at_vertex(mesh, s.face, s.end, fb.pen, vertex_radius);
+      const CurveEnd end = at_vertex(mesh, mesh.face_loop(s.face), s.end, fb.pen, vertex_radius);
       fb.face = mesh.face_id(s.face);
       fb.target_edge = mesh.edge_id(end.edge);
       fb.target_point = end.point;
@@ -251,7 +282,7 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
         const double end_snap = radius(state.end_snap), both_snap = std::max(radius(state.start_snap), end_snap);
         if (mesh.edge_count() == 0) {
           r.command.kind = EditKind::StartBorder;
-        } else if (border_open(mesh)) {
+        } else if (mesh.border_in_progress()) {
           auto [first, last] = border_ends(mesh);
           const Vec3& first_position = mesh.vertices.position[first];
           double gap = (r.command.points.back() - first_position).norm();
@@ -260,19 +291,28 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           blend_ends(r.command.points, mesh.vertices.position[last],
                      r.command.kind == EditKind::CloseBorder ? first_position : r.command.points.back(), 1);
         } else {
-          Snap s = snap_to_face(mesh, snap, r.command.points.front(), r.command.points.back(), both_snap);
-          if (s.face == kNone) {
+          // A face holding both ends takes the stroke, as the thesis's sketch model has it. Else the stroke may
+          // cross a border loop's hole (the far side of the surface), or, far from every curve, start a new part.
+          const Snap s = snap_to_face(mesh, snap, r.command.points.front(), r.command.points.back(), both_snap);
+          const HoleSnap h = s.face == kNone && settings.topology_strokes ? snap_to_hole(mesh, snap, r.command.points.front(), r.command.points.back(), both_snap) : HoleSnap{};
+          const SnapHit start_hit = snap.nearest(r.command.points.front()), end_hit = snap.nearest(r.command.points.back());
+          if (s.face == kNone && h.rim.empty()) {
+            if (settings.topology_strokes && start_hit.distance > radius(state.start_snap) && end_hit.distance > end_snap) {
+              r.command.kind = EditKind::StartBorder;
+              requests.push_back(std::move(r));
+              break;
+            }
             // How far each end is from any curve tells a person which end missed.
-            const SnapHit start = snap.nearest(r.command.points.front()), end = snap.nearest(r.command.points.back());
-            reject("the stroke does not start and end on the boundary of one face: no face has both ends within " +
-                   format_mm(both_snap) + " (the start is " + format_mm(start.distance) + " from the nearest curve, the end " +
-                   format_mm(end.distance) + ")");
+            reject("the stroke does not start and end on the boundary of one face: no face or border loop has both ends within " +
+                   format_mm(both_snap) + " (the start is " + format_mm(start_hit.distance) + " from the nearest curve, the end " +
+                   format_mm(end_hit.distance) + ")");
             break;
           }
-          r.command.kind = EditKind::SplitFace;
+          const std::span<const uint32_t> loop = s.face != kNone ? mesh.face_loop(s.face) : std::span<const uint32_t>(h.rim);
+          r.command.kind = s.face != kNone ? EditKind::SplitFace : EditKind::SplitHole;
           r.command.face = s.face;
-          r.command.start = at_vertex(mesh, s.face, s.start, r.command.points.front(), vertex_radius(state.start_snap));
-          r.command.end = at_vertex(mesh, s.face, s.end, r.command.points.back(), vertex_radius(state.end_snap));
+          r.command.start = at_vertex(mesh, loop, s.face != kNone ? s.start : h.start, r.command.points.front(), vertex_radius(state.start_snap));
+          r.command.end = at_vertex(mesh, loop, s.face != kNone ? s.end : h.end, r.command.points.back(), vertex_radius(state.end_snap));
           const Vec3& start = mesh.polyline(r.command.start.edge)[r.command.start.point];
           const Vec3& end = mesh.polyline(r.command.end.edge)[r.command.end.point];
           drop_pauses(r.command.points, start, vertex_radius(state.start_snap), end, vertex_radius(state.end_snap));
@@ -287,7 +327,7 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
         if (ev.command == CommandKind::Undo) r.kind = RequestKind::Undo;
         else if (ev.command == CommandKind::Redo) r.kind = RequestKind::Redo;
         else if (ev.command == CommandKind::Close) {
-          if (!border_open(mesh)) {
+          if (!mesh.border_in_progress()) {
             reject("close: there is no open border polygon");
             break;
           }
@@ -299,6 +339,15 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           }
           r.command.kind = EditKind::CloseBorder;
           r.command.snap_distance = settings.snap_distance;
+        } else if (ev.command == CommandKind::Hole) {
+          const uint32_t f = face_under(mesh, ev.p);
+          if (f == kNone) {
+            reject("hole: no face under the picked point (" + format_double(ev.p.x()) + ", " + format_double(ev.p.y()) + ", " +
+                   format_double(ev.p.z()) + ")");
+            break;
+          }
+          r.command.kind = EditKind::MakeHole;
+          r.command.face = f;
         } else {  // delete or sharp: the curve nearest to the picked point
           const bool remove = ev.command == CommandKind::Delete;
           uint32_t e = pick_edge(snap, ev.p, settings.snap_distance);

@@ -30,6 +30,10 @@ struct SketchSettings {
   // stroke; a border's always do). Under 1 the middle stays where it was drawn, so a curve snapped onto curves that were themselves
   // moved does not inherit their moves: over a drawing of many curves drawn onto each other they add up.
   double blend_reach = 1;
+  // Strokes that change the topology (engine/INPUT_LOG.md, version 2): a stroke that no face holds may cross one
+  // border loop's hole (the far side of the surface), and one with both ends far from every curve starts a new
+  // part's border. Off for a version-1 log, where such strokes were refused, so it replays as it was drawn.
+  bool topology_strokes = true;
 };
 
 // For a pen tracked by the rig: vertex_snap (metres), a few times the tracked pen's error at rest, and

@@ -86,7 +86,7 @@ TEST_CASE("input log: truncated, unknown version and malformed lines are refused
     CHECK_THAT(r.error(), Contains(part));
   };
   refuse("FIRE-LOG 1\n0 down\n10 pen 1 2", "truncated");
-  refuse("FIRE-LOG 2\n", "unknown input log version '2'");
+  refuse("FIRE-LOG 3\n", "unknown input log version '3'");
   refuse("hello\n", "not a FIRE input log");
   refuse("", "empty");
   refuse("FIRE-LOG 1\n10 pen 1 2\n", "pen needs three numbers");

@@ -150,6 +150,10 @@ std::string AppLive::act(PadAction action) {
       command(remove ? CommandKind::Delete : CommandKind::Sharp, *p);
       return remove ? "deleting the curve drawn last" : "the curve drawn last: sharp / smooth";
     }
+    case PadAction::HoleLastTouched:
+      // The pen is lit only while it touches: where it last touched is where the person pointed.
+      command(CommandKind::Hole, world_.pen_feedback.pen);
+      return "a hole at the face the pen last touched";
     case PadAction::TouchMark: {
       if (marks_.empty()) return "no marks to touch: give --marks FILE";
       InputEvent e;

@@ -40,6 +40,7 @@ const std::vector<std::string> kAppKeys = {
     "C               close the border to its first vertex (logged)",
     "Delete          delete the curve under the cursor (logged)",
     "K               the curve under the cursor sharp / smooth (logged)",
+    "O               the face under the cursor a hole (logged)",
     "1 / 2 / 3       surface / curves / wireframe on or off",
     "F               frame everything",
     "Ctrl+S / E      save the network (-o) / export the surface (--export)",
@@ -373,6 +374,11 @@ int run_app(const AppOptions& a) {
             log_command(CommandKind::Sharp, p);
             hud_data.status = w.mesh.edges.flags[edge] & kSharpEdge ? "making the curve smooth" : "marking the curve sharp";
           }
+        } else if (e.key == GLFW_KEY_O) {
+          if (const std::optional<Vec3> p = pen.point_under(cursor, w.surface)) {
+            log_command(CommandKind::Hole, *p);
+            hud_data.status = "making a hole of the face under the cursor";
+          } else hud_data.status = "nothing under the cursor to make a hole of";
         } else if (e.key == GLFW_KEY_E) {
           // The surface as the frames have built it so far; a failed write leaves the session untouched.
           if (w.surface.empty()) report("export: no surface yet (it needs a closed border)");

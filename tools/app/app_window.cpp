@@ -125,7 +125,8 @@ bool AppWindow::display(const render::Orbit& orbit, render::Image* capture) {
   hud_data.faces = w.mesh.face_count();
   hud_data.points = w.mesh.live_point_count();
   hud_data.surface_quads = w.surface.quad_count();
-  hud_data.border_mode = w.mesh.face_count() == 0;
+  hud_data.border_mode = w.mesh.face_count() == 0 || w.mesh.border_in_progress();
+  hud_data.border_loops = w.mesh.border_loop_count();
   hud_->build(hud_data);
   stages_.hud = ms_since(mark);
   auto shown = presenter_->frame(*renderer_, camera_, hud_data.view, [&](VkCommandBuffer cmd) { hud_->draw(cmd); },

@@ -72,6 +72,7 @@ std::vector<PadPress> pad_presses_for(const std::vector<InputEvent>& commands, s
       case CommandKind::Delete: action = PadAction::DeleteLastCurve; break;
       case CommandKind::Sharp: action = PadAction::SharpLastCurve; break;
       case CommandKind::Register: action = PadAction::Register; break;
+      case CommandKind::Hole: action = PadAction::HoleLastTouched; break;
       case CommandKind::Mark: {
         if (mark_count == 0 || c.mark >= mark_count) continue;
         // The shorter way round to the mark, the presses ending just before the touch.

@@ -33,6 +33,26 @@ std::optional<Vec3> MousePen::hit_plane(glm::vec2 pixel) const {
   return Vec3(origin + t * direction);
 }
 
+namespace {
+
+evaluate::TriangleMesh surface_triangles(const SurfaceLevels& surface) {
+  evaluate::TriangleMesh mesh{surface.positions, {}};
+  mesh.triangles.reserve(surface.quads.size() / 4 * 6);
+  for (size_t q = 0; q + 3 < surface.quads.size(); q += 4) {
+    const uint32_t* v = &surface.quads[q];
+    mesh.triangles.insert(mesh.triangles.end(), {v[0], v[1], v[2], v[0], v[2], v[3]});
+  }
+  return mesh;
+}
+
+}  // namespace
+
+std::optional<Vec3> MousePen::point_under(glm::vec2 pixel, const SurfaceLevels& surface) const {
+  if (reference_) return hit_mesh(*reference_, pixel);
+  if (surface.empty()) return std::nullopt;
+  return hit_mesh(evaluate::TriangleBvh(surface_triangles(surface)), pixel);
+}
+
 bool MousePen::begin(glm::vec2 pixel, const SurfaceLevels& surface, const glm::vec3& view_target) {
   if (reference_) {
     stroke_mesh_ = reference_;
@@ -40,13 +60,7 @@ bool MousePen::begin(glm::vec2 pixel, const SurfaceLevels& surface, const glm::v
   }
   stroke_mesh_ = nullptr;
   if (!surface.empty()) {
-    evaluate::TriangleMesh mesh{surface.positions, {}};
-    mesh.triangles.reserve(surface.quads.size() / 4 * 6);
-    for (size_t q = 0; q + 3 < surface.quads.size(); q += 4) {
-      const uint32_t* v = &surface.quads[q];
-      mesh.triangles.insert(mesh.triangles.end(), {v[0], v[1], v[2], v[0], v[2], v[3]});
-    }
-    surface_bvh_.emplace(mesh);
+    surface_bvh_.emplace(surface_triangles(surface));
     if (hit_mesh(*surface_bvh_, pixel)) {
       stroke_mesh_ = &*surface_bvh_;
       return true;

@@ -23,6 +23,8 @@ class MousePen {
   // Chooses what the stroke starting at `pixel` draws on: false when it would draw on nothing. `surface`
   // is the surface as the stroke begins; `view_target` the point the view turns about.
   bool begin(glm::vec2 pixel, const SurfaceLevels& surface, const glm::vec3& view_target);
+  // The point under `pixel` on the reference, or without one on `surface`: what a command picks a face by.
+  std::optional<Vec3> point_under(glm::vec2 pixel, const SurfaceLevels& surface) const;
   // Logs a pen sample where `pixel` hits what the stroke draws on; false when it hits nothing.
   bool sample(glm::vec2 pixel);
 

@@ -4,9 +4,9 @@
 
 namespace fire::app {
 
-const std::array<PadBinding, 9>& pad_bindings() {
+const std::array<PadBinding, 10>& pad_bindings() {
   using namespace wiimote;
-  static const std::array<PadBinding, 9> bindings = {{
+  static const std::array<PadBinding, 10> bindings = {{
       {kButtonA, "A", PadAction::CloseBorder, "close the border to its first vertex"},
       {kButtonB, "B", PadAction::Undo, "undo"},
       {kButtonPlus, "+", PadAction::Redo, "redo"},
@@ -16,6 +16,7 @@ const std::array<PadBinding, 9>& pad_bindings() {
       {kButtonHome, "Home", PadAction::Register, "register the object on the marks touched (3 or more)"},
       {kButtonLeft, "left", PadAction::PreviousMark, "show the previous mark"},
       {kButtonRight, "right", PadAction::NextMark, "show the next mark"},
+      {kButtonDown, "down", PadAction::HoleLastTouched, "the face the pen last touched becomes a hole (no surface)"},
   }};
   return bindings;
 }

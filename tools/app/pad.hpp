@@ -16,7 +16,7 @@
 
 namespace fire::app {
 
-enum class PadAction : uint8_t { CloseBorder, Undo, Redo, DeleteLastCurve, SharpLastCurve, TouchMark, Register, PreviousMark, NextMark };
+enum class PadAction : uint8_t { CloseBorder, Undo, Redo, DeleteLastCurve, SharpLastCurve, TouchMark, Register, PreviousMark, NextMark, HoleLastTouched };
 
 struct PadBinding {
   uint16_t button = 0;  // a wiimote::kButton* bit
@@ -26,7 +26,7 @@ struct PadBinding {
 };
 
 // The mapping, in the order the help lists it.
-const std::array<PadBinding, 9>& pad_bindings();
+const std::array<PadBinding, 10>& pad_bindings();
 // One help line a binding: "pad A           close the border to its first vertex".
 std::vector<std::string> pad_help_lines();
 

@@ -33,13 +33,16 @@ std::vector<SystemSpec> session_systems(World& w) {
         register_system(events, pen_events, rig.has_value(), state, object_events, rejections);
       }));
   systems.push_back(declare_system<Read<&W::object_events>, ReadPrevious<&W::mesh>, ReadPrevious<&W::snap>,
-                                   Read<&W::sketch_settings>, Write<&W::sketch>, Write<&W::requests>,
+                                   Read<&W::sketch_settings>, Read<&W::log>, Write<&W::sketch>, Write<&W::requests>,
                                    Write<&W::rejections>, Write<&W::pen_feedback>>(
       w, "sketch",
       [](const std::vector<InputEvent>& events, const Mesh& mesh, const SnapIndex& snap, const SketchSettings& settings,
-         SketchState& state, std::vector<EditRequest>& requests, std::vector<Rejection>& rejections,
+         const InputLog& log, SketchState& state, std::vector<EditRequest>& requests, std::vector<Rejection>& rejections,
          PenFeedback& feedback) {
-        sketch_system(events, mesh, snap, settings, state, requests, rejections, feedback);
+        // A version-1 log replays by the rules it was drawn with.
+        SketchSettings rules = settings;
+        rules.topology_strokes = settings.topology_strokes && log.version >= 2;
+        sketch_system(events, mesh, snap, rules, state, requests, rejections, feedback);
       }));
   systems.push_back(declare_system<Read<&W::requests>, Write<&W::mesh>, Write<&W::history>, Write<&W::rejections>>(
       w, "split", [](const std::vector<EditRequest>& requests, Mesh& mesh, EditHistory& history,

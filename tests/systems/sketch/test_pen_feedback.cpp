@@ -4,44 +4,13 @@
 // stroke's ends land: on a vertex within the snap radius, the pen's pauses there not drawn.
 #include <catch2/catch.hpp>
 
-#include "tools/app/session.hpp"
+#include "scripted_log.hpp"
 
 using namespace fire;
+using fire::test::Log;
+using fire::test::replay;
 
 namespace {
-
-// A log built line by line, each event 10 ms after the last, so each lands in a frame of its own.
-struct Log {
-  std::string text = "FIRE-LOG 1\n";
-  int64_t t = 0;
-  Log& event(const std::string& what) {
-    text += std::to_string(t += 10000) + " " + what + "\n";
-    return *this;
-  }
-  Log& pen(double x, double y, double z = 0) {
-    return event("pen " + format_double(x) + " " + format_double(y) + " " + format_double(z));
-  }
-  Log& stroke(std::initializer_list<Vec3> points) {
-    event("down");
-    for (const Vec3& p : points) pen(p.x(), p.y(), p.z());
-    return event("up");
-  }
-};
-
-int64_t step_clock() {
-  static int64_t t = 0;
-  return t += 1000;
-}
-
-std::unique_ptr<World> replay(const Log& log) {
-  auto parsed = parse_input_log(log.text, "feedback.log");
-  REQUIRE(parsed);
-  auto w = std::make_unique<World>();
-  w->log = std::move(*parsed);
-  Scheduler scheduler = make_scheduler(*w, step_clock);
-  replay_headless(*w, scheduler);
-  return w;
-}
 
 // Three sides of the square; the fourth closes it when it ends within the default 1 cm of (0, 0, 0).
 Log open_border() {
