@@ -117,6 +117,7 @@ int main(int argc, char** argv) {
   if (!draw_border(mesh, history, rng, why)) return fail(0, why);
 
   uint64_t applied = 0, rejected = 0, compactions = 0, borders = 1, checks = 0, refused_surfaces = 0;
+  uint64_t closed = 0, holed = 0;  // operations after which the network had no border loop, or more than one
   const double rss_start = resident_mib();
   const double t0 = seconds_now();
   double next_report = t0 + 10;
@@ -144,6 +145,11 @@ int main(int argc, char** argv) {
       if (auto edit = test::random_edit(mesh, history, rng, split, dice, 750, 900)) r = std::move(*edit);
     }
     (r.ok() ? applied : rejected) += 1;
+    if (mesh.face_count() > 0) {
+      const size_t loops = mesh.border_loop_count();
+      closed += loops == 0;
+      holed += loops > 1;
+    }
     if (auto bad = mesh.validate(); !bad.empty()) return fail(op, "pools: " + bad);
     snap.sync(mesh);
     if (op % s.surface_every == 0) {
@@ -184,6 +190,8 @@ int main(int argc, char** argv) {
               "network the method refuses)\n",
               (unsigned long long)applied, (unsigned long long)rejected, (unsigned long long)compactions,
               (unsigned long long)borders, (unsigned long long)checks, (unsigned long long)refused_surfaces);
+  std::printf("  topology: closed after %llu operations, with more than one border loop (holes) after %llu\n",
+              (unsigned long long)closed, (unsigned long long)holed);
   std::printf("  %.1f s, %.0f operations per second; resident memory %.1f MiB at the start, %.1f MiB at the end, "
               "peak %.1f MiB\n",
               elapsed, double(s.operations) / elapsed, rss_start, resident_mib(), peak_mib());

@@ -1,10 +1,12 @@
-// 10,000 seeded random operations (splits, deletes, undos, redos) with validate() after each; a rejected
+// 10,000 seeded random operations (splits, holes, curves across a border's hole, deletes, undos, redos) with
+// validate() after each; a rejected
 // operation must leave the pools untouched, and undo followed by redo must give the same pools back.
 #include <random>
 
 #include <catch2/catch.hpp>
 
 #include "engine/network_io.hpp"
+#include "../reconstruct/networks.hpp"
 #include "test_helpers.hpp"
 
 using namespace fire;
@@ -13,7 +15,7 @@ using namespace fire::test;
 namespace {
 
 struct Stats {
-  int splits = 0, deletes = 0, undos = 0, redos = 0, rejected = 0;
+  int splits = 0, topology = 0, deletes = 0, undos = 0, redos = 0, rejected = 0;
 };
 
 
@@ -28,7 +30,11 @@ TEST_CASE("10,000 random edits keep every invariant", "[random]") {
     uint64_t dice = rng() % 100;
     uint64_t before = m.hash();
     Status r;
-    if (dice < 55) {
+    if (dice < 5) {
+      const std::optional<EditCommand> c = random_topology_edit(m, rng);
+      r = c ? h.apply(m, *c) : Status::failure("no face");
+      s.topology += r.ok();
+    } else if (dice < 55) {
       r = h.apply(m, random_split(m, rng, 8));
       s.splits += r.ok();
     } else if (dice < 70) {
@@ -61,6 +67,7 @@ TEST_CASE("10,000 random edits keep every invariant", "[random]") {
   }
   // The mix really exercised every operation.
   CHECK(s.splits > 3000);
+  CHECK(s.topology > 50);
   CHECK(s.deletes > 300);
   CHECK(s.undos > 1000);
   CHECK(s.redos > 150);

@@ -40,10 +40,13 @@ Mesh limit_grid_network(uint32_t m, uint32_t levels, const Height& height);
 // A curve across a random live face between two random points of its border, bowed up. Mostly between
 // points inside two different edges; one in sixteen may end anywhere, which can make 2-sided faces.
 EditCommand random_split(const Mesh& m, std::mt19937_64& rng);
+// A random change of topology: a random face made a hole (refused when it lies beside or touches the border),
+// or a curve across a random border loop's hole between two of its points, bowed down; nothing without faces.
+std::optional<EditCommand> random_topology_edit(const Mesh& m, std::mt19937_64& rng);
 // Deleting a random interior curve, or nothing when every curve is on the border.
 std::optional<EditCommand> random_delete(const Mesh& m, std::mt19937_64& rng);
-// One random edit through `history`, as the random-edit tests and the soak draw them: a random split when
-// `split`, else by `dice`: a random delete below `delete_below`, an undo below `undo_below`, else a redo.
+// One random edit through `history`, as the random-edit tests and the soak draw them: when `split`, a random
+// topology edit one time in eight, else a random split; else by `dice`: a random delete below `delete_below`, an undo below `undo_below`, else a redo.
 // Nothing (no edit made) when a delete was drawn and every curve is on the border.
 std::optional<Status> random_edit(Mesh& net, EditHistory& history, std::mt19937_64& rng, bool split, uint64_t dice,
                                   uint64_t delete_below, uint64_t undo_below);

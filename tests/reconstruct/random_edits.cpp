@@ -32,6 +32,35 @@ EditCommand random_split(const Mesh& m, std::mt19937_64& rng) {
 }
 
 
+std::optional<EditCommand> random_topology_edit(const Mesh& m, std::mt19937_64& rng) {
+  std::vector<uint32_t> rim, faces;
+  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e) && m.is_border_edge(e) && !m.is_loose_edge(e)) rim.push_back(e);
+  for (uint32_t f = 0; f < m.face_slots(); ++f)
+    if (m.face_alive(f)) faces.push_back(f);
+  if (faces.empty()) return std::nullopt;
+  EditCommand c;
+  if (rim.empty() || rng() % 2 == 0) {
+    c.kind = EditKind::MakeHole;
+    c.face = faces[rng() % faces.size()];
+    return c;
+  }
+  const std::vector<uint32_t> loop = m.border_loop(rim[rng() % rim.size()]);
+  if (loop.size() < 2) return std::nullopt;
+  c.kind = EditKind::SplitHole;
+  auto pick = [&](uint32_t e) { return CurveEnd{e, uint32_t(rng() % m.edges.point_count[e])}; };
+  const size_t first = rng() % loop.size(), second = (first + 1 + rng() % (loop.size() - 1)) % loop.size();
+  c.start = pick(edge_of(loop[first]));
+  c.end = pick(edge_of(loop[second]));
+  const Vec3 a = m.polyline(c.start.edge)[c.start.point], b = m.polyline(c.end.edge)[c.end.point];
+  const int n = 3 + int(rng() % 8);
+  for (int k = 0; k < n; ++k) {
+    const double s = double(k) / (n - 1);
+    c.points.push_back(a + (b - a) * s - Vec3(0, 0, 0.2 * std::sin(M_PI * s)));
+  }
+  return c;
+}
+
 std::optional<EditCommand> random_delete(const Mesh& m, std::mt19937_64& rng) {
   std::vector<uint32_t> interior;
   for (uint32_t e = 0; e < m.edge_slots(); ++e)
@@ -45,7 +74,11 @@ std::optional<EditCommand> random_delete(const Mesh& m, std::mt19937_64& rng) {
 
 std::optional<Status> random_edit(Mesh& net, EditHistory& history, std::mt19937_64& rng, bool split, uint64_t dice,
                                   uint64_t delete_below, uint64_t undo_below) {
-  if (split) return history.apply(net, random_split(net, rng));
+  if (split) {
+    if (rng() % 8 == 0)
+      if (const std::optional<EditCommand> topology = random_topology_edit(net, rng)) return history.apply(net, *topology);
+    return history.apply(net, random_split(net, rng));
+  }
   if (dice < delete_below) {
     const std::optional<EditCommand> del = random_delete(net, rng);
     if (!del) return std::nullopt;
