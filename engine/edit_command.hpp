@@ -16,14 +16,15 @@ struct CurveEnd {
 };
 
 // Kinds are appended, never reordered: snapshots hold them as bytes.
-enum class EditKind : uint8_t { StartBorder, AppendBorder, CloseBorder, SplitFace, DeleteCurve, ToggleSharp, MakeHole, SplitHole };
+enum class EditKind : uint8_t { StartBorder, AppendBorder, CloseBorder, SplitFace, DeleteCurve, ToggleSharp, MakeHole, SplitHole,
+                                JoinBorders };
 
 struct EditCommand {
   EditKind kind = EditKind::StartBorder;
   std::vector<Vec3> points;  // the new curve's polyline (the border and split kinds)
   uint32_t face = kNone;     // SplitFace: the face the curve crosses; MakeHole: the face that becomes a hole
   CurveEnd start, end;       // SplitFace: where the curve starts and ends on that face's boundary; SplitHole: on
-                             // one border loop, whose hole the curve crosses
+                             // one border loop, whose hole the curve crosses; JoinBorders: on two border loops
   uint32_t edge = kNone;     // DeleteCurve, ToggleSharp (sharp becomes smooth, smooth sharp)
   double snap_distance = 0;  // CloseBorder: how far the last point may lie from the first vertex
 };

@@ -115,8 +115,14 @@ std::vector<uint32_t> Mesh::border_loop(uint32_t e) const {
 
 bool Mesh::border_in_progress() const {
   for (uint32_t e = 0; e < edge_slots(); ++e)
-    if (edge_alive(e) && is_loose_edge(e)) return true;
+    if (edge_alive(e) && is_loose_edge(e) && !(edges.flags[e] & kBridgeEdge)) return true;
   return false;
+}
+
+size_t Mesh::pending_bridge_count() const {
+  size_t n = 0;
+  for (uint32_t e = 0; e < edge_slots(); ++e) n += edge_alive(e) && is_loose_edge(e) && (edges.flags[e] & kBridgeEdge);
+  return n;
 }
 
 size_t Mesh::border_loop_count() const {

@@ -45,6 +45,7 @@ enum ElementFlag : uint8_t {
   kAlive = 1,
   kSplitVertex = 2,  // vertex made by splitting an edge: joined again when no curve needs it
   kSharpEdge = 4,    // crease for subdivision
+  kBridgeEdge = 8,   // a curve between two border loops across their hole, no face yet: the second one makes the faces
 };
 
 struct VertexPool {
@@ -154,8 +155,10 @@ class Mesh {
   // The border loop through border edge e as the hole beside it walks it, starting with e; empty when e has
   // not exactly one face, or the loop passes a vertex with more than two border curves (it pinches there).
   std::vector<uint32_t> border_loop(uint32_t e) const;
-  // Whether a border polygon is being drawn: some live edge has no face yet.
+  // Whether a border polygon is being drawn: some live edge other than a bridge has no face yet.
   bool border_in_progress() const;
+  // Bridges (kBridgeEdge) still waiting for the second curve between their two border loops.
+  size_t pending_bridge_count() const;
   // The border loops of the faces (what Mesh::border_loop walks; a loop through a pinched vertex is not counted).
   size_t border_loop_count() const;
   // Index of edge e in f's loop, or kNone.

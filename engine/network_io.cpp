@@ -19,6 +19,7 @@ std::string network_to_json(const Mesh& m) {
     edges.push_back({{"v", {m.edges.vertex[e][0], m.edges.vertex[e][1]}},
                      {"sharp", bool(m.edges.flags[e] & kSharpEdge)},
                      {"points", std::move(pts)}});
+    if (m.edges.flags[e] & kBridgeEdge) edges.back()["bridge"] = true;  // only then: older networks read the same
   }
   for (uint32_t f = 0; f < m.face_slots(); ++f) {
     json es = json::array(), rs = json::array();
@@ -99,6 +100,10 @@ Result<Mesh> network_from_json(std::string_view text, const std::string& source)
       if (!sharp.is_boolean()) throw Bad{where + ": \"sharp\" must be true or false"};
       uint32_t e = m.add_edge(a, b, line);
       if (sharp.get<bool>()) m.set_edge_flag(e, kSharpEdge, true);
+      if (const auto bridge = es[i].find("bridge"); bridge != es[i].end()) {
+        if (!bridge->is_boolean()) throw Bad{where + ": \"bridge\" must be true or false"};
+        if (bridge->get<bool>()) m.set_edge_flag(e, kBridgeEdge, true);
+      }
     }
     std::vector<uint32_t> loop;
     for (size_t i = 0; i < fs.size(); ++i) {

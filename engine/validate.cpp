@@ -80,6 +80,7 @@ std::string Mesh::validate() const {
       if (hits != 1) return name + " appears " + std::to_string(hits) + " times in face " + str(f) + " that it names";
     }
     if (ef[0] != kNone && ef[0] == ef[1]) return name + " has face " + str(ef[0]) + " on both sides";
+    if ((edges.flags[e] & kBridgeEdge) && (ef[0] != kNone || ef[1] != kNone)) return name + " is a bridge but has a face";
     ++incidences;
   }
 

@@ -145,6 +145,9 @@ void Hud::build(const HudData& d) {
   ImGui::Separator();
   ImGui::Text("vertices %zu  edges %zu  faces %zu", d.vertices, d.edges, d.faces);
   ImGui::Text("border loops %zu%s", d.border_loops, d.border_loops == 0 && d.faces > 0 ? " (closed)" : "");
+  if (d.pending_bridges > 0)
+    ImGui::TextWrapped("%zu curve(s) between two border loops: no surface between them until a second curve joins the same two loops",
+                       d.pending_bridges);
   ImGui::Text("points %zu  surface quads %zu", d.points, d.surface_quads);
   ImGui::Text("mode: %s", d.border_mode ? "border (strokes extend the border)" : "split (strokes split faces)");
   ImGui::Text("view: surface %s  curves %s  wireframe %s", d.view.surface ? "on" : "off", d.view.curves ? "on" : "off",

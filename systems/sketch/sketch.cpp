@@ -70,11 +70,14 @@ CurveEnd at_vertex(const Mesh& mesh, std::span<const uint32_t> loop, const Curve
 }
 
 
-// Where a stroke across a hole lands: both ends on one border loop (the nearest border point to each end
-// within `limit`, the end's on the start's loop).
+// Where a stroke across a hole lands: both ends on border loops, the nearest border point to each end within
+// `limit`, the end's on the start's loop where there is one (a curve across that loop's hole), else on another
+// loop (a curve joining the two, `join`).
 struct HoleSnap {
-  std::vector<uint32_t> rim;  // the border loop, as Mesh::border_loop walks it; empty when there is none
+  std::vector<uint32_t> rim;  // the start's border loop, as Mesh::border_loop walks it; empty when there is none
+  std::vector<uint32_t> end_rim;  // the end's: `rim` unless `join`
   CurveEnd start, end;
+  bool join = false;
 };
 
 HoleSnap snap_to_hole(const Mesh& m, const SnapIndex& index, const Vec3& start, const Vec3& end, double limit) {
@@ -94,8 +97,12 @@ HoleSnap snap_to_hole(const Mesh& m, const SnapIndex& index, const Vec3& start, 
   if (!a.found()) return out;
   std::vector<uint32_t> rim = m.border_loop(a.edge);
   if (rim.empty()) return out;
-  const SnapHit b = nearest_border(end, &rim);
+  SnapHit b = nearest_border(end, &rim);
+  out.join = !b.found();
+  if (out.join) b = nearest_border(end, nullptr);
   if (!b.found()) return out;
+  out.end_rim = out.join ? m.border_loop(b.edge) : rim;
+  if (out.end_rim.empty()) return out;
   out.rim = std::move(rim);
   out.start = {a.edge, a.point};
   out.end = {b.edge, b.point};
@@ -309,10 +316,11 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
             break;
           }
           const std::span<const uint32_t> loop = s.face != kNone ? mesh.face_loop(s.face) : std::span<const uint32_t>(h.rim);
-          r.command.kind = s.face != kNone ? EditKind::SplitFace : EditKind::SplitHole;
+          const std::span<const uint32_t> end_loop = s.face != kNone ? loop : std::span<const uint32_t>(h.end_rim);
+          r.command.kind = s.face != kNone ? EditKind::SplitFace : h.join ? EditKind::JoinBorders : EditKind::SplitHole;
           r.command.face = s.face;
           r.command.start = at_vertex(mesh, loop, s.face != kNone ? s.start : h.start, r.command.points.front(), vertex_radius(state.start_snap));
-          r.command.end = at_vertex(mesh, loop, s.face != kNone ? s.end : h.end, r.command.points.back(), vertex_radius(state.end_snap));
+          r.command.end = at_vertex(mesh, end_loop, s.face != kNone ? s.end : h.end, r.command.points.back(), vertex_radius(state.end_snap));
           const Vec3& start = mesh.polyline(r.command.start.edge)[r.command.start.point];
           const Vec3& end = mesh.polyline(r.command.end.edge)[r.command.end.point];
           drop_pauses(r.command.points, start, vertex_radius(state.start_snap), end, vertex_radius(state.end_snap));

@@ -200,6 +200,101 @@ Status make_hole(Mesh& m, const EditCommand& c) {
   return Status::success();
 }
 
+// The bridge waiting at a vertex of border loop `loop`, or kNone.
+uint32_t bridge_at(const Mesh& m, const std::vector<uint32_t>& loop) {
+  for (uint32_t oe : loop)
+    for (uint32_t g : m.vertex_edges(m.tail(oe)))
+      if (m.is_loose_edge(g) && (m.edges.flags[g] & kBridgeEdge)) return g;
+  return kNone;
+}
+
+bool on_loop(const Mesh& m, const std::vector<uint32_t>& loop, uint32_t v) {
+  return std::any_of(loop.begin(), loop.end(), [&](uint32_t oe) { return m.tail(oe) == v; });
+}
+
+// The border loop through vertex v, walked by its hole (empty if v is on none).
+std::vector<uint32_t> rim_at(const Mesh& m, uint32_t v) {
+  for (uint32_t g : m.vertex_edges(v))
+    if (m.is_border_edge(g) && !m.is_loose_edge(g)) return m.border_loop(g);
+  return {};
+}
+
+// The part of closed walk `loop` from the vertex `from` to the vertex `to`; the whole loop when they are one
+// vertex and `whole`, else nothing.
+std::vector<uint32_t> arc(const Mesh& m, const std::vector<uint32_t>& loop, uint32_t from, uint32_t to, bool whole) {
+  const size_t n = loop.size();
+  size_t i = 0;
+  while (i < n && m.tail(loop[i]) != from) ++i;
+  std::vector<uint32_t> out;
+  if (from == to && !whole) return out;
+  for (size_t k = 0; k < n; ++k) {
+    const uint32_t oe = loop[(i + k) % n];
+    if (k > 0 && m.tail(oe) == to) break;
+    out.push_back(oe);
+  }
+  return out;
+}
+
+// Checks one end of a curve between border loops: on a border curve with one face, whose loop has a single rim.
+Status border_end(const Mesh& m, const CurveEnd& end, const char* which, std::vector<uint32_t>& loop) {
+  if (!m.edge_alive(end.edge)) return Status::failure(std::string("the curve's ") + which + " names edge " + str(end.edge) + ", which does not exist");
+  if (!m.is_border_edge(end.edge) || m.is_loose_edge(end.edge))
+    return Status::failure(std::string("the curve's ") + which + " lies on curve " + str(end.edge) + ", which is not on the border");
+  loop = m.border_loop(end.edge);
+  if (loop.empty())
+    return Status::failure("the border through curve " + str(end.edge) + " passes a vertex with more than two border curves; a hole there has no single rim");
+  return Status::success();
+}
+
+// A curve from one border loop to another across the hole between them. The first between two loops is a
+// bridge with no face (the hole between them is not a disc yet: no surface there); the second turns it into
+// two faces, each bounded by an arc of both loops and both curves.
+Status join_borders(Mesh& m, const EditCommand& c) {
+  if (!has_faces(m)) return Status::failure("close a border polygon before joining border loops");
+  if (m.border_in_progress()) return Status::failure("a border polygon is being drawn; close it first");
+  if (auto ok = check_points(c.points); !ok.ok()) return ok;
+  std::vector<uint32_t> loop_a, loop_b;
+  if (auto ok = border_end(m, c.start, "start", loop_a); !ok.ok()) return ok;
+  if (auto ok = border_end(m, c.end, "end", loop_b); !ok.ok()) return ok;
+  if (on_loop(m, loop_a, m.tail(loop_b.front())))
+    return Status::failure("both ends lie on one border loop: the curve crosses that loop's hole, it joins no two loops");
+  ResolvedEnd a, b;
+  if (auto ok = resolve_point(m, c.start, "start", a); !ok.ok()) return ok;
+  if (auto ok = resolve_point(m, c.end, "end", b); !ok.ok()) return ok;
+  // A bridge already waiting between these two loops.
+  uint32_t bridge = kNone;
+  for (uint32_t g = 0; g < m.edge_slots() && bridge == kNone; ++g) {
+    if (!m.edge_alive(g) || !m.is_loose_edge(g) || !(m.edges.flags[g] & kBridgeEdge)) continue;
+    const auto ends = m.edges.vertex[g];
+    if ((on_loop(m, loop_a, ends[0]) && on_loop(m, loop_b, ends[1])) || (on_loop(m, loop_a, ends[1]) && on_loop(m, loop_b, ends[0])))
+      bridge = g;
+  }
+  const uint32_t va = a.vertex != kNone ? a.vertex : split_edge(m, a.edge, a.point);
+  const uint32_t vb = b.vertex != kNone ? b.vertex : split_edge(m, b.edge, b.point);
+  const uint32_t e = m.add_edge(va, vb, c.points);
+  if (bridge == kNone) {
+    m.set_edge_flag(e, kBridgeEdge, true);
+    return Status::success();
+  }
+  const std::vector<uint32_t> rim_a = rim_at(m, va), rim_b = rim_at(m, vb);
+  const auto ends = m.edges.vertex[bridge];
+  const uint32_t pa = on_loop(m, rim_a, ends[0]) ? ends[0] : ends[1], qb = pa == ends[0] ? ends[1] : ends[0];
+  const uint32_t bridge_forward = make_oriented(bridge, ends[0] != pa), bridge_back = make_oriented(bridge, ends[0] == pa);
+  // One face walks rim a from va to pa, the bridge, rim b from qb to vb, the new curve back; the other the rest.
+  std::vector<uint32_t> first = arc(m, rim_a, va, pa, false), second = arc(m, rim_a, pa, va, true);
+  first.push_back(bridge_forward);
+  const std::vector<uint32_t> b_first = arc(m, rim_b, qb, vb, false), b_second = arc(m, rim_b, vb, qb, true);
+  first.insert(first.end(), b_first.begin(), b_first.end());
+  first.push_back(make_oriented(e, true));
+  second.push_back(make_oriented(e, false));
+  second.insert(second.end(), b_second.begin(), b_second.end());
+  second.push_back(bridge_back);
+  m.set_edge_flag(bridge, kBridgeEdge, false);
+  if (m.add_face(first) == kNone || m.add_face(second) == kNone)
+    return Status::failure("internal: the two curves between the border loops do not bound two faces");
+  return Status::success();
+}
+
 // A curve across a border loop's hole, drawn on the far side of the surface (an object turned over to draw
 // its underside): the hole is a disc like any face, and the curve splits it as split_face does.
 Status split_hole(Mesh& m, const EditCommand& c) {
@@ -211,6 +306,8 @@ Status split_hole(Mesh& m, const EditCommand& c) {
   const std::vector<uint32_t> loop = m.border_loop(c.start.edge);
   if (loop.empty())
     return Status::failure("the border through curve " + str(c.start.edge) + " passes a vertex with more than two border curves; a hole there has no single rim");
+  if (bridge_at(m, loop) != kNone)
+    return Status::failure("a bridge from this border loop waits for its second curve: draw that (or undo the bridge) before crossing the loop's hole");
   ResolvedEnd a, b;
   if (auto ok = resolve_hole_end(m, loop, c.start, "start", a); !ok.ok()) return ok;
   if (auto ok = resolve_hole_end(m, loop, c.end, "end", b); !ok.ok()) return ok;
@@ -272,6 +369,13 @@ Status delete_curve(Mesh& m, const EditCommand& c) {
   uint32_t e = c.edge;
   if (!m.edge_alive(e)) return Status::failure("edge " + str(e) + " does not exist");
   if (!has_faces(m)) return Status::failure("curves can be deleted once the border polygon is closed");
+  if ((m.edges.flags[e] & kBridgeEdge) && m.is_loose_edge(e)) {  // a bridge still waiting: it goes alone
+    const auto ends = m.edges.vertex[e];
+    m.remove_edge(e);
+    join_at(m, ends[0]);
+    join_at(m, ends[1]);
+    return Status::success();
+  }
   uint32_t f0 = m.edges.face[e][0], f1 = m.edges.face[e][1];
   if (f0 == kNone || f1 == kNone) return Status::failure("edge " + str(e) + " is on the border polygon; only curves inside it can be deleted");
   // The merged face walks f0 after e, then f1 after e: it must stay a simple loop.
@@ -346,6 +450,7 @@ Status execute_edit(Mesh& mesh, const EditCommand& c) {
     case EditKind::ToggleSharp: return toggle_sharp(mesh, c);
     case EditKind::MakeHole: return make_hole(mesh, c);
     case EditKind::SplitHole: return split_hole(mesh, c);
+    case EditKind::JoinBorders: return join_borders(mesh, c);
   }
   return Status::failure("unknown edit command");
 }
@@ -412,7 +517,7 @@ bool load_command(SnapshotReader& in, EditCommand& c) {
   uint8_t kind = 0;
   in.get(kind);
   for_each_command_field(c, [&](auto& value) { in.get(value); });
-  if (kind > uint8_t(EditKind::SplitHole)) in.fail();
+  if (kind > uint8_t(EditKind::JoinBorders)) in.fail();
   c.kind = EditKind(kind);
   return in.ok();
 }

@@ -18,7 +18,10 @@ namespace fire {
 // and DeleteCurve need a closed border. ToggleSharp flips an inner curve's sharp flag (a crease of the
 // surface); border curves are creases already and are refused. MakeHole removes a face that touches no border
 // (its curves become border). SplitHole draws a curve across the hole of one border loop, the far side of the
-// surface there: the hole becomes two faces, one each side of the curve, and that border is gone.
+// surface there: the hole becomes two faces, one each side of the curve, and that border is gone. JoinBorders
+// draws a curve from one border loop to another across the hole between them (a handle, a vessel's wall, two
+// parts joined): the first is a bridge, with no face, and the second between the same two loops turns the hole
+// between them into two faces. DeleteCurve removes a bridge still waiting.
 Status execute_edit(Mesh& mesh, const EditCommand& command);
 
 // Splits edge e at interior polyline point `point` (0 < point < count-1): a new vertex and two edges

@@ -608,3 +608,73 @@ TEST_CASE("a border drawn apart from the network starts a second part", "[split]
   while (h.undo_depth() > 0) REQUIRE(h.undo(m).ok());
   CHECK(m.same_pools(Mesh{}));
 }
+
+TEST_CASE("two curves between two border loops: a bridge with no face, then two faces, holes make a tube", "[split][topology]") {
+  EditHistory h;
+  Mesh m = square(&h);
+  const Vec3 c[4] = {{0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  REQUIRE(h.apply(m, make(EditKind::StartBorder, line(c[0], c[1]))).ok());
+  REQUIRE(h.apply(m, make(EditKind::AppendBorder, line(c[1], c[2]))).ok());
+  REQUIRE(h.apply(m, make(EditKind::AppendBorder, line(c[2], c[3]))).ok());
+  EditCommand close = make(EditKind::CloseBorder, line(c[3], c[0]));
+  close.snap_distance = 0.01;
+  REQUIRE(h.apply(m, close).ok());
+  auto point_at = [&](const Vec3& p) {
+    for (uint32_t e = 0; e < m.edge_slots(); ++e)
+      if (m.edge_alive(e))
+        for (uint32_t k = 0; k < m.edges.point_count[e]; ++k)
+          if (at(m, e, k) == p) return CurveEnd{e, k};
+    return CurveEnd{};
+  };
+  auto bridge = [&](double y) {
+    EditCommand b = make(EditKind::JoinBorders, line({0.5, y, 0}, {0.5, y, 1}, 5));
+    b.points[2] += Vec3(0, y == 0 ? -0.3 : 0.3, 0);
+    b.start = point_at({0.5, y, 0});
+    b.end = point_at({0.5, y, 1});
+    return b;
+  };
+  const Mesh two_parts = m;
+  apply_undo_redo(m, h, bridge(0));
+  CHECK(m.pending_bridge_count() == 1);
+  CHECK(m.face_count() == 2);
+  CHECK(m.border_loop_count() == 2);
+  CHECK_FALSE(m.border_in_progress());
+  // Crossing a loop that a bridge waits on is refused; so is a bridge with both ends on one loop.
+  EditCommand across = make(EditKind::SplitHole, line({0.25, 0, 0}, {1, 0.5, 0}));
+  across.start = point_at({0.25, 0, 0});
+  across.end = point_at({1, 0.5, 0});
+  REQUIRE(across.start.edge != kNone);
+  REQUIRE(across.end.edge != kNone);
+  const Mesh waiting = m;
+  CHECK_THAT(h.apply(m, across).error, Catch::Matchers::Contains("waits for its second curve"));
+  EditCommand same = across;
+  same.kind = EditKind::JoinBorders;
+  CHECK_THAT(h.apply(m, same).error, Catch::Matchers::Contains("one border loop"));
+  CHECK(m.same_pools(waiting));
+  // A waiting bridge can be deleted; its ends join the rims again.
+  EditCommand del = remove(kNone);
+  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e) && (m.edges.flags[e] & kBridgeEdge)) del.edge = e;
+  REQUIRE(h.apply(m, del).ok());
+  CHECK(m.validate() == "");
+  CHECK(m.edge_count() == two_parts.edge_count());
+  CHECK(m.vertex_count() == two_parts.vertex_count());
+  REQUIRE(h.undo(m).ok());
+  CHECK(m.same_pools(waiting));
+
+  apply_undo_redo(m, h, bridge(1));
+  CHECK(m.pending_bridge_count() == 0);
+  CHECK(m.face_count() == 4);
+  CHECK(m.border_loop_count() == 0);
+  CHECK(euler_characteristic(m) == 2);  // two discs and the band between them: a sphere
+  // Both squares made holes: a tube open at both ends, as a lampshade.
+  uint32_t bottom = m.edges.face[point_at({0.25, 0, 0}).edge][0], top = m.edges.face[point_at({0.25, 0, 1}).edge][0];
+  REQUIRE(h.apply(m, hole(bottom)).ok());
+  REQUIRE(h.apply(m, hole(top)).ok());
+  CHECK(m.validate() == "");
+  CHECK(m.face_count() == 2);
+  CHECK(m.border_loop_count() == 2);
+  CHECK(euler_characteristic(m) == 0);
+  while (h.undo_depth() > 0) REQUIRE(h.undo(m).ok());
+  CHECK(m.same_pools(Mesh{}));
+}

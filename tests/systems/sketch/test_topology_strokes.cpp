@@ -26,12 +26,12 @@ Log& arc(Log& log, const Vec3& a, const Vec3& b, double bulge = 0) {
   return log.event("up");
 }
 
-// A 10 cm square at z = 0 offset by x0 along x, closed, a sample every centimetre.
-Log& square(Log& log, double x0 = 0) {
-  arc(log, {x0, 0, 0}, {x0 + 0.1, 0, 0});
-  arc(log, {x0 + 0.1, 0, 0}, {x0 + 0.1, 0.1, 0});
-  arc(log, {x0 + 0.1, 0.1, 0}, {x0, 0.1, 0});
-  return arc(log, {x0, 0.1, 0}, {x0 + 0.001, 0.001, 0});
+// A 10 cm square offset by x0 along x at height z, closed, a sample every centimetre.
+Log& square(Log& log, double x0 = 0, double z = 0) {
+  arc(log, {x0, 0, z}, {x0 + 0.1, 0, z});
+  arc(log, {x0 + 0.1, 0, z}, {x0 + 0.1, 0.1, z});
+  arc(log, {x0 + 0.1, 0.1, z}, {x0, 0.1, z});
+  return arc(log, {x0, 0.1, z}, {x0 + 0.001, 0.001, z});
 }
 
 // The square, its top split by an arch, and a curve under it from near one corner to near the opposite one:
@@ -139,4 +139,40 @@ TEST_CASE("a version-1 log replays by version 1's rules: the same strokes are re
     log->text = version2;
     CHECK(replay(*log)->log.version == 2);
   }
+}
+
+TEST_CASE("strokes between two parts' border loops: the first waits with no surface, the second makes the band", "[sketch][topology]") {
+  // Two squares 10 cm apart, one above the other, joined by two curves bowed outwards: a closed box; with
+  // both squares made holes, a tube open at both ends.
+  Log log;
+  square(log);
+  square(log, 0, 0.1);
+  log.event("down");
+  for (int k = 0; k <= 10; ++k) log.pen(0.05, -0.03 * std::sin(std::numbers::pi * k / 10.0), 0.01 * k);
+  log.event("up");
+  auto w = replay(log);
+  INFO(rejections(*w));
+  CHECK(w->rejections.empty());
+  CHECK(w->mesh.pending_bridge_count() == 1);
+  CHECK(w->mesh.face_count() == 2);
+  log.event("down");
+  for (int k = 0; k <= 10; ++k) log.pen(0.05, 0.1 + 0.03 * std::sin(std::numbers::pi * k / 10.0), 0.01 * k);
+  log.event("up");
+  w = replay(log);
+  CHECK(w->rejections.empty());
+  CHECK(w->mesh.pending_bridge_count() == 0);
+  CHECK(w->mesh.face_count() == 4);
+  REQUIRE(w->surface.level > 0);
+  evaluate::Topology t = surface_topology(*w);
+  CHECK(t.border_loops == 0);
+  CHECK(t.euler_characteristic == 2);
+  log.event("cmd hole 0.05 0.05 -0.002");
+  log.event("cmd hole 0.05 0.05 0.102");
+  w = replay(log);
+  INFO(rejections(*w));
+  CHECK(w->rejections.empty());
+  CHECK(w->mesh.face_count() == 2);
+  t = surface_topology(*w);
+  CHECK(t.border_loops == 2);
+  CHECK(t.euler_characteristic == 0);
 }
