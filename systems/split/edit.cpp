@@ -269,6 +269,10 @@ Status join_borders(Mesh& m, const EditCommand& c) {
     if ((on_loop(m, loop_a, ends[0]) && on_loop(m, loop_b, ends[1])) || (on_loop(m, loop_a, ends[1]) && on_loop(m, loop_b, ends[0])))
       bridge = g;
   }
+  if (bridge != kNone)
+    for (uint32_t v : {a.vertex, b.vertex})
+      if (v != kNone && (v == m.edges.vertex[bridge][0] || v == m.edges.vertex[bridge][1]))
+        return Status::failure("the curve ends at vertex " + str(v) + ", where the bridge waiting between these loops ends: the face beside them would touch itself there");
   const uint32_t va = a.vertex != kNone ? a.vertex : split_edge(m, a.edge, a.point);
   const uint32_t vb = b.vertex != kNone ? b.vertex : split_edge(m, b.edge, b.point);
   const uint32_t e = m.add_edge(va, vb, c.points);

@@ -651,6 +651,12 @@ TEST_CASE("two curves between two border loops: a bridge with no face, then two 
   same.kind = EditKind::JoinBorders;
   CHECK_THAT(h.apply(m, same).error, Catch::Matchers::Contains("one border loop"));
   CHECK(m.same_pools(waiting));
+  // A second curve from where the bridge ends would make a face that touches itself there.
+  EditCommand from_bridge_end = bridge(1);
+  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e) && m.is_border_edge(e) && !m.is_loose_edge(e) && at(m, e, 0) == Vec3(0.5, 0, 0)) from_bridge_end.start = {e, 0};
+  CHECK_THAT(h.apply(m, from_bridge_end).error, Catch::Matchers::Contains("touch itself"));
+  CHECK(m.same_pools(waiting));
   // A waiting bridge can be deleted; its ends join the rims again.
   EditCommand del = remove(kNone);
   for (uint32_t e = 0; e < m.edge_slots(); ++e)

@@ -41,7 +41,8 @@ Mesh limit_grid_network(uint32_t m, uint32_t levels, const Height& height);
 // points inside two different edges; one in sixteen may end anywhere, which can make 2-sided faces.
 EditCommand random_split(const Mesh& m, std::mt19937_64& rng);
 // A random change of topology: a random face made a hole (refused when it lies beside or touches the border),
-// or a curve across a random border loop's hole between two of its points, bowed down; nothing without faces.
+// or a curve from a random border loop, bowed down: across its hole to another of its points, or to another
+// border loop (a bridge, or the faces of a second one); nothing without faces.
 std::optional<EditCommand> random_topology_edit(const Mesh& m, std::mt19937_64& rng);
 // Deleting a random interior curve, or nothing when every curve is on the border.
 std::optional<EditCommand> random_delete(const Mesh& m, std::mt19937_64& rng);

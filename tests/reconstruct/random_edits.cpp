@@ -1,4 +1,5 @@
 // The random edits of networks.hpp, without Catch, so the soak in perf/soak/ builds them too.
+#include <algorithm>
 #include <cmath>
 
 #include "networks.hpp"
@@ -47,11 +48,21 @@ std::optional<EditCommand> random_topology_edit(const Mesh& m, std::mt19937_64& 
   }
   const std::vector<uint32_t> loop = m.border_loop(rim[rng() % rim.size()]);
   if (loop.size() < 2) return std::nullopt;
-  c.kind = EditKind::SplitHole;
   auto pick = [&](uint32_t e) { return CurveEnd{e, uint32_t(rng() % m.edges.point_count[e])}; };
-  const size_t first = rng() % loop.size(), second = (first + 1 + rng() % (loop.size() - 1)) % loop.size();
-  c.start = pick(edge_of(loop[first]));
-  c.end = pick(edge_of(loop[second]));
+  // One time in two, towards another border loop where there is one: a curve joining the two.
+  std::vector<uint32_t> other;
+  for (uint32_t e : rim)
+    if (std::none_of(loop.begin(), loop.end(), [&](uint32_t oe) { return edge_of(oe) == e; })) other.push_back(e);
+  if (!other.empty() && rng() % 2 == 0) {
+    c.kind = EditKind::JoinBorders;
+    c.start = pick(edge_of(loop[rng() % loop.size()]));
+    c.end = pick(other[rng() % other.size()]);
+  } else {
+    c.kind = EditKind::SplitHole;
+    const size_t first = rng() % loop.size(), second = (first + 1 + rng() % (loop.size() - 1)) % loop.size();
+    c.start = pick(edge_of(loop[first]));
+    c.end = pick(edge_of(loop[second]));
+  }
   const Vec3 a = m.polyline(c.start.edge)[c.start.point], b = m.polyline(c.end.edge)[c.end.point];
   const int n = 3 + int(rng() % 8);
   for (int k = 0; k < n; ++k) {

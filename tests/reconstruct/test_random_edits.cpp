@@ -78,7 +78,7 @@ TEST_CASE("random edits: incremental reconstruction equals a rebuild after every
     net.begin_frame(net.frame() + 1);
   }
   // The mix really edited the network, the topology too (closed by curves across the border's hole, opened
-  // again by holes), and the thesis comparison really ran (seed 20261124: 105 edits applied, 19 thesis
+  // again by holes), and the thesis comparison really ran (seed 20261124: 108 edits applied, 19 thesis
   // comparisons, 101 refusals; 5 steps closed, 50 with more than one border loop).
   INFO("applied " << applied << ", thesis compared " << compared << ", refused " << thesis_refused << ", closed "
                   << closed_steps << ", holed " << holed_steps);
