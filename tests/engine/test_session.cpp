@@ -3,6 +3,8 @@
 // every snapshot; each time the reopened world holds every committed stroke, its pools validate, and its
 // hash is a clean replay's of the log that survived. FIRE_CRASH_RUNS=N sets the kills and the cuts
 // (20 each by default; the 100-run record in perf/RESULTS.md is FIRE_CRASH_RUNS=100).
+#include <numbers>
+
 #include <catch2/catch.hpp>
 
 #include <chrono>
@@ -401,6 +403,56 @@ TEST_CASE("every snapshot plus the log's tail equals a full replay, hash for has
     CHECK(c.pen_down > 0);
     CHECK(c.redo > 0);
     CHECK(c.provisional > 0);
+  }
+  SECTION("topology strokes (version 2): closed across the hole, a face made a hole and back, two loops joined") {
+    std::string text = "FIRE-LOG 2\n";
+    int64_t t = 0;
+    auto stroke = [&](const Vec3& a, const Vec3& b, double bulge) {
+      text += std::to_string(t) + " down\n";
+      for (int k = 0; k <= 8; ++k) {
+        const Vec3 p = a + (b - a) * (k / 8.0) + Vec3(0, 0, bulge * std::sin(std::numbers::pi * k / 8.0));
+        text += std::to_string(t += 10'000) + " pen " + format_double(p.x()) + " " + format_double(p.y()) + " " +
+                format_double(p.z()) + "\n";
+      }
+      text += std::to_string(t += 10'000) + " up\n";
+    };
+    auto command = [&](const std::string& c) { text += std::to_string(t += 10'000) + " cmd " + c + "\n"; };
+    stroke({0, 0, 0}, {1, 0, 0}, 0);
+    stroke({1, 0, 0}, {1, 1, 0}, 0);
+    stroke({1, 1, 0}, {0, 1, 0}, 0);
+    stroke({0, 1, 0}, {0.001, 0.001, 0}, 0);
+    stroke({0.5, 0, 0}, {0.5, 1, 0}, 0.3);     // the top split
+    stroke({0.25, 0, 0}, {0.75, 1, 0}, -0.3);  // across the hole below: closed
+    command("hole 0.1 0.5 -0.05");             // the face below on the left: a hole again
+    command("undo");
+    command("redo");
+    stroke({0, 0, 2}, {1, 0, 2}, 0);           // a second part, 2 above
+    stroke({1, 0, 2}, {1, 1, 2}, 0);
+    stroke({1, 1, 2}, {0, 1, 2}, 0);
+    stroke({0, 1, 2}, {0.001, 0.001, 2}, 0);
+    text += std::to_string(t) + " down\n";      // a bridge from the hole's rim up to the second part
+    for (int k = 0; k <= 8; ++k)
+      text += std::to_string(t += 10'000) + " pen 0 " + format_double(0.5 + 0.1 * std::sin(std::numbers::pi * k / 8.0)) + " " +
+              format_double(0.25 * k) + "\n";
+    text += std::to_string(t += 10'000) + " up\n";
+    auto log = parse_input_log(text, "topology.log");
+    REQUIRE(log.ok());
+    WrittenSession s;
+    write_with_snapshots(*log, 2, s);
+    const uint64_t expected = clean_hash(log->events);
+    CHECK(clean_hash(recover_input_log(s.log, "log")->log.events) == expected);
+    const SnapshotCoverage c = reopen_from_each_snapshot(s, expected);
+    CHECK(c.redo > 0);
+    // What the log drew: 5 faces (two on top, one below, the second part) and a bridge waiting.
+    World w;
+    w.log = *log;
+    Scheduler scheduler = make_scheduler(w, [] { return int64_t(0); });
+    replay_headless(w, scheduler);
+    INFO((w.rejections.empty() ? std::string() : w.rejections.back().reason));
+    CHECK(w.rejections.empty());
+    CHECK(w.mesh.face_count() == 4);
+    CHECK(w.mesh.pending_bridge_count() == 1);
+    CHECK(w.mesh.border_loop_count() == 2);
   }
 }
 
