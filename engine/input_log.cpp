@@ -222,8 +222,8 @@ std::string format_event(const InputEvent& e) {
   return s;
 }
 
-std::string format_input_log(const std::vector<InputEvent>& events) {
-  std::string s(kInputLogHeader);
+std::string format_input_log(const std::vector<InputEvent>& events, uint32_t version) {
+  std::string s = input_log_header(version);
   s += '\n';
   for (const auto& e : events) s += format_event(e);
   return s;

@@ -40,7 +40,10 @@ struct InputLog {
   uint32_t version = 2;
 };
 
+inline constexpr uint32_t kInputLogVersion = 2;
 inline constexpr std::string_view kInputLogHeader = "FIRE-LOG 2";
+// The header line of a log of `version` (1 or 2), without its end of line.
+inline std::string input_log_header(uint32_t version) { return "FIRE-LOG " + std::to_string(version); }
 
 // Parses a whole log held in memory; `source` names it in error messages.
 Result<InputLog> parse_input_log(std::string_view text, const std::string& source);
@@ -49,8 +52,9 @@ Result<InputLog> read_input_log(const std::string& path);
 
 // One line of the format, ending in '\n'.
 std::string format_event(const InputEvent& e);
-// The header line followed by every event.
-std::string format_input_log(const std::vector<InputEvent>& events);
+// The header line followed by every event. A log read from a version-1 file is written as version 1, so it
+// keeps replaying by its own rules.
+std::string format_input_log(const std::vector<InputEvent>& events, uint32_t version = kInputLogVersion);
 
 // Shortest text that reads back as the same double.
 std::string format_double(double v);

@@ -7,7 +7,7 @@
 namespace fire {
 
 Result<SessionWriter> SessionWriter::create(const std::string& dir, std::string_view settings_json, std::string_view rig_json,
-                                            std::string_view marks_json) {
+                                            std::string_view marks_json, uint32_t log_version) {
   using R = Result<SessionWriter>;
   if (Status s = make_directory(dir); !s) return R::failure(s.error);
   auto names = list_directory(dir);
@@ -22,8 +22,7 @@ Result<SessionWriter> SessionWriter::create(const std::string& dir, std::string_
   auto log = AppendFile::open(paths.log());
   if (!log) return R::failure(log.error());
   SessionWriter w(paths, std::move(*log));
-  std::string header(kInputLogHeader);
-  header += '\n';
+  std::string header = input_log_header(log_version) + '\n';
   if (Status s = w.write(header); !s) return R::failure(s.error);
   if (Status s = w.log_.sync(); !s) return R::failure(s.error);
   if (Status s = sync_directory(dir); !s) return R::failure(s.error);

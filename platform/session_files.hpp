@@ -28,9 +28,10 @@ struct SessionContents {
 class SessionWriter {
  public:
   // Makes `dir` (missing or empty) and writes the settings, the rig and the marks (each when given) and the
-  // log's header, durably.
+  // log's header (of `log_version`: the version of the log the session goes on from), durably.
   static Result<SessionWriter> create(const std::string& dir, std::string_view settings_json,
-                                      std::string_view rig_json = {}, std::string_view marks_json = {});
+                                      std::string_view rig_json = {}, std::string_view marks_json = {},
+                                      uint32_t log_version = kInputLogVersion);
   // Opens a session that read_session recovered for appending after a crash: cuts its torn last record
   // off the log (durably), so the next record starts a line of its own, and removes the temporary files a
   // killed writer left. The records kept count as not yet on disk until the next commit.

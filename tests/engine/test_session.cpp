@@ -123,7 +123,7 @@ Status write_session(const InputLog& log, const fs::path& dir, const SessionWrit
   w->log = log;
   if (auto rig = rig_of(rig_json, log.events)) set_rig(*w, *rig);
   Scheduler s = make_scheduler(*w, fake_clock);
-  auto out = SessionWriter::create(dir.string(), settings_json(*w), rig_json);
+  auto out = SessionWriter::create(dir.string(), settings_json(*w), rig_json, {}, log.version);
   if (!out) return Status::failure(out.error());
   return replay_into_session(*w, s, *out, options);
 }
@@ -748,4 +748,50 @@ TEST_CASE("a session resumed after a crash goes on drawing and reopens to a clea
     CHECK(world_hash(*again->world) == live);
     CHECK(clean_hash(again->world->log.events) == live);
   }
+}
+
+TEST_CASE("a version-1 log written into a session stays version 1 and reopens by its own rules", "[session]") {
+  // A square, then a square apart from it: version 2 would start a second part, version 1 refused it.
+  std::string text = "FIRE-LOG 1\n";
+  int64_t t = 0;
+  auto stroke = [&](const Vec3& a, const Vec3& b) {
+    text += std::to_string(t += 10'000) + " down\n";
+    for (int k = 0; k <= 4; ++k) {
+      const Vec3 p = a + (b - a) * (k / 4.0);
+      text += std::to_string(t += 10'000) + " pen " + format_double(p.x()) + " " + format_double(p.y()) + " " +
+              format_double(p.z()) + "\n";
+    }
+    text += std::to_string(t += 10'000) + " up\n";
+  };
+  for (double x0 : {0.0, 3.0}) {
+    stroke({x0, 0, 0}, {x0 + 1, 0, 0});
+    stroke({x0 + 1, 0, 0}, {x0 + 1, 1, 0});
+    stroke({x0 + 1, 1, 0}, {x0, 1, 0});
+    stroke({x0, 1, 0}, {x0, 0, 0});
+  }
+  auto log = parse_input_log(text, "v1.log");
+  REQUIRE(log.ok());
+  REQUIRE(log->version == 1);
+  const TempDir dir;
+  REQUIRE(write_session(*log, dir.path / "s", {}).ok());
+  std::ifstream in(dir.path / "s" / "input.log");
+  std::string header;
+  std::getline(in, header);
+  CHECK(header == "FIRE-LOG 1");
+  auto r = reopen_session((dir.path / "s").string(), fake_clock);
+  REQUIRE(r.ok());
+  CHECK(r->world->log.version == 1);
+  CHECK(r->world->mesh.face_count() == 1);
+  auto replay_hash = [](const InputLog& l) {
+    auto w = std::make_unique<World>();
+    w->log = l;
+    Scheduler s = make_scheduler(*w, fake_clock);
+    replay_headless(*w, s);
+    return std::pair{world_hash(*w), w->mesh.face_count()};
+  };
+  CHECK(world_hash(*r->world) == replay_hash(*log).first);
+  // The same strokes as version 2 draw the second part.
+  auto v2 = parse_input_log("FIRE-LOG 2" + text.substr(10), "v2.log");
+  REQUIRE(v2.ok());
+  CHECK(replay_hash(*v2).second == 2);
 }

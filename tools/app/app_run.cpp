@@ -231,7 +231,7 @@ int run_app(const AppOptions& a) {
     w.log.events.push_back(start);
   }
   if (!live && !a.session_dir.empty()) {
-    auto created = SessionWriter::create(a.session_dir, settings_json(w));
+    auto created = SessionWriter::create(a.session_dir, settings_json(w), {}, {}, w.log.version);
     if (!created) return fail(created.error());
     writer.emplace(std::move(*created));
   }
@@ -442,7 +442,7 @@ int run_app(const AppOptions& a) {
   if (!a.screenshot_path.empty())
     if (Status s = render::write_png(shot, a.screenshot_path); !s) return fail(s.error);
   if (!a.record_path.empty())
-    if (Status s = write_file_atomic(a.record_path, format_input_log(w.log.events)); !s) return fail(s.error);
+    if (Status s = write_file_atomic(a.record_path, format_input_log(w.log.events, w.log.version)); !s) return fail(s.error);
 
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016" PRIx64, hash);

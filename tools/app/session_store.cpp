@@ -268,7 +268,7 @@ Status replay_into_session(World& w, Scheduler& scheduler, SessionWriter& out, c
 
 Status write_log_session(const std::string& dir, const World& w, std::span<const InputEvent> events,
                          std::string_view rig_json, std::string_view marks_json) {
-  auto out = SessionWriter::create(dir, settings_json(w), rig_json, marks_json);
+  auto out = SessionWriter::create(dir, settings_json(w), rig_json, marks_json, w.log.version);
   if (!out) return Status::failure(out.error());
   constexpr size_t kCommitEvery = 1000;
   size_t since_commit = 0;

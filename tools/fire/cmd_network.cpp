@@ -121,7 +121,7 @@ int run_replay(const ReplayOptions& o) {
     if (o.session_dir.empty()) {
       replay_headless(*world, *scheduler_owner);
     } else {
-      auto writer = SessionWriter::create(o.session_dir, settings_json(*world), rig_text);
+      auto writer = SessionWriter::create(o.session_dir, settings_json(*world), rig_text, {}, world->log.version);
       if (!writer) {
         std::cerr << "fire replay: " << writer.error() << "\n";
         return 1;
