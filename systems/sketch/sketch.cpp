@@ -69,7 +69,6 @@ CurveEnd at_vertex(const Mesh& mesh, std::span<const uint32_t> loop, const Curve
   return best;
 }
 
-
 // Where a stroke across a hole lands: both ends on border loops, the nearest border point to each end within
 // `limit`, the end's on the start's loop where there is one (a curve across that loop's hole), else on another
 // loop (a curve joining the two, `join`).
