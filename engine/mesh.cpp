@@ -115,13 +115,13 @@ std::vector<uint32_t> Mesh::border_loop(uint32_t e) const {
 
 bool Mesh::border_in_progress() const {
   for (uint32_t e = 0; e < edge_slots(); ++e)
-    if (edge_alive(e) && is_loose_edge(e) && !(edges.flags[e] & kBridgeEdge)) return true;
+    if (edge_alive(e) && is_loose_edge(e) && !is_waiting_bridge(e)) return true;
   return false;
 }
 
 size_t Mesh::pending_bridge_count() const {
   size_t n = 0;
-  for (uint32_t e = 0; e < edge_slots(); ++e) n += edge_alive(e) && is_loose_edge(e) && (edges.flags[e] & kBridgeEdge);
+  for (uint32_t e = 0; e < edge_slots(); ++e) n += edge_alive(e) && is_waiting_bridge(e);
   return n;
 }
 

@@ -150,6 +150,8 @@ class Mesh {
   bool is_border_edge(uint32_t e) const { return edges.face[e][0] == kNone || edges.face[e][1] == kNone; }
   // An edge with no face on either side: a curve of a border polygon still being drawn.
   bool is_loose_edge(uint32_t e) const { return edges.face[e][0] == kNone && edges.face[e][1] == kNone; }
+  // A bridge (kBridgeEdge) still waiting for the second curve between its two border loops.
+  bool is_waiting_bridge(uint32_t e) const { return is_loose_edge(e) && (edges.flags[e] & kBridgeEdge); }
   // The oriented edge that walks border edge e as the hole beside it would: against its one face.
   uint32_t hole_side(uint32_t e) const { return make_oriented(e, edges.face[e][1] == kNone); }
   // The border loop through border edge e as the hole beside it walks it, starting with e; empty when e has

@@ -80,25 +80,31 @@ struct HoleSnap {
 };
 
 HoleSnap snap_to_hole(const Mesh& m, const SnapIndex& index, const Vec3& start, const Vec3& end, double limit) {
-  std::vector<SnapHit> hits;
-  auto nearest_border = [&](const Vec3& p, const std::vector<uint32_t>* on_rim) {
-    index.nearest_per_edge(p, limit, hits);
-    SnapHit best;
+  // The nearest of `hits` on a border curve with a face, and the nearest of those on `rim` (when given).
+  auto nearest_border = [&](const std::vector<SnapHit>& hits, const std::vector<uint32_t>* rim) {
+    SnapHit best, best_on_rim;
+    auto better = [](const SnapHit& h, const SnapHit& than) {
+      return !than.found() || h.distance < than.distance || (h.distance == than.distance && h.edge < than.edge);
+    };
     for (const SnapHit& h : hits) {
       if (!m.is_border_edge(h.edge) || m.is_loose_edge(h.edge)) continue;
-      if (on_rim && std::none_of(on_rim->begin(), on_rim->end(), [&](uint32_t oe) { return edge_of(oe) == h.edge; })) continue;
-      if (!best.found() || h.distance < best.distance || (h.distance == best.distance && h.edge < best.edge)) best = h;
+      if (better(h, best)) best = h;
+      if (rim && std::any_of(rim->begin(), rim->end(), [&](uint32_t oe) { return edge_of(oe) == h.edge; }) && better(h, best_on_rim))
+        best_on_rim = h;
     }
-    return best;
+    return std::pair{best, best_on_rim};
   };
+  std::vector<SnapHit> hits;
   HoleSnap out;
-  const SnapHit a = nearest_border(start, nullptr);
+  index.nearest_per_edge(start, limit, hits);
+  const SnapHit a = nearest_border(hits, nullptr).first;
   if (!a.found()) return out;
   std::vector<uint32_t> rim = m.border_loop(a.edge);
   if (rim.empty()) return out;
-  SnapHit b = nearest_border(end, &rim);
-  out.join = !b.found();
-  if (out.join) b = nearest_border(end, nullptr);
+  index.nearest_per_edge(end, limit, hits);
+  const auto [any_rim, on_rim] = nearest_border(hits, &rim);
+  out.join = !on_rim.found();
+  const SnapHit b = out.join ? any_rim : on_rim;
   if (!b.found()) return out;
   out.end_rim = out.join ? m.border_loop(b.edge) : rim;
   if (out.end_rim.empty()) return out;
@@ -301,8 +307,8 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           // cross a border loop's hole (the far side of the surface), or, far from every curve, start a new part.
           const Snap s = snap_to_face(mesh, snap, r.command.points.front(), r.command.points.back(), both_snap);
           const HoleSnap h = s.face == kNone && settings.topology_strokes ? snap_to_hole(mesh, snap, r.command.points.front(), r.command.points.back(), both_snap) : HoleSnap{};
-          const SnapHit start_hit = snap.nearest(r.command.points.front()), end_hit = snap.nearest(r.command.points.back());
           if (s.face == kNone && h.rim.empty()) {
+            const SnapHit start_hit = snap.nearest(r.command.points.front()), end_hit = snap.nearest(r.command.points.back());
             if (settings.topology_strokes && start_hit.distance > radius(state.start_snap) && end_hit.distance > end_snap) {
               r.command.kind = EditKind::StartBorder;
               requests.push_back(std::move(r));

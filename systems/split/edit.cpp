@@ -137,20 +137,28 @@ Status resolve_hole_end(const Mesh& m, const std::vector<uint32_t>& loop, const 
   return resolve_point(m, end, which, out);
 }
 
+// The part of closed walk `loop` from the vertex `from` to the vertex `to`; the whole loop when they are one
+// vertex and `whole`, else nothing.
+std::vector<uint32_t> arc(const Mesh& m, std::span<const uint32_t> loop, uint32_t from, uint32_t to, bool whole) {
+  const size_t n = loop.size();
+  size_t i = 0;
+  while (i < n && m.tail(loop[i]) != from) ++i;
+  std::vector<uint32_t> out;
+  if (from == to && !whole) return out;
+  for (size_t k = 0; k < n; ++k) {
+    const uint32_t oe = loop[(i + k) % n];
+    if (k > 0 && m.tail(oe) == to) break;
+    out.push_back(oe);
+  }
+  return out;
+}
+
 // Cuts `loop` (a closed walk through va and vb) at both vertices and closes each half with the new edge
 // e = va -> vb: the walk from va to vb comes back along e reversed, the walk from vb to va along e.
 std::pair<std::vector<uint32_t>, std::vector<uint32_t>> cut_loop(const Mesh& m, std::span<const uint32_t> loop, uint32_t va,
                                                                  uint32_t vb, uint32_t e) {
-  const uint32_t n = static_cast<uint32_t>(loop.size());
-  uint32_t i = kNone, j = kNone;
-  for (uint32_t k = 0; k < n; ++k) {
-    if (m.tail(loop[k]) == va) i = k;
-    if (m.tail(loop[k]) == vb) j = k;
-  }
-  std::vector<uint32_t> first, second;
-  for (uint32_t k = i; k != j; k = (k + 1) % n) first.push_back(loop[k]);
+  std::vector<uint32_t> first = arc(m, loop, va, vb, false), second = arc(m, loop, vb, va, false);
   first.push_back(make_oriented(e, true));
-  for (uint32_t k = j; k != i; k = (k + 1) % n) second.push_back(loop[k]);
   second.push_back(make_oriented(e, false));
   return {std::move(first), std::move(second)};
 }
@@ -204,7 +212,7 @@ Status make_hole(Mesh& m, const EditCommand& c) {
 uint32_t bridge_at(const Mesh& m, const std::vector<uint32_t>& loop) {
   for (uint32_t oe : loop)
     for (uint32_t g : m.vertex_edges(m.tail(oe)))
-      if (m.is_loose_edge(g) && (m.edges.flags[g] & kBridgeEdge)) return g;
+      if (m.is_waiting_bridge(g)) return g;
   return kNone;
 }
 
@@ -217,22 +225,6 @@ std::vector<uint32_t> rim_at(const Mesh& m, uint32_t v) {
   for (uint32_t g : m.vertex_edges(v))
     if (m.is_border_edge(g) && !m.is_loose_edge(g)) return m.border_loop(g);
   return {};
-}
-
-// The part of closed walk `loop` from the vertex `from` to the vertex `to`; the whole loop when they are one
-// vertex and `whole`, else nothing.
-std::vector<uint32_t> arc(const Mesh& m, const std::vector<uint32_t>& loop, uint32_t from, uint32_t to, bool whole) {
-  const size_t n = loop.size();
-  size_t i = 0;
-  while (i < n && m.tail(loop[i]) != from) ++i;
-  std::vector<uint32_t> out;
-  if (from == to && !whole) return out;
-  for (size_t k = 0; k < n; ++k) {
-    const uint32_t oe = loop[(i + k) % n];
-    if (k > 0 && m.tail(oe) == to) break;
-    out.push_back(oe);
-  }
-  return out;
 }
 
 // Checks one end of a curve between border loops: on a border curve with one face, whose loop has a single rim.
@@ -264,7 +256,7 @@ Status join_borders(Mesh& m, const EditCommand& c) {
   // A bridge already waiting between these two loops.
   uint32_t bridge = kNone;
   for (uint32_t g = 0; g < m.edge_slots() && bridge == kNone; ++g) {
-    if (!m.edge_alive(g) || !m.is_loose_edge(g) || !(m.edges.flags[g] & kBridgeEdge)) continue;
+    if (!m.edge_alive(g) || !m.is_waiting_bridge(g)) continue;
     const auto ends = m.edges.vertex[g];
     if ((on_loop(m, loop_a, ends[0]) && on_loop(m, loop_b, ends[1])) || (on_loop(m, loop_a, ends[1]) && on_loop(m, loop_b, ends[0])))
       bridge = g;
@@ -305,11 +297,8 @@ Status split_hole(Mesh& m, const EditCommand& c) {
   if (!has_faces(m)) return Status::failure("close the border polygon before drawing across its hole");
   if (m.border_in_progress()) return Status::failure("a border polygon is being drawn; close it first");
   if (auto ok = check_points(c.points); !ok.ok()) return ok;
-  if (!m.edge_alive(c.start.edge)) return Status::failure("the curve's start names edge " + str(c.start.edge) + ", which does not exist");
-  if (!m.is_border_edge(c.start.edge)) return Status::failure("the curve's start lies on curve " + str(c.start.edge) + ", which is not on the border");
-  const std::vector<uint32_t> loop = m.border_loop(c.start.edge);
-  if (loop.empty())
-    return Status::failure("the border through curve " + str(c.start.edge) + " passes a vertex with more than two border curves; a hole there has no single rim");
+  std::vector<uint32_t> loop;
+  if (auto ok = border_end(m, c.start, "start", loop); !ok.ok()) return ok;
   if (bridge_at(m, loop) != kNone)
     return Status::failure("a bridge from this border loop waits for its second curve: draw that (or undo the bridge) before crossing the loop's hole");
   ResolvedEnd a, b;
@@ -322,9 +311,7 @@ Status split_hole(Mesh& m, const EditCommand& c) {
   const uint32_t va = a.vertex != kNone ? a.vertex : split_edge(m, a.edge, a.point);
   const uint32_t vb = b.vertex != kNone ? b.vertex : split_edge(m, b.edge, b.point);
   // The split edges are new: the rim is walked again from one of va's border curves.
-  std::vector<uint32_t> rim;
-  for (uint32_t g : m.vertex_edges(va))
-    if (rim.empty() && m.is_border_edge(g)) rim = m.border_loop(g);
+  const std::vector<uint32_t> rim = rim_at(m, va);
   const uint32_t e = m.add_edge(va, vb, c.points);
   auto [first, second] = cut_loop(m, rim, va, vb, e);
   m.add_face(first);
@@ -373,7 +360,7 @@ Status delete_curve(Mesh& m, const EditCommand& c) {
   uint32_t e = c.edge;
   if (!m.edge_alive(e)) return Status::failure("edge " + str(e) + " does not exist");
   if (!has_faces(m)) return Status::failure("curves can be deleted once the border polygon is closed");
-  if ((m.edges.flags[e] & kBridgeEdge) && m.is_loose_edge(e)) {  // a bridge still waiting: it goes alone
+  if (m.is_waiting_bridge(e)) {  // it goes alone
     const auto ends = m.edges.vertex[e];
     m.remove_edge(e);
     join_at(m, ends[0]);

@@ -449,6 +449,14 @@ int64_t euler_characteristic(const Mesh& m) {
   return int64_t(m.vertex_count()) - int64_t(m.edge_count()) + int64_t(m.face_count());
 }
 
+// The live face of the highest slot with `sides` edges, or kNone.
+uint32_t face_with_sides(const Mesh& m, uint32_t sides) {
+  uint32_t found = kNone;
+  for (uint32_t f = 0; f < m.face_slots(); ++f)
+    if (m.face_alive(f) && m.faces.edge_count[f] == sides) found = f;
+  return found;
+}
+
 EditCommand hole(uint32_t face) {
   EditCommand c = make(EditKind::MakeHole);
   c.face = face;
@@ -479,9 +487,7 @@ TEST_CASE("a hole and its undo: the face goes, its curves become border, undo br
   Mesh m = square(&h);
   REQUIRE(h.apply(m, across_hole(m)).ok());
   // The two faces under the square are apart from any border on a closed object.
-  uint32_t under = kNone;
-  for (uint32_t f = 0; f < m.face_slots(); ++f)
-    if (m.face_alive(f) && m.faces.edge_count[f] == 4) under = f;
+  const uint32_t under = face_with_sides(m, 4);
   REQUIRE(under != kNone);
   apply_undo_redo(m, h, hole(under));
   CHECK(m.face_count() == 2);
@@ -489,9 +495,7 @@ TEST_CASE("a hole and its undo: the face goes, its curves become border, undo br
   CHECK(euler_characteristic(m) == 1);  // a disc again
   CHECK(m.border_loop_count() == 1);
   // The other face under the square now lies beside the border: refused, nothing changes.
-  uint32_t other = kNone;
-  for (uint32_t f = 0; f < m.face_slots(); ++f)
-    if (m.face_alive(f) && m.faces.edge_count[f] == 4) other = f;
+  const uint32_t other = face_with_sides(m, 4);
   REQUIRE(other != kNone);
   const Mesh before = m;
   const Status beside = h.apply(m, hole(other));
@@ -524,9 +528,7 @@ TEST_CASE("a hole touching the border at a corner is refused: it would pinch the
   Mesh m = square(&h);
   REQUIRE(h.apply(m, across_hole(m)).ok());
   // The top split by a curve between the same two points as the one below: four faces meet at each end.
-  uint32_t top = kNone;
-  for (uint32_t f = 0; f < m.face_slots(); ++f)
-    if (m.face_alive(f) && m.faces.edge_count[f] == 6) top = f;
+  const uint32_t top = face_with_sides(m, 6);
   REQUIRE(top != kNone);
   CurveEnd a, b;
   for (uint32_t oe : m.face_loop(top)) {
