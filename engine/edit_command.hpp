@@ -17,14 +17,24 @@ struct CurveEnd {
 
 // Kinds are appended, never reordered: snapshots hold them as bytes.
 enum class EditKind : uint8_t { StartBorder, AppendBorder, CloseBorder, SplitFace, DeleteCurve, ToggleSharp, MakeHole, SplitHole,
-                                JoinBorders };
+                                JoinBorders, CrossCurves };
+
+// CrossCurves: one place where the stroke crosses a curve of the network.
+struct Crossing {
+  CurveEnd at;           // the crossed curve's polyline point (a vertex at its first or last point) where the stroke is cut
+  uint32_t point = 0;    // the stroke's point there, an index into EditCommand::points: the pieces either side share it
+  uint32_t face = kNone; // the face the stroke runs into after the crossing
+};
 
 struct EditCommand {
   EditKind kind = EditKind::StartBorder;
   std::vector<Vec3> points;  // the new curve's polyline (the border and split kinds)
-  uint32_t face = kNone;     // SplitFace: the face the curve crosses; MakeHole: the face that becomes a hole
+  uint32_t face = kNone;     // SplitFace: the face the curve crosses; MakeHole: the face that becomes a hole;
+                             // CrossCurves: the face the stroke starts in
   CurveEnd start, end;       // SplitFace: where the curve starts and ends on that face's boundary; SplitHole: on
-                             // one border loop, whose hole the curve crosses; JoinBorders: on two border loops
+                             // one border loop, whose hole the curve crosses; JoinBorders: on two border loops;
+                             // CrossCurves: on the boundaries of the first and the last face it runs through
+  std::vector<Crossing> crossings;  // CrossCurves: in stroke order, at least one
   uint32_t edge = kNone;     // DeleteCurve, ToggleSharp (sharp becomes smooth, smooth sharp)
   double snap_distance = 0;  // CloseBorder: how far the last point may lie from the first vertex
 };

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <iterator>
 #include <limits>
+#include <optional>
 
 #include "engine/text.hpp"
 
@@ -123,6 +124,193 @@ std::pair<uint32_t, uint32_t> border_ends(const Mesh& m) {
     if (m.valence(m.edges.vertex[e][1]) == 1) last = m.edges.vertex[e][1];
   }
   return {first, last};
+}
+
+// Which face of the surface each pen sample is over, told by the side of its nearest curve: a face walking that
+// curve forwards lies to its left about the surface normal. A sample is over that face only within the face's
+// slab: as far off the plane of its boundary as the boundary itself is, and a quarter of its size more (a face
+// bulges past its curves); else it is off the surface, as the underside of an object drawn across its hole is.
+// Samples within `radius` of a curve, or nearest to a curve's end (at a vertex one curve's side does not say
+// which face), are not told.
+inline constexpr uint32_t kUntold = kNone - 1;
+
+class FaceBySide {
+ public:
+  FaceBySide(const Mesh& m, const SnapIndex& index, double radius) : m_(m), index_(index), radius_(radius) {}
+  uint32_t operator()(const Vec3& p) {
+    const SnapHit h = index_.nearest(p);
+    if (!h.found() || h.distance <= radius_) return kUntold;
+    const std::span<const Vec3> line = m_.polyline(h.edge);
+    if (h.point == 0 || h.point + 1 == line.size()) return kUntold;
+    const Vec3 tangent = line[h.point + 1] - line[h.point - 1];
+    Vec3 normal = Vec3::Zero();
+    for (uint32_t f : m_.edges.face[h.edge])
+      if (f != kNone) normal += slab(f).normal;
+    const bool left = tangent.cross(p - line[h.point]).dot(normal) > 0;
+    const uint32_t f = m_.edges.face[h.edge][left ? 0 : 1];
+    if (f == kNone) return kNone;
+    const Slab& s = slab(f);
+    const double height = (p - s.centroid).dot(s.normal);
+    return height >= s.low && height <= s.high ? f : kNone;
+  }
+
+ private:
+  struct Slab {
+    uint32_t face;
+    Vec3 centroid, normal;
+    double low, high;
+  };
+  const Slab& slab(uint32_t f) {
+    for (const Slab& s : slabs_)
+      if (s.face == f) return s;
+    const std::vector<Vec3> boundary = m_.face_boundary(f);
+    const LoopPlane plane = loop_plane(boundary);
+    double low = 0, high = 0, extent = 0;
+    for (const Vec3& q : boundary) {
+      const double height = (q - plane.centroid).dot(plane.normal);
+      low = std::min(low, height);
+      high = std::max(high, height);
+      extent = std::max(extent, (q - plane.centroid).norm());
+    }
+    const double margin = std::max(radius_, extent / 4);
+    slabs_.push_back({f, plane.centroid, plane.normal, low - margin, high + margin});
+    return slabs_.back();
+  }
+  const Mesh& m_;
+  const SnapIndex& index_;
+  double radius_;
+  std::vector<Slab> slabs_;
+};
+
+// The faces a stroke runs over, in order, each with the samples told to be over it (first, last).
+struct FaceRun {
+  uint32_t face;
+  size_t first, last;
+};
+
+std::vector<FaceRun> face_runs(const std::vector<Vec3>& stroke, FaceBySide& face_of) {
+  std::vector<FaceRun> runs;
+  for (size_t i = 0; i < stroke.size(); ++i) {
+    const uint32_t f = face_of(stroke[i]);
+    if (f == kUntold) continue;
+    if (!runs.empty() && runs.back().face == f) runs.back().last = i;
+    else runs.push_back({f, i, i});
+  }
+  return runs;
+}
+
+// Whether faces a and b share a corner (and so maybe a curve).
+bool faces_touch(const Mesh& m, uint32_t a, uint32_t b) {
+  const std::span<const uint32_t> la = m.face_loop(a), lb = m.face_loop(b);
+  return std::any_of(la.begin(), la.end(), [&](uint32_t oa) {
+    return std::any_of(lb.begin(), lb.end(), [&](uint32_t ob) { return m.tail(oa) == m.tail(ob); });
+  });
+}
+
+// Where a stroke passing from face a to face b over samples [from, to] crosses: the point of a curve between them
+// nearest to those samples (a corner they share, where they share no curve), and the sample nearest to it.
+struct Cut {
+  CurveEnd at;
+  size_t sample = 0;
+};
+
+std::optional<Cut> crossing_between(const Mesh& m, uint32_t a, uint32_t b, const std::vector<Vec3>& stroke, size_t from, size_t to,
+                                    double vertex_radius) {
+  std::optional<Cut> best;
+  double best_distance = std::numeric_limits<double>::infinity();
+  auto consider = [&](uint32_t e, uint32_t k) {
+    const Vec3& q = m.polyline(e)[k];
+    for (size_t j = from; j <= to; ++j)
+      if (const double d = (stroke[j] - q).norm(); d < best_distance) {
+        best_distance = d;
+        best = Cut{{e, k}, j};
+      }
+  };
+  const std::span<const uint32_t> loop = m.face_loop(a);
+  for (uint32_t oe : loop)
+    if (m.other_face(edge_of(oe), a) == b)
+      for (uint32_t k = 0; k < m.edges.point_count[edge_of(oe)]; ++k) consider(edge_of(oe), k);
+  if (!best) {
+    const std::span<const uint32_t> other = m.face_loop(b);
+    for (uint32_t oe : loop)
+      if (std::any_of(other.begin(), other.end(), [&](uint32_t ob) { return m.tail(ob) == m.tail(oe); }))
+        consider(edge_of(oe), is_reversed(oe) ? m.edges.point_count[edge_of(oe)] - 1 : 0);
+  }
+  if (best) best->at = at_vertex(m, loop, best->at, stroke[best->sample], vertex_radius);
+  return best;
+}
+
+// A stroke over several faces (issue 40): cut where it crosses a curve, each piece splitting the face it runs
+// through, as one command. A crossing is a change of side of a curve on the surface: a stroke that runs along a
+// curve, or touches one and leaves on the side it came from, stays in its face. Nothing when the stroke stays in
+// one face, leaves the surface, or does not start and end on the curves of the faces it runs over (the other
+// sketch rules then say what it is); `refusal` says why a stroke over several faces cannot be drawn.
+std::optional<EditCommand> plan_crossing(const Mesh& m, const SnapIndex& index, std::vector<Vec3> stroke, double start_radius,
+                                         double end_radius, double start_vertex_radius, double end_vertex_radius, double vertex_radius,
+                                         double blend_reach, std::string& refusal) {
+  FaceBySide face_of(m, index, std::max(start_radius, end_radius));
+  // A crossing within the radius of an end is not told by side: the end's curve tells the face the stroke
+  // starts in (or ends in) then, where one face by it touches the nearest told one.
+  std::vector<SnapHit> hits;
+  auto runs_with_ends = [&] {
+    std::vector<FaceRun> runs = face_runs(stroke, face_of);
+    if (runs.empty()) return runs;
+    auto end_face = [&](const Vec3& p, double radius, uint32_t told) {
+      if (told == kNone) return kNone;
+      index.nearest_per_edge(p, radius, hits);
+      std::vector<uint32_t> touching;
+      for (const SnapHit& h : hits)
+        for (uint32_t f : m.edges.face[h.edge]) {
+          if (f == told) return told;
+          if (f != kNone && !std::count(touching.begin(), touching.end(), f) && faces_touch(m, f, told)) touching.push_back(f);
+        }
+      return touching.size() == 1 ? touching.front() : kNone;
+    };
+    if (const uint32_t f = end_face(stroke.front(), start_radius, runs.front().face); f != kNone && f != runs.front().face)
+      runs.insert(runs.begin(), FaceRun{f, 0, 0});
+    if (const uint32_t f = end_face(stroke.back(), end_radius, runs.back().face); f != kNone && f != runs.back().face)
+      runs.push_back(FaceRun{f, stroke.size() - 1, stroke.size() - 1});
+    return runs;
+  };
+  std::vector<FaceRun> runs = runs_with_ends();
+  if (runs.size() < 2 || std::any_of(runs.begin(), runs.end(), [](const FaceRun& r) { return r.face == kNone; })) return std::nullopt;
+  EditCommand c;
+  c.kind = EditKind::CrossCurves;
+  c.face = runs.front().face;
+  const uint32_t last_face = runs.back().face;
+  const SnapHit a = index.nearest_on_face(m, c.face, stroke.front(), start_radius);
+  const SnapHit b = index.nearest_on_face(m, last_face, stroke.back(), end_radius);
+  if (!a.found() || !b.found()) return std::nullopt;
+  c.start = at_vertex(m, m.face_loop(c.face), {a.edge, a.point}, stroke.front(), start_vertex_radius);
+  c.end = at_vertex(m, m.face_loop(last_face), {b.edge, b.point}, stroke.back(), end_vertex_radius);
+  const Vec3 start = m.polyline(c.start.edge)[c.start.point], end = m.polyline(c.end.edge)[c.end.point];
+  drop_pauses(stroke, start, start_vertex_radius, end, end_vertex_radius);
+  runs = runs_with_ends();
+  if (runs.size() < 2 || runs.front().face != c.face || runs.back().face != last_face) return std::nullopt;
+  std::vector<Vec3> cuts{start};
+  for (size_t r = 0; r + 1 < runs.size(); ++r) {
+    const std::optional<Cut> cut = crossing_between(m, runs[r].face, runs[r + 1].face, stroke, runs[r].last, runs[r + 1].first, vertex_radius);
+    if (!cut) return std::nullopt;  // faces that do not touch: not a stroke over the surface
+    const size_t sample = std::max<size_t>(cut->sample, (c.crossings.empty() ? 0 : c.crossings.back().point) + 1);
+    if (sample + 1 >= stroke.size()) {
+      refusal = "the stroke crosses curves closer together than its pen samples; draw it more slowly";
+      return std::nullopt;
+    }
+    c.crossings.push_back({cut->at, uint32_t(sample), runs[r + 1].face});
+    cuts.push_back(m.polyline(cut->at.edge)[cut->at.point]);
+  }
+  cuts.push_back(end);
+  // Each piece's ends move onto its cuts, as a single curve's do onto its ends.
+  std::vector<size_t> at{0};
+  for (const Crossing& x : c.crossings) at.push_back(x.point);
+  at.push_back(stroke.size() - 1);
+  for (size_t i = 0; i + 1 < at.size(); ++i) {
+    std::vector<Vec3> piece(stroke.begin() + std::ptrdiff_t(at[i]), stroke.begin() + std::ptrdiff_t(at[i + 1] + 1));
+    blend_ends(piece, cuts[i], cuts[i + 1], blend_reach);
+    std::copy(piece.begin(), piece.end(), stroke.begin() + std::ptrdiff_t(at[i]));
+  }
+  c.points = std::move(stroke);
+  return c;
 }
 
 }  // namespace
@@ -303,9 +491,26 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           blend_ends(r.command.points, mesh.vertices.position[last],
                      r.command.kind == EditKind::CloseBorder ? first_position : r.command.points.back(), 1);
         } else {
-          // A face holding both ends takes the stroke, as the thesis's sketch model has it. Else the stroke may
-          // cross a border loop's hole (the far side of the surface), or, far from every curve, start a new part.
+          // A face holding both ends takes the stroke, as the thesis's sketch model has it. Else the stroke may run
+          // over several faces, cross a border loop's hole (the far side of the surface), or, far from every
+          // curve, start a new part.
           const Snap s = snap_to_face(mesh, snap, r.command.points.front(), r.command.points.back(), both_snap);
+          // A stroke over several faces is cut where it crosses curves.
+          if (s.face == kNone && settings.topology_strokes) {
+            std::string refusal;
+            std::optional<EditCommand> crossing =
+                plan_crossing(mesh, snap, r.command.points, radius(state.start_snap), end_snap, vertex_radius(state.start_snap),
+                              vertex_radius(state.end_snap), settings.vertex_snap, settings.blend_reach, refusal);
+            if (!refusal.empty()) {
+              reject(refusal);
+              break;
+            }
+            if (crossing) {
+              r.command = std::move(*crossing);
+              requests.push_back(std::move(r));
+              break;
+            }
+          }
           const HoleSnap h = s.face == kNone && settings.topology_strokes ? snap_to_hole(mesh, snap, r.command.points.front(), r.command.points.back(), both_snap) : HoleSnap{};
           if (s.face == kNone && h.rim.empty()) {
             const SnapHit start_hit = snap.nearest(r.command.points.front()), end_hit = snap.nearest(r.command.points.back());

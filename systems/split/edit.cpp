@@ -163,6 +163,16 @@ std::pair<std::vector<uint32_t>, std::vector<uint32_t>> cut_loop(const Mesh& m, 
   return {std::move(first), std::move(second)};
 }
 
+// Steps 3-6 of thesis 5.4.2: the new edge va -> vb, and face f replaced by the two loops on either side of it.
+// Returns the new face (the walk from vb back to va).
+uint32_t split_between(Mesh& m, uint32_t f, uint32_t va, uint32_t vb, std::span<const Vec3> points) {
+  const std::vector<uint32_t> loop(m.face_loop(f).begin(), m.face_loop(f).end());
+  const uint32_t e = m.add_edge(va, vb, points);
+  auto [first, second] = cut_loop(m, loop, va, vb, e);
+  m.set_face_loop(f, first);
+  return m.add_face(second);
+}
+
 Status split_face(Mesh& m, const EditCommand& c) {
   if (!has_faces(m)) return Status::failure("close the border polygon before splitting faces");
   if (!m.face_alive(c.face)) return Status::failure("face " + str(c.face) + " does not exist");
@@ -179,12 +189,7 @@ Status split_face(Mesh& m, const EditCommand& c) {
   uint32_t va = a.vertex != kNone ? a.vertex : split_edge(m, a.edge, a.point);
   uint32_t vb = b.vertex != kNone ? b.vertex : split_edge(m, b.edge, b.point);
 
-  // Steps 3-6: the new edge, and the face replaced by the two loops on either side of it.
-  const std::vector<uint32_t> loop(m.face_loop(c.face).begin(), m.face_loop(c.face).end());
-  const uint32_t e = m.add_edge(va, vb, c.points);
-  auto [first, second] = cut_loop(m, loop, va, vb, e);
-  m.set_face_loop(c.face, first);
-  m.add_face(second);
+  split_between(m, c.face, va, vb, c.points);
   return Status::success();
 }
 
@@ -399,6 +404,123 @@ Status delete_curve(Mesh& m, const EditCommand& c) {
   return Status::success();
 }
 
+bool on_face(const Mesh& m, uint32_t f, const ResolvedEnd& r) {
+  if (r.vertex == kNone) return m.loop_position(f, r.edge) != kNone;
+  const std::span<const uint32_t> loop = m.face_loop(f);
+  return std::any_of(loop.begin(), loop.end(), [&](uint32_t oe) { return m.tail(oe) == r.vertex; });
+}
+
+// Where a cut lies along face f's walk: the loop position of its edge (of its vertex's first edge), then how far
+// along that edge in the walking direction.
+std::pair<size_t, uint32_t> along_loop(const Mesh& m, uint32_t f, const ResolvedEnd& r) {
+  const std::span<const uint32_t> loop = m.face_loop(f);
+  for (size_t i = 0; i < loop.size(); ++i) {
+    const uint32_t e = edge_of(loop[i]);
+    if (r.vertex != kNone && m.tail(loop[i]) == r.vertex) return {i, 0};
+    if (r.vertex == kNone && e == r.edge) return {i, is_reversed(loop[i]) ? m.edges.point_count[e] - 1 - r.point : r.point};
+  }
+  return {loop.size(), 0};
+}
+
+// Two chords of one face cross when exactly one end of the second lies strictly inside the first's arc.
+bool chords_cross(std::pair<size_t, uint32_t> a, std::pair<size_t, uint32_t> b, std::pair<size_t, uint32_t> c,
+                  std::pair<size_t, uint32_t> d) {
+  if (a == c || a == d || b == c || b == d) return false;
+  if (b < a) std::swap(a, b);
+  auto inside = [&](std::pair<size_t, uint32_t> x) { return a < x && x < b; };
+  return inside(c) != inside(d);
+}
+
+bool same_place(const ResolvedEnd& a, const ResolvedEnd& b) {
+  return a.vertex != kNone ? a.vertex == b.vertex : a.edge == b.edge && a.point == b.point;
+}
+
+// A stroke drawn across curves: cut where it crosses each, and each piece splits the face it runs through. One
+// command, so that one undo takes the whole stroke back.
+Status cross_curves(Mesh& m, const EditCommand& c) {
+  if (!has_faces(m)) return Status::failure("close the border polygon before drawing across curves");
+  if (auto ok = check_points(c.points); !ok.ok()) return ok;
+  if (c.crossings.empty()) return Status::failure("the stroke across curves names no crossing");
+  std::vector<uint32_t> faces{c.face}, at{0};
+  std::vector<CurveEnd> cuts{c.start};
+  for (const Crossing& x : c.crossings) {
+    faces.push_back(x.face);
+    at.push_back(x.point);
+    cuts.push_back(x.at);
+  }
+  at.push_back(uint32_t(c.points.size() - 1));
+  cuts.push_back(c.end);
+  std::vector<ResolvedEnd> cut(cuts.size());
+  for (size_t i = 0; i < cuts.size(); ++i) {
+    const std::string which = i == 0 ? "start" : i + 1 == cuts.size() ? "end" : "crossing " + str(uint32_t(i));
+    if (!m.edge_alive(cuts[i].edge)) return Status::failure("the stroke's " + which + " names edge " + str(cuts[i].edge) + ", which does not exist");
+    if (auto ok = resolve_point(m, cuts[i], which.c_str(), cut[i]); !ok.ok()) return ok;
+    if (i > 0 && !(at[i] > at[i - 1] && at[i] < c.points.size()))
+      return Status::failure("the stroke's " + which + " is at its point " + str(at[i]) + ", not after the previous cut's and within its " +
+                             str(uint32_t(c.points.size())) + " points");
+    if (i > 0 && i + 1 < cuts.size() && cut[i].vertex == kNone && m.is_border_edge(cut[i].edge))
+      return Status::failure("the stroke's " + which + " is on border curve " + str(cut[i].edge) + ": the stroke would leave the surface there");
+    for (size_t j = 0; j < i; ++j)
+      if (same_place(cut[i], cut[j]))
+        return Status::failure("the stroke's " + which + " is where an earlier cut of it is: a piece would close on itself");
+  }
+  for (size_t i = 0; i < faces.size(); ++i) {
+    if (!m.face_alive(faces[i])) return Status::failure("face " + str(faces[i]) + " does not exist");
+    if (i > 0 && faces[i] == faces[i - 1])
+      return Status::failure("crossing " + str(uint32_t(i)) + " leads from face " + str(faces[i]) + " into itself: a crossing changes face");
+    if (!on_face(m, faces[i], cut[i]) || !on_face(m, faces[i], cut[i + 1]))
+      return Status::failure("piece " + str(uint32_t(i + 1)) + " of the stroke does not start and end on the boundary of face " + str(faces[i]));
+  }
+
+  // Pieces in one face must not cross there: the stroke may not cross itself.
+  for (size_t i = 0; i < faces.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      if (faces[j] == faces[i] && chords_cross(along_loop(m, faces[i], cut[j]), along_loop(m, faces[i], cut[j + 1]),
+                                               along_loop(m, faces[i], cut[i]), along_loop(m, faces[i], cut[i + 1])))
+        return Status::failure("piece " + str(uint32_t(i + 1)) + " of the stroke crosses piece " + str(uint32_t(j + 1)) + " of it in face " +
+                               str(faces[i]) + "; a stroke across curves may not cross itself");
+
+  // Cut the curves. On each edge from its last cut point to its first, so the points still to cut stay on the
+  // first half, which is the edge that ends at the new vertex.
+  std::vector<uint32_t> vertex(cut.size(), kNone), order;
+  for (size_t i = 0; i < cut.size(); ++i) {
+    if (cut[i].vertex != kNone) vertex[i] = cut[i].vertex;
+    else order.push_back(uint32_t(i));
+  }
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    return cut[a].edge != cut[b].edge ? cut[a].edge < cut[b].edge : cut[a].point > cut[b].point;
+  });
+  for (size_t k = 0; k < order.size(); ++k) {
+    const uint32_t i = order[k];
+    const bool same_edge_as_last = k > 0 && cut[order[k - 1]].edge == cut[i].edge;
+    uint32_t edge = cut[i].edge;
+    if (same_edge_as_last)
+      for (uint32_t e : m.vertex_edges(vertex[order[k - 1]]))
+        if (m.edges.vertex[e][1] == vertex[order[k - 1]]) edge = e;
+    vertex[i] = split_edge(m, edge, cut[i].point);
+  }
+
+  // Each piece splits the part of its face (as earlier pieces left it) that holds both its ends.
+  std::vector<std::pair<uint32_t, uint32_t>> parts;  // (face the stroke was drawn over, a face it has become)
+  for (uint32_t f : faces) parts.emplace_back(f, f);
+  for (size_t i = 0; i + 1 < cut.size(); ++i) {
+    const uint32_t va = vertex[i], vb = vertex[i + 1];
+    std::vector<uint32_t> holding;
+    for (const auto& [drawn, part] : parts) {
+      if (drawn != faces[i] || std::count(holding.begin(), holding.end(), part)) continue;
+      if (on_face(m, part, {va}) && on_face(m, part, {vb})) holding.push_back(part);
+    }
+    if (holding.size() != 1)  // non-crossing pieces leave one part of a disc with both ends: only a pinched face has more
+      return Status::failure("piece " + str(uint32_t(i + 1)) + " of the stroke could run through " + str(uint32_t(holding.size())) +
+                             " parts of face " + str(faces[i]) + "; draw it in strokes that cross fewer curves");
+    std::vector<Vec3> points(c.points.begin() + at[i], c.points.begin() + at[i + 1] + 1);
+    points.front() = m.vertices.position[va];
+    points.back() = m.vertices.position[vb];
+    parts.emplace_back(faces[i], split_between(m, holding.front(), va, vb, points));
+  }
+  return Status::success();
+}
+
 // A crease for subdivision along an inner curve; the border is a crease already.
 Status toggle_sharp(Mesh& m, const EditCommand& c) {
   const uint32_t e = c.edge;
@@ -442,6 +564,7 @@ Status execute_edit(Mesh& mesh, const EditCommand& c) {
     case EditKind::MakeHole: return make_hole(mesh, c);
     case EditKind::SplitHole: return split_hole(mesh, c);
     case EditKind::JoinBorders: return join_borders(mesh, c);
+    case EditKind::CrossCurves: return cross_curves(mesh, c);
   }
   return Status::failure("unknown edit command");
 }
@@ -502,14 +625,36 @@ void for_each_command_field(Command& c, Field&& field) {
 void save_command(SnapshotWriter& out, const EditCommand& c) {
   out.put(uint8_t(c.kind));
   for_each_command_field(c, [&](const auto& value) { out.put(value); });
+  // Only this kind holds crossings, so the snapshots of every other command keep their bytes.
+  if (c.kind != EditKind::CrossCurves) return;
+  out.put(uint64_t(c.crossings.size()));
+  for (const Crossing& x : c.crossings) {
+    out.put(x.at.edge);
+    out.put(x.at.point);
+    out.put(x.point);
+    out.put(x.face);
+  }
 }
 
 bool load_command(SnapshotReader& in, EditCommand& c) {
   uint8_t kind = 0;
   in.get(kind);
   for_each_command_field(c, [&](auto& value) { in.get(value); });
-  if (kind > uint8_t(EditKind::JoinBorders)) in.fail();
+  if (kind > uint8_t(EditKind::CrossCurves)) in.fail();
   c.kind = EditKind(kind);
+  if (c.kind == EditKind::CrossCurves && in.ok()) {
+    uint64_t n = 0;
+    in.get(n);
+    if (n > c.points.size()) in.fail();  // each crossing has a stroke point of its own
+    for (uint64_t k = 0; k < n && in.ok(); ++k) {
+      Crossing x;
+      in.get(x.at.edge);
+      in.get(x.at.point);
+      in.get(x.point);
+      in.get(x.face);
+      c.crossings.push_back(x);
+    }
+  }
   return in.ok();
 }
 

@@ -21,7 +21,10 @@ namespace fire {
 // surface there: the hole becomes two faces, one each side of the curve, and that border is gone. JoinBorders
 // draws a curve from one border loop to another across the hole between them (a handle, a vessel's wall, two
 // parts joined): the first is a bridge, with no face, and the second between the same two loops turns the hole
-// between them into two faces. DeleteCurve removes a bridge still waiting.
+// between them into two faces. DeleteCurve removes a bridge still waiting. CrossCurves draws a stroke over
+// several faces: every curve it crosses, and the curves its ends lie on, are cut there, and each piece splits
+// the face it runs over, in one transaction (one undo); refused when a crossing is on the border, when two
+// cuts are at one place, or when two pieces cross in one face.
 Status execute_edit(Mesh& mesh, const EditCommand& command);
 
 // Splits edge e at interior polyline point `point` (0 < point < count-1): a new vertex and two edges

@@ -404,7 +404,7 @@ TEST_CASE("every snapshot plus the log's tail equals a full replay, hash for has
     CHECK(c.redo > 0);
     CHECK(c.provisional > 0);
   }
-  SECTION("topology strokes (version 2): closed across the hole, a face made a hole and back, two loops joined") {
+  SECTION("topology strokes (version 2): closed across the hole, a face made a hole and back, a stroke across a curve, two loops joined") {
     std::string text = "FIRE-LOG 2\n";
     int64_t t = 0;
     auto stroke = [&](const Vec3& a, const Vec3& b, double bulge) {
@@ -430,6 +430,10 @@ TEST_CASE("every snapshot plus the log's tail equals a full replay, hash for has
     stroke({1, 0, 2}, {1, 1, 2}, 0);
     stroke({1, 1, 2}, {0, 1, 2}, 0);
     stroke({0, 1, 2}, {0.001, 0.001, 2}, 0);
+    stroke({0.5, 0, 2}, {0.5, 1, 2}, 0);        // split in two, and a stroke across both halves: one edit
+    stroke({0.25, 0, 2}, {0.75, 1, 2}, 0);
+    command("undo");
+    command("redo");
     text += std::to_string(t) + " down\n";      // a bridge from the hole's rim up to the second part
     for (int k = 0; k <= 8; ++k)
       text += std::to_string(t += 10'000) + " pen 0 " + format_double(0.5 + 0.1 * std::sin(std::numbers::pi * k / 8.0)) + " " +
@@ -443,14 +447,14 @@ TEST_CASE("every snapshot plus the log's tail equals a full replay, hash for has
     CHECK(clean_hash(recover_input_log(s.log, "log")->log.events) == expected);
     const SnapshotCoverage c = reopen_from_each_snapshot(s, expected);
     CHECK(c.redo > 0);
-    // What the log drew: 5 faces (two on top, one below, the second part) and a bridge waiting.
+    // What the log drew: 7 faces (two on top, one below, the second part's four) and a bridge waiting.
     World w;
     w.log = *log;
     Scheduler scheduler = make_scheduler(w, [] { return int64_t(0); });
     replay_headless(w, scheduler);
     INFO((w.rejections.empty() ? std::string() : w.rejections.back().reason));
     CHECK(w.rejections.empty());
-    CHECK(w.mesh.face_count() == 4);
+    CHECK(w.mesh.face_count() == 7);
     CHECK(w.mesh.pending_bridge_count() == 1);
     CHECK(w.mesh.border_loop_count() == 2);
   }

@@ -686,3 +686,72 @@ TEST_CASE("two curves between two border loops: a bridge with no face, then two 
   while (h.undo_depth() > 0) REQUIRE(h.undo(m).ok());
   CHECK(m.same_pools(Mesh{}));
 }
+
+namespace {
+
+// The polyline point at p exactly, as a curve end (the first found), or an end with no edge.
+CurveEnd point_at(const Mesh& m, const Vec3& p) {
+  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e))
+      for (uint32_t k = 0; k < m.edges.point_count[e]; ++k)
+        if (at(m, e, k) == p) return {e, k};
+  return {};
+}
+
+// The square split in half, and a stroke from (0.25, 0) on the bottom across the middle curve at (0.5, 0.5) to
+// (0.75, 1) on the top.
+EditCommand across_middle(const Mesh& m, uint32_t middle) {
+  EditCommand c = make(EditKind::CrossCurves, {{0.25, 0, 0}, {0.375, 0.25, 0.1}, {0.5, 0.5, 0}, {0.625, 0.75, 0.1}, {0.75, 1, 0}});
+  c.start = point_at(m, {0.25, 0, 0});
+  c.end = point_at(m, {0.75, 1, 0});
+  c.face = m.edges.face[c.start.edge][0];
+  c.crossings.push_back({point_at(m, {0.5, 0.5, 0}), 2, m.other_face(middle, c.face)});
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("a stroke across a curve: each piece splits its face, undo takes both back at once", "[split][crossing]") {
+  EditHistory h;
+  Mesh m = square(&h);
+  const uint32_t middle = split_square(m, h);
+  const EditCommand cross = across_middle(m, middle);
+  REQUIRE(cross.start.edge != kNone);
+  REQUIRE(cross.end.edge != kNone);
+  REQUIRE(cross.crossings[0].at.edge == middle);
+  const size_t depth = h.undo_depth();
+  apply_undo_redo(m, h, cross);
+  CHECK(m.face_count() == 4);
+  CHECK(face_sizes(m) == std::vector<uint32_t>{3, 3, 5, 5});  // a triangle each side between the piece and the middle curve
+  CHECK(h.undo_depth() == depth + 1);
+  CHECK(euler_characteristic(m) == 1);
+}
+
+TEST_CASE("a stroke across curves is refused in words when a crossing is on the border, stays in one face, or repeats a cut", "[split][crossing][reject]") {
+  EditHistory h;
+  Mesh m = square(&h);
+  const uint32_t middle = split_square(m, h);
+  const Mesh before = m;
+  EditCommand border = across_middle(m, middle);
+  border.crossings[0].at = point_at(m, {1, 0.5, 0});
+  EditCommand same_face = across_middle(m, middle);
+  same_face.crossings[0].face = same_face.face;
+  EditCommand twice = across_middle(m, middle);
+  twice.crossings.push_back(twice.crossings[0]);
+  twice.crossings[1].point = 3;
+  twice.crossings[1].face = twice.face;
+  EditCommand backwards = across_middle(m, middle);
+  backwards.crossings[0].point = 0;
+  struct Case {
+    const EditCommand* command;
+    const char* says;
+  };
+  for (const Case& c : {Case{&border, "would leave the surface"}, Case{&same_face, "a crossing changes face"},
+                        Case{&twice, "where an earlier cut of it is"}, Case{&backwards, "not after the previous cut"}}) {
+    const Status outcome = h.apply(m, *c.command);
+    INFO(outcome.error);
+    CHECK_FALSE(outcome.ok());
+    CHECK_THAT(outcome.error, Catch::Matchers::Contains(c.says));
+    CHECK(m.same_pools(before));
+  }
+}

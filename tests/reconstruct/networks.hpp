@@ -37,12 +37,17 @@ Mesh grid_network(uint32_t nx, uint32_t ny, uint32_t samples, const Height& heig
 // vertices (2^levels samples per control edge). Its FIRE base mesh has the control grid's topology.
 Mesh limit_grid_network(uint32_t m, uint32_t levels, const Height& height);
 
-// A curve across a random live face between two random points of its border, bowed up. Mostly between
+// A curve across a random live face between two random points of its border, bowed up by a random height. Mostly between
 // points inside two different edges; one in sixteen may end anywhere, which can make 2-sided faces.
 EditCommand random_split(const Mesh& m, std::mt19937_64& rng);
-// A random change of topology: a random face made a hole (refused when it lies beside or touches the border),
-// or a curve from a random border loop, bowed down: across its hole to another of its points, or to another
-// border loop (a bridge, or the faces of a second one); nothing without faces.
+// A stroke across 1 to 5 curves: from a random point of a random face's boundary, over random inner curves
+// into the face beyond each, to a random point of the last face's boundary, each piece bowed up. The split
+// system refuses the ones that cross at one place twice or whose pieces it cannot place.
+std::optional<EditCommand> random_crossing(const Mesh& m, std::mt19937_64& rng);
+// A random change of topology: one time in three a random crossing stroke; else a random face made a hole
+// (refused when it lies beside or touches the border), or a curve from a random border loop, bowed down: across
+// its hole to another of its points, or to another border loop (a bridge, or the faces of a second one);
+// nothing without faces.
 std::optional<EditCommand> random_topology_edit(const Mesh& m, std::mt19937_64& rng);
 // Deleting a random interior curve, or nothing when every curve is on the border.
 std::optional<EditCommand> random_delete(const Mesh& m, std::mt19937_64& rng);

@@ -25,13 +25,65 @@ EditCommand random_split(const Mesh& m, std::mt19937_64& rng) {
   c.end = pick(loop[second] >> 1);
   const Vec3 a = m.polyline(c.start.edge)[c.start.point], b = m.polyline(c.end.edge)[c.end.point];
   const int n = 3 + int(rng() % 8);
+  // A bow of its own: two curves between the same two points must not share a point between them.
+  const double bow = 0.15 + 0.1 * double(rng() % 1024) / 1024;
   for (int k = 0; k < n; ++k) {
     const double s = double(k) / (n - 1);
-    c.points.push_back(a + (b - a) * s + Vec3(0, 0, 0.2 * std::sin(M_PI * s)));
+    c.points.push_back(a + (b - a) * s + Vec3(0, 0, bow * std::sin(M_PI * s)));
   }
   return c;
 }
 
+
+std::optional<EditCommand> random_crossing(const Mesh& m, std::mt19937_64& rng) {
+  std::vector<uint32_t> faces;
+  for (uint32_t f = 0; f < m.face_slots(); ++f)
+    if (m.face_alive(f)) faces.push_back(f);
+  if (faces.empty()) return std::nullopt;
+  // Mostly inside a curve; one time in eight at either end, a vertex.
+  auto pick = [&](uint32_t e) {
+    const uint32_t n = m.edges.point_count[e];
+    return CurveEnd{e, rng() % 8 == 0 || n < 3 ? uint32_t(rng() % 2) * (n - 1) : 1 + uint32_t(rng() % (n - 2))};
+  };
+  auto position = [&](const CurveEnd& at) { return m.polyline(at.edge)[at.point]; };
+  EditCommand c;
+  c.kind = EditKind::CrossCurves;
+  c.face = faces[rng() % faces.size()];
+  uint32_t face = c.face, last_edge = edge_of(m.face_loop(face)[rng() % m.face_loop(face).size()]);
+  c.start = pick(last_edge);
+  std::vector<Vec3> cuts{position(c.start)};
+  // Each piece leaves its face by another curve than it came in by.
+  for (size_t crossings = 1 + rng() % 5; c.crossings.size() < crossings;) {
+    std::vector<uint32_t> inner;
+    for (uint32_t oe : m.face_loop(face))
+      if (m.other_face(edge_of(oe), face) != kNone && edge_of(oe) != last_edge) inner.push_back(edge_of(oe));
+    if (inner.empty()) break;
+    const uint32_t e = last_edge = inner[rng() % inner.size()];
+    face = m.other_face(e, face);
+    c.crossings.push_back({pick(e), 0, face});
+    cuts.push_back(position(c.crossings.back().at));
+  }
+  if (c.crossings.empty()) return std::nullopt;
+  std::vector<uint32_t> exits;
+  for (uint32_t oe : m.face_loop(face))
+    if (edge_of(oe) != last_edge) exits.push_back(edge_of(oe));
+  if (exits.empty()) return std::nullopt;
+  c.end = pick(exits[rng() % exits.size()]);
+  cuts.push_back(position(c.end));
+  // Each piece a few points bowed up; its last is the next piece's first.
+  c.points.push_back(cuts.front());
+  for (size_t i = 0; i + 1 < cuts.size(); ++i) {
+    const int n = 2 + int(rng() % 4);
+    const double bow = 0.05 + 0.1 * double(rng() % 1024) / 1024;
+    for (int k = 1; k <= n; ++k) {
+      const double s = double(k) / n;
+      c.points.push_back(cuts[i] + (cuts[i + 1] - cuts[i]) * s + Vec3(0, 0, bow * std::sin(M_PI * s)));
+    }
+    c.points.back() = cuts[i + 1];
+    if (i < c.crossings.size()) c.crossings[i].point = uint32_t(c.points.size() - 1);
+  }
+  return c;
+}
 
 std::optional<EditCommand> random_topology_edit(const Mesh& m, std::mt19937_64& rng) {
   std::vector<uint32_t> rim, faces;
@@ -40,6 +92,7 @@ std::optional<EditCommand> random_topology_edit(const Mesh& m, std::mt19937_64& 
   for (uint32_t f = 0; f < m.face_slots(); ++f)
     if (m.face_alive(f)) faces.push_back(f);
   if (faces.empty()) return std::nullopt;
+  if (rng() % 3 == 0) return random_crossing(m, rng);
   EditCommand c;
   if (rim.empty() || rng() % 2 == 0) {
     c.kind = EditKind::MakeHole;

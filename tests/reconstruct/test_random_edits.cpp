@@ -34,20 +34,21 @@ bool finite(const SurfaceMesh& s) {
 }  // namespace
 
 TEST_CASE("random edits: incremental reconstruction equals a rebuild after every edit", "[reconstruct][incremental][random]") {
-  std::mt19937_64 rng(20261124);
+  std::mt19937_64 rng(20261208);
   Mesh net = grid_network(4, 3, 9, height);
   EditHistory history;
   const Options fire_options{Method::fire, 1, 2, Planarity::least_squares};
   const Options thesis_options{Method::thesis, 1, 2, Planarity::least_squares};
   ReconstructionState fire_state, thesis_state;
   SurfaceMesh fire_surface, thesis_surface;
-  int applied = 0, thesis_refused = 0, compared = 0, closed_steps = 0, holed_steps = 0;
+  int applied = 0, thesis_refused = 0, compared = 0, closed_steps = 0, holed_steps = 0, crossed = 0;
   for (int step = 0; step < 120; ++step) {
     const uint64_t dice = rng() % 100;
     const std::optional<Status> edit = random_edit(net, history, rng, dice < 60, dice, 75, 90);
     if (!edit) continue;
     const Status& r = *edit;
     applied += r.ok();
+    crossed += r.ok() && dice < 60 && history.last_drawn() && history.last_drawn()->kind == EditKind::CrossCurves;
     INFO("step " << step << " (" << (r.ok() ? "applied" : r.error) << "), " << net.face_count() << " faces");
     REQUIRE(net.validate() == "");
 
@@ -78,11 +79,13 @@ TEST_CASE("random edits: incremental reconstruction equals a rebuild after every
     net.begin_frame(net.frame() + 1);
   }
   // The mix really edited the network, the topology too (closed by curves across the border's hole, opened
-  // again by holes), and the thesis comparison really ran (seed 20261124: 108 edits applied, 19 thesis
-  // comparisons, 101 refusals; 5 steps closed, 50 with more than one border loop).
+  // again by holes, strokes across curves), and the thesis comparison really ran (seed 20261208: 104 edits
+  // applied, 22 thesis comparisons, 98 refusals; 50 steps closed, 2 with more than one border loop, 2 strokes
+  // across curves).
   INFO("applied " << applied << ", thesis compared " << compared << ", refused " << thesis_refused << ", closed "
-                  << closed_steps << ", holed " << holed_steps);
+                  << closed_steps << ", holed " << holed_steps << ", strokes across curves " << crossed);
   CHECK(applied > 60);
+  CHECK(crossed > 0);
   CHECK(closed_steps > 0);
   CHECK(holed_steps > 0);
   CHECK(compared > 15);

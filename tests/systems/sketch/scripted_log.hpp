@@ -42,4 +42,11 @@ inline std::unique_ptr<World> replay(const Log& log) {
   return w;
 }
 
+// Every refusal's reason, one a line: what a failed check should show.
+inline std::string rejections(const World& w) {
+  std::string all;
+  for (const Rejection& r : w.rejections) all += r.reason + "\n";
+  return all;
+}
+
 }  // namespace fire::test

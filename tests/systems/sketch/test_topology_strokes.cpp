@@ -11,6 +11,7 @@
 
 using namespace fire;
 using fire::test::Log;
+using fire::test::rejections;
 using fire::test::replay;
 
 namespace {
@@ -48,12 +49,6 @@ evaluate::Topology surface_topology(const World& w) {
   std::vector<uint32_t> offsets;
   for (size_t q = 0; q <= w.surface.quads.size(); q += 4) offsets.push_back(uint32_t(q));
   return evaluate::topology(w.surface.positions, offsets, w.surface.quads);
-}
-
-std::string rejections(const World& w) {
-  std::string all;
-  for (const Rejection& r : w.rejections) all += r.reason + "\n";
-  return all;
 }
 
 }  // namespace
