@@ -17,7 +17,7 @@ struct CurveEnd {
 
 // Kinds are appended, never reordered: snapshots hold them as bytes.
 enum class EditKind : uint8_t { StartBorder, AppendBorder, CloseBorder, SplitFace, DeleteCurve, ToggleSharp, MakeHole, SplitHole,
-                                JoinBorders, CrossCurves };
+                                JoinBorders, CrossCurves, ExtendChain };
 
 // CrossCurves: one place where the stroke crosses a curve of the network.
 struct Crossing {
@@ -35,7 +35,10 @@ struct EditCommand {
                              // one border loop, whose hole the curve crosses; JoinBorders: on two border loops;
                              // CrossCurves: on the boundaries of the first and the last face it runs through
   std::vector<Crossing> crossings;  // CrossCurves: in stroke order, at least one
-  uint32_t edge = kNone;     // DeleteCurve, ToggleSharp (sharp becomes smooth, smooth sharp)
+  uint32_t edge = kNone;     // DeleteCurve, ToggleSharp (sharp becomes smooth, smooth sharp); ExtendChain and the
+                             // kinds that split (SplitFace, SplitHole, JoinBorders, CrossCurves): the last piece of
+                             // the pending chain the stroke goes on from (kNone: none; points then hold the whole
+                             // chain and the stroke, from where the chain began)
   double snap_distance = 0;  // CloseBorder: how far the last point may lie from the first vertex
 };
 

@@ -115,8 +115,27 @@ std::vector<uint32_t> Mesh::border_loop(uint32_t e) const {
 
 bool Mesh::border_in_progress() const {
   for (uint32_t e = 0; e < edge_slots(); ++e)
-    if (edge_alive(e) && is_loose_edge(e) && !is_waiting_bridge(e)) return true;
+    if (edge_alive(e) && is_loose_edge(e) && !is_waiting_bridge(e) && !is_pending(e)) return true;
   return false;
+}
+
+std::vector<std::vector<uint32_t>> Mesh::pending_chains() const {
+  std::vector<std::vector<uint32_t>> chains;
+  for (uint32_t e = 0; e < edge_slots(); ++e) {
+    if (!edge_alive(e) || !is_pending(e) || valence(edges.vertex[e][0]) != 1) continue;  // a chain's first piece
+    std::vector<uint32_t> chain{e};
+    for (bool more = true; more && chain.size() <= edge_slots();) {
+      more = false;
+      for (uint32_t g : vertex_edges(edges.vertex[chain.back()][1]))
+        if (g != chain.back() && is_pending(g) && edges.vertex[g][0] == edges.vertex[chain.back()][1]) {
+          chain.push_back(g);
+          more = true;
+          break;
+        }
+    }
+    chains.push_back(std::move(chain));
+  }
+  return chains;
 }
 
 size_t Mesh::pending_bridge_count() const {

@@ -46,6 +46,7 @@ enum ElementFlag : uint8_t {
   kSplitVertex = 2,  // vertex made by splitting an edge: joined again when no curve needs it
   kSharpEdge = 4,    // crease for subdivision
   kBridgeEdge = 8,   // a curve between two border loops across their hole, no face yet: the second one makes the faces
+  kPendingEdge = 16, // a piece of a stroke that ended off the network: no face, apart from the network, drawn on from its free end
 };
 
 struct VertexPool {
@@ -152,6 +153,10 @@ class Mesh {
   bool is_loose_edge(uint32_t e) const { return edges.face[e][0] == kNone && edges.face[e][1] == kNone; }
   // A bridge (kBridgeEdge) still waiting for the second curve between its two border loops.
   bool is_waiting_bridge(uint32_t e) const { return is_loose_edge(e) && (edges.flags[e] & kBridgeEdge); }
+  bool is_pending(uint32_t e) const { return edges.flags[e] & kPendingEdge; }
+  // The pending chains (kPendingEdge), each as its pieces in drawing order (edge i ends where i + 1 starts):
+  // the first starts on the network where the chain began, the last ends at the chain's free end.
+  std::vector<std::vector<uint32_t>> pending_chains() const;
   // The oriented edge that walks border edge e as the hole beside it would: against its one face.
   uint32_t hole_side(uint32_t e) const { return make_oriented(e, edges.face[e][1] == kNone); }
   // The border loop through border edge e as the hole beside it walks it, starting with e; empty when e has

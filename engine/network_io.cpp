@@ -20,6 +20,7 @@ std::string network_to_json(const Mesh& m) {
                      {"sharp", bool(m.edges.flags[e] & kSharpEdge)},
                      {"points", std::move(pts)}});
     if (m.edges.flags[e] & kBridgeEdge) edges.back()["bridge"] = true;  // only then: older networks read the same
+    if (m.edges.flags[e] & kPendingEdge) edges.back()["pending"] = true;
   }
   for (uint32_t f = 0; f < m.face_slots(); ++f) {
     json es = json::array(), rs = json::array();
@@ -100,10 +101,11 @@ Result<Mesh> network_from_json(std::string_view text, const std::string& source)
       if (!sharp.is_boolean()) throw Bad{where + ": \"sharp\" must be true or false"};
       uint32_t e = m.add_edge(a, b, line);
       if (sharp.get<bool>()) m.set_edge_flag(e, kSharpEdge, true);
-      if (const auto bridge = es[i].find("bridge"); bridge != es[i].end()) {
-        if (!bridge->is_boolean()) throw Bad{where + ": \"bridge\" must be true or false"};
-        if (bridge->get<bool>()) m.set_edge_flag(e, kBridgeEdge, true);
-      }
+      for (const auto& [name, flag] : {std::pair{"bridge", kBridgeEdge}, std::pair{"pending", kPendingEdge}})
+        if (const auto on = es[i].find(name); on != es[i].end()) {
+          if (!on->is_boolean()) throw Bad{where + ": \"" + name + "\" must be true or false"};
+          if (on->get<bool>()) m.set_edge_flag(e, flag, true);
+        }
     }
     std::vector<uint32_t> loop;
     for (size_t i = 0; i < fs.size(); ++i) {

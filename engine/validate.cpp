@@ -81,6 +81,7 @@ std::string Mesh::validate() const {
     }
     if (ef[0] != kNone && ef[0] == ef[1]) return name + " has face " + str(ef[0]) + " on both sides";
     if ((edges.flags[e] & kBridgeEdge) && (ef[0] != kNone || ef[1] != kNone)) return name + " is a bridge but has a face";
+    if ((edges.flags[e] & kPendingEdge) && (ef[0] != kNone || ef[1] != kNone)) return name + " is pending but has a face";
     ++incidences;
   }
 
@@ -98,6 +99,12 @@ std::string Mesh::validate() const {
     }
   }
   if (listed != 2 * incidences) return "vertex edge lists hold " + std::to_string(listed) + " entries for " + std::to_string(incidences) + " edges";
+  // A pending chain lies apart from the network until the stroke that finishes it.
+  for (uint32_t e = 0; e < ne; ++e)
+    if (edge_alive(e) && (edges.flags[e] & kPendingEdge))
+      for (uint32_t v : edges.vertex[e])
+        for (uint32_t g : vertex_edges(v))
+          if (!(edges.flags[g] & kPendingEdge)) return "edge " + str(e) + " is pending but touches curve " + str(g) + " of the network";
 
   for (uint32_t f = 0; f < nf; ++f) {
     if (!face_alive(f)) continue;

@@ -333,6 +333,7 @@ Status Renderer::upload_points(const Mesh& network) {
   if (grown) edge_records_.clear();
   edge_records_.resize(network.edge_slots());
   curve_draws_.clear();
+  pending_draws_.clear();
   std::vector<glm::vec3> floats;
   for (uint32_t e = 0; e < network.edge_slots(); ++e) {
     EdgeRecord& record = edge_records_[e];
@@ -349,7 +350,7 @@ Status Renderer::upload_points(const Mesh& network) {
       ++stats_.edges;
       record = now;
     }
-    if (now.count >= 2) curve_draws_.emplace_back(now.offset, now.count);
+    if (now.count >= 2) (network.is_pending(e) ? pending_draws_ : curve_draws_).emplace_back(now.offset, now.count);
   }
   return Status::success();
 }
@@ -725,6 +726,13 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
     pc.params.w = camera.line_depth_pull;
     bind(curves_, points_.buffer);
     for (const auto& [first, count] : curve_draws_) vkCmdDraw(cmd, 6, count - 1, 0, first);
+  }
+  if (!pending_draws_.empty() && options.curves) {  // as the stroke being drawn: not yet a curve
+    pc.color = linear(Palette::stroke);
+    pc.params.x = std::max(1.0f, 2.0f * scale);
+    pc.params.w = camera.line_depth_pull;
+    bind(curves_, points_.buffer);
+    for (const auto& [first, count] : pending_draws_) vkCmdDraw(cmd, 6, count - 1, 0, first);
   }
   if (!marker_draws_.empty() && options.curves) {
     pc.color = linear(Palette::marker);

@@ -59,7 +59,7 @@ struct Palette {
   static constexpr uint8_t marker[3] = {250, 250, 250};
   static constexpr uint8_t reference[3] = {120, 170, 255};
   static constexpr uint8_t wireframe[3] = {40, 44, 52};
-  static constexpr uint8_t stroke[3] = {255, 220, 60};  // the stroke being drawn, not yet a curve
+  static constexpr uint8_t stroke[3] = {255, 220, 60};  // the stroke being drawn, and pieces pending: not yet a curve
   static constexpr uint8_t pen_face[3] = {255, 70, 200};       // tint of the face under the pen
   static constexpr uint8_t snap_target[3] = {40, 225, 255};    // where a stroke end at the pen snaps
   static constexpr uint8_t close_border[3] = {70, 235, 110};   // the first vertex, when a stroke end closes the border
@@ -177,7 +177,8 @@ class Renderer {
   Buffer points_;
   std::vector<EdgeRecord> edge_records_;
   Frame network_frame_ = 0;  // the network's frame at the last upload: later stamps are news
-  std::vector<std::pair<uint32_t, uint32_t>> curve_draws_;  // (first point, point count) per live edge
+  std::vector<std::pair<uint32_t, uint32_t>> curve_draws_;  // (first point, point count) per live edge of the network
+  std::vector<std::pair<uint32_t, uint32_t>> pending_draws_;  // the same per pending piece (Mesh::pending_chains)
   Buffer vertices_;
   std::vector<glm::vec3> vertex_copy_;  // what the vertex buffer holds, per slot
   std::vector<uint8_t> vertex_live_;

@@ -148,6 +148,9 @@ void Hud::build(const HudData& d) {
   if (d.pending_bridges > 0)
     ImGui::TextWrapped("%zu curve(s) between two border loops: no surface between them until a second curve joins the same two loops",
                        d.pending_bridges);
+  if (d.pending_pieces > 0)
+    ImGui::TextWrapped("%zu stroke piece(s) pending: go on from the free end to a curve (undo takes off the last piece)",
+                       d.pending_pieces);
   ImGui::Text("points %zu  surface quads %zu", d.points, d.surface_quads);
   ImGui::Text("mode: %s", d.border_mode ? "border (strokes extend the border)" : "split (strokes split faces)");
   ImGui::Text("view: surface %s  curves %s  wireframe %s", d.view.surface ? "on" : "off", d.view.curves ? "on" : "off",

@@ -34,6 +34,7 @@ struct HudData {
   bool border_mode = true;   // no face yet, or a new part's border open: strokes extend the border; else they split faces
   size_t border_loops = 0;   // the surface's border loops: 0 once the object is closed
   size_t pending_bridges = 0;  // curves between two border loops waiting for their second: no surface there yet
+  size_t pending_pieces = 0;   // pieces of strokes that ended off the network, waiting to be continued from their free end
   std::string last_rejection; // the last edit refused, in words; empty if none
   std::string status;         // a line of news (saved to, nothing to undo...)
   render::DrawOptions view;

@@ -115,6 +115,28 @@ HoleSnap snap_to_hole(const Mesh& m, const SnapIndex& index, const Vec3& start, 
   return out;
 }
 
+// The nearest point to p within `radius` of a curve of the network, not of a pending chain.
+SnapHit network_nearest(const Mesh& m, const SnapIndex& index, const Vec3& p, double radius) {
+  const SnapHit nearest = index.nearest(p, radius);
+  if (!nearest.found() || !m.is_pending(nearest.edge)) return nearest;
+  std::vector<SnapHit> hits;
+  index.nearest_per_edge(p, radius, hits);
+  SnapHit best;
+  for (const SnapHit& h : hits)
+    if (!m.is_pending(h.edge) && (h.distance < best.distance || (h.distance == best.distance && h.edge < best.edge))) best = h;
+  return best;
+}
+
+// The points of a pending chain's pieces, from where it began to its free end.
+std::vector<Vec3> chain_points(const Mesh& m, const std::vector<uint32_t>& chain) {
+  std::vector<Vec3> points;
+  for (uint32_t e : chain) {
+    const std::span<const Vec3> line = m.polyline(e);
+    points.insert(points.end(), line.begin() + (points.empty() ? 0 : 1), line.end());
+  }
+  return points;
+}
+
 // The open border's first and last vertices (the first is the start of the first edge drawn).
 std::pair<uint32_t, uint32_t> border_ends(const Mesh& m) {
   uint32_t first = kNone, last = kNone;
@@ -139,7 +161,7 @@ class FaceBySide {
   FaceBySide(const Mesh& m, const SnapIndex& index, double radius) : m_(m), index_(index), radius_(radius) {}
   uint32_t operator()(const Vec3& p) {
     const SnapHit h = index_.nearest(p);
-    if (!h.found() || h.distance <= radius_) return kUntold;
+    if (!h.found() || h.distance <= radius_ || m_.is_loose_edge(h.edge)) return kUntold;
     const std::span<const Vec3> line = m_.polyline(h.edge);
     if (h.point == 0 || h.point + 1 == line.size()) return kUntold;
     const Vec3 tangent = line[h.point + 1] - line[h.point - 1];
@@ -491,6 +513,47 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           blend_ends(r.command.points, mesh.vertices.position[last],
                      r.command.kind == EditKind::CloseBorder ? first_position : r.command.points.back(), 1);
         } else {
+          // A stroke in pieces: one that ends off the network waits as a pending chain, and the next stroke from
+          // its free end goes on with it, until one reaches the network and the whole curve is drawn.
+          uint32_t chain_last = kNone;
+          if (settings.topology_strokes && mesh.face_count() > 0) {
+            const double start_radius = radius(state.start_snap);
+            const bool end_on_network = network_nearest(mesh, snap, r.command.points.back(), end_snap).found();
+            const std::vector<std::vector<uint32_t>> chains = mesh.pending_chains();
+            double nearest_free_end = std::numeric_limits<double>::infinity();
+            const std::vector<uint32_t>* chain = nullptr;
+            for (const std::vector<uint32_t>& c : chains) {
+              const double d = (mesh.vertices.position[mesh.edges.vertex[c.back()][1]] - r.command.points.front()).norm();
+              if (d < nearest_free_end) {
+                nearest_free_end = d;
+                chain = &c;
+              }
+            }
+            if (chain && nearest_free_end <= start_radius) {
+              chain_last = chain->back();
+              blend_ends(r.command.points, mesh.vertices.position[mesh.edges.vertex[chain_last][1]], r.command.points.back(), settings.blend_reach);
+              if (!end_on_network) {
+                r.command.kind = EditKind::ExtendChain;
+                r.command.edge = chain_last;
+                requests.push_back(std::move(r));
+                break;
+              }
+              std::vector<Vec3> whole = chain_points(mesh, *chain);
+              whole.insert(whole.end(), r.command.points.begin() + 1, r.command.points.end());
+              r.command.points = std::move(whole);
+            } else if (const SnapHit start_hit = network_nearest(mesh, snap, r.command.points.front(), start_radius); start_hit.found()) {
+              if (!end_on_network) {
+                r.command.kind = EditKind::ExtendChain;
+                blend_ends(r.command.points, mesh.polyline(start_hit.edge)[start_hit.point], r.command.points.back(), settings.blend_reach);
+                requests.push_back(std::move(r));
+                break;
+              }
+            } else if (chain) {
+              reject("the stroke starts " + format_mm(nearest_free_end) + " from the free end of the pending stroke, farther than " +
+                     format_mm(start_radius) + ", and away from every curve: go on from that end, or undo the pending pieces");
+              break;
+            }
+          }
           // A face holding both ends takes the stroke, as the thesis's sketch model has it. Else the stroke may run
           // over several faces, cross a border loop's hole (the far side of the surface), or, far from every
           // curve, start a new part.
@@ -507,6 +570,7 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
             }
             if (crossing) {
               r.command = std::move(*crossing);
+              r.command.edge = chain_last;
               requests.push_back(std::move(r));
               break;
             }
@@ -535,6 +599,7 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           const Vec3& end = mesh.polyline(r.command.end.edge)[r.command.end.point];
           drop_pauses(r.command.points, start, vertex_radius(state.start_snap), end, vertex_radius(state.end_snap));
           blend_ends(r.command.points, start, end, settings.blend_reach);
+          r.command.edge = chain_last;
         }
         requests.push_back(std::move(r));
         break;

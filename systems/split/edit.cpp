@@ -365,6 +365,7 @@ Status delete_curve(Mesh& m, const EditCommand& c) {
   uint32_t e = c.edge;
   if (!m.edge_alive(e)) return Status::failure("edge " + str(e) + " does not exist");
   if (!has_faces(m)) return Status::failure("curves can be deleted once the border polygon is closed");
+  if (m.is_pending(e)) return Status::failure("edge " + str(e) + " is a piece of a stroke still pending; undo removes its last piece");
   if (m.is_waiting_bridge(e)) {  // it goes alone
     const auto ends = m.edges.vertex[e];
     m.remove_edge(e);
@@ -521,6 +522,42 @@ Status cross_curves(Mesh& m, const EditCommand& c) {
   return Status::success();
 }
 
+// The pending chain whose last piece is `last`, in drawing order; empty when `last` is no chain's last piece.
+std::vector<uint32_t> chain_ending(const Mesh& m, uint32_t last) {
+  if (!m.edge_alive(last) || !m.is_pending(last)) return {};
+  for (std::vector<uint32_t>& chain : m.pending_chains())
+    if (chain.back() == last) return std::move(chain);
+  return {};
+}
+
+// A stroke that ends off the network: a new pending chain from the network, or the next piece of one.
+Status extend_chain(Mesh& m, const EditCommand& c) {
+  if (!has_faces(m)) return Status::failure("close the border polygon before drawing a stroke in pieces");
+  if (auto ok = check_points(c.points); !ok.ok()) return ok;
+  if (c.points.front() == c.points.back()) return Status::failure("the piece ends where it starts");
+  uint32_t from = kNone;
+  if (c.edge != kNone) {
+    if (chain_ending(m, c.edge).empty()) return Status::failure("edge " + str(c.edge) + " is not the last piece of a pending chain");
+    from = m.edges.vertex[c.edge][1];
+    if (c.points.front() != m.vertices.position[from]) return Status::failure("the piece does not start at the chain's free end");
+  } else {
+    from = m.add_vertex(c.points.front());
+  }
+  const uint32_t e = m.add_edge(from, m.add_vertex(c.points.back()), c.points);
+  m.set_edge_flag(e, kPendingEdge, true);
+  return Status::success();
+}
+
+// The pieces of a finished chain go: the curve that finished it holds their points.
+void remove_chain(Mesh& m, const std::vector<uint32_t>& chain) {
+  for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+    const auto ends = m.edges.vertex[*it];
+    m.remove_edge(*it);
+    m.remove_vertex(ends[1]);
+    if (it + 1 == chain.rend()) m.remove_vertex(ends[0]);
+  }
+}
+
 // A crease for subdivision along an inner curve; the border is a crease already.
 Status toggle_sharp(Mesh& m, const EditCommand& c) {
   const uint32_t e = c.edge;
@@ -553,7 +590,9 @@ uint32_t split_edge(Mesh& m, uint32_t e, uint32_t point) {
   return v;
 }
 
-Status execute_edit(Mesh& mesh, const EditCommand& c) {
+namespace {
+
+Status run_kind(Mesh& mesh, const EditCommand& c) {
   switch (c.kind) {
     case EditKind::StartBorder: return start_border(mesh, c);
     case EditKind::AppendBorder: return append_border(mesh, c);
@@ -565,8 +604,26 @@ Status execute_edit(Mesh& mesh, const EditCommand& c) {
     case EditKind::SplitHole: return split_hole(mesh, c);
     case EditKind::JoinBorders: return join_borders(mesh, c);
     case EditKind::CrossCurves: return cross_curves(mesh, c);
+    case EditKind::ExtendChain: return extend_chain(mesh, c);
   }
   return Status::failure("unknown edit command");
+}
+
+}  // namespace
+
+Status execute_edit(Mesh& mesh, const EditCommand& c) {
+  // A curve that finishes a pending chain: the curve first, which checks before it writes, then the chain goes.
+  const bool splits = c.kind == EditKind::SplitFace || c.kind == EditKind::SplitHole || c.kind == EditKind::JoinBorders ||
+                      c.kind == EditKind::CrossCurves;
+  std::vector<uint32_t> chain;
+  if (splits && c.edge != kNone) {
+    chain = chain_ending(mesh, c.edge);
+    if (chain.empty()) return Status::failure("edge " + str(c.edge) + " is not the last piece of a pending chain");
+    if (c.points.front() == c.points.back()) return Status::failure("the chain and the stroke that finishes it end where they start");
+  }
+  Status outcome = run_kind(mesh, c);
+  if (outcome.ok()) remove_chain(mesh, chain);
+  return outcome;
 }
 
 Status EditHistory::run(Mesh& mesh, const EditCommand& command) {
@@ -640,7 +697,7 @@ bool load_command(SnapshotReader& in, EditCommand& c) {
   uint8_t kind = 0;
   in.get(kind);
   for_each_command_field(c, [&](auto& value) { in.get(value); });
-  if (kind > uint8_t(EditKind::CrossCurves)) in.fail();
+  if (kind > uint8_t(EditKind::ExtendChain)) in.fail();
   c.kind = EditKind(kind);
   if (c.kind == EditKind::CrossCurves && in.ok()) {
     uint64_t n = 0;

@@ -44,7 +44,11 @@ EditCommand random_split(const Mesh& m, std::mt19937_64& rng);
 // into the face beyond each, to a random point of the last face's boundary, each piece bowed up. The split
 // system refuses the ones that cross at one place twice or whose pieces it cannot place.
 std::optional<EditCommand> random_crossing(const Mesh& m, std::mt19937_64& rng);
-// A random change of topology: one time in three a random crossing stroke; else a random face made a hole
+// A stroke in pieces: a new pending chain from a random curve point up into the air, a piece more on a random
+// chain, or a random chain finished by a split down to a random point of a face beside where it began.
+std::optional<EditCommand> random_chain(const Mesh& m, std::mt19937_64& rng);
+// A random change of topology: one time in three a random crossing stroke, one in three a random chain edit;
+// else a random face made a hole
 // (refused when it lies beside or touches the border), or a curve from a random border loop, bowed down: across
 // its hole to another of its points, or to another border loop (a bridge, or the faces of a second one);
 // nothing without faces.

@@ -85,6 +85,53 @@ std::optional<EditCommand> random_crossing(const Mesh& m, std::mt19937_64& rng) 
   return c;
 }
 
+std::optional<EditCommand> random_chain(const Mesh& m, std::mt19937_64& rng) {
+  const std::vector<std::vector<uint32_t>> chains = m.pending_chains();
+  EditCommand c;
+  // A piece from a point off the network (a free end, or a random curve point) up into the air.
+  auto piece_from = [&](const Vec3& a) {
+    const Vec3 b = a + Vec3(0.02 * double(rng() % 64) / 64 - 0.01, 0.02 * double(rng() % 64) / 64 - 0.01, 0.05 + 0.05 * double(rng() % 64) / 64);
+    for (int k = 0; k < 4; ++k) c.points.push_back(a + (b - a) * (k / 4.0));
+    c.points.push_back(b);
+  };
+  if (chains.empty() || rng() % 3 == 0) {
+    std::vector<uint32_t> curves;
+    for (uint32_t e = 0; e < m.edge_slots(); ++e)
+      if (m.edge_alive(e) && !m.is_loose_edge(e)) curves.push_back(e);
+    if (curves.empty()) return std::nullopt;
+    const uint32_t e = curves[rng() % curves.size()];
+    c.kind = EditKind::ExtendChain;
+    piece_from(m.polyline(e)[rng() % m.edges.point_count[e]]);
+    return c;
+  }
+  const std::vector<uint32_t>& chain = chains[rng() % chains.size()];
+  c.edge = chain.back();
+  const Vec3 free_end = m.vertices.position[m.edges.vertex[chain.back()][1]];
+  if (rng() % 2 == 0) {
+    c.kind = EditKind::ExtendChain;
+    piece_from(free_end);
+    return c;
+  }
+  // Finished: down to a random point of a face beside the curve point where the chain began.
+  const Vec3 began = m.vertices.position[m.edges.vertex[chain.front()][0]];
+  for (uint32_t e = 0; e < m.edge_slots() && c.start.edge == kNone; ++e)
+    if (m.edge_alive(e) && !m.is_loose_edge(e))
+      for (uint32_t k = 0; k < m.edges.point_count[e]; ++k)
+        if (m.polyline(e)[k] == began) c.start = {e, k};
+  if (c.start.edge == kNone) return std::nullopt;  // that curve was deleted: the chain waits for an undo
+  c.kind = EditKind::SplitFace;
+  c.face = m.edges.face[c.start.edge][m.edges.face[c.start.edge][0] == kNone ? 1 : 0];
+  const std::span<const uint32_t> loop = m.face_loop(c.face);
+  const uint32_t e = edge_of(loop[rng() % loop.size()]);
+  c.end = {e, 1 + uint32_t(rng() % std::max<uint32_t>(1, m.edges.point_count[e] - 2))};
+  const Vec3 end = m.polyline(e)[std::min(c.end.point, m.edges.point_count[e] - 1)];
+  for (uint32_t g : chain)
+    for (uint32_t k = c.points.empty() ? 0 : 1; k < m.edges.point_count[g]; ++k) c.points.push_back(m.polyline(g)[k]);
+  for (int k = 1; k < 4; ++k) c.points.push_back(free_end + (end - free_end) * (k / 4.0));
+  c.points.push_back(end);
+  return c;
+}
+
 std::optional<EditCommand> random_topology_edit(const Mesh& m, std::mt19937_64& rng) {
   std::vector<uint32_t> rim, faces;
   for (uint32_t e = 0; e < m.edge_slots(); ++e)
@@ -92,7 +139,8 @@ std::optional<EditCommand> random_topology_edit(const Mesh& m, std::mt19937_64& 
   for (uint32_t f = 0; f < m.face_slots(); ++f)
     if (m.face_alive(f)) faces.push_back(f);
   if (faces.empty()) return std::nullopt;
-  if (rng() % 3 == 0) return random_crossing(m, rng);
+  if (const uint64_t kind = rng() % 6; kind < 2) return random_crossing(m, rng);
+  else if (kind < 4) return random_chain(m, rng);
   EditCommand c;
   if (rim.empty() || rng() % 2 == 0) {
     c.kind = EditKind::MakeHole;

@@ -34,14 +34,14 @@ bool finite(const SurfaceMesh& s) {
 }  // namespace
 
 TEST_CASE("random edits: incremental reconstruction equals a rebuild after every edit", "[reconstruct][incremental][random]") {
-  std::mt19937_64 rng(20261208);
+  std::mt19937_64 rng(20261214);
   Mesh net = grid_network(4, 3, 9, height);
   EditHistory history;
   const Options fire_options{Method::fire, 1, 2, Planarity::least_squares};
   const Options thesis_options{Method::thesis, 1, 2, Planarity::least_squares};
   ReconstructionState fire_state, thesis_state;
   SurfaceMesh fire_surface, thesis_surface;
-  int applied = 0, thesis_refused = 0, compared = 0, closed_steps = 0, holed_steps = 0, crossed = 0;
+  int applied = 0, thesis_refused = 0, compared = 0, closed_steps = 0, holed_steps = 0, crossed = 0, chained_steps = 0;
   for (int step = 0; step < 120; ++step) {
     const uint64_t dice = rng() % 100;
     const std::optional<Status> edit = random_edit(net, history, rng, dice < 60, dice, 75, 90);
@@ -76,16 +76,19 @@ TEST_CASE("random edits: incremental reconstruction equals a rebuild after every
     }
     closed_steps += net.border_loop_count() == 0;
     holed_steps += net.border_loop_count() > 1;
+    chained_steps += !net.pending_chains().empty();
     net.begin_frame(net.frame() + 1);
   }
   // The mix really edited the network, the topology too (closed by curves across the border's hole, opened
-  // again by holes, strokes across curves), and the thesis comparison really ran (seed 20261208: 104 edits
-  // applied, 22 thesis comparisons, 98 refusals; 50 steps closed, 2 with more than one border loop, 2 strokes
-  // across curves).
+  // again by holes, strokes across curves, strokes in pieces), and the thesis comparison really ran (seed
+  // 20261214: 105 edits applied, 17 thesis comparisons, 103 refusals; 63 steps closed, 28 with more than one
+  // border loop, 2 strokes across curves, 41 steps with a pending chain).
   INFO("applied " << applied << ", thesis compared " << compared << ", refused " << thesis_refused << ", closed "
-                  << closed_steps << ", holed " << holed_steps << ", strokes across curves " << crossed);
+                  << closed_steps << ", holed " << holed_steps << ", strokes across curves " << crossed
+                  << ", steps with a pending chain " << chained_steps);
   CHECK(applied > 60);
   CHECK(crossed > 0);
+  CHECK(chained_steps > 0);
   CHECK(closed_steps > 0);
   CHECK(holed_steps > 0);
   CHECK(compared > 15);

@@ -4,6 +4,7 @@
 #include <iostream>
 #include <memory>
 
+#include "engine/text.hpp"
 #include "platform/clock.hpp"
 #include "platform/files.hpp"
 #include "platform/network_file.hpp"
@@ -156,6 +157,13 @@ int run_replay(const ReplayOptions& o) {
     return 2;
   }
   const Mesh& m = world->mesh;
+  // Nothing pending is dropped in silence: a stroke in pieces the log never finished is in the network, not the surface.
+  for (const std::vector<uint32_t>& chain : m.pending_chains()) {
+    const Vec3& free_end = m.vertices.position[m.edges.vertex[chain.back()][1]];
+    std::cerr << lines_of << ": a stroke in " << chain.size() << " piece(s) is still pending: it ends off the network at ("
+              << format_double(free_end.x()) << ", " << format_double(free_end.y()) << ", " << format_double(free_end.z())
+              << "); no surface follows it until a stroke from there reaches a curve\n";
+  }
   const SurfaceLevels& surface = world->surface;
   if (!world->surface_build.problem.empty())
     std::cerr << o.log_path << ": the surface does not follow the last edit: " << world->surface_build.problem << "\n";

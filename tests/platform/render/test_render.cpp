@@ -184,6 +184,40 @@ TEST_CASE("the demo network renders as expected from two views, with the surface
   }
 }
 
+TEST_CASE("a pending piece of a stroke is drawn in the stroke's colour, not as a curve", "[render][chain]") {
+  auto context = make_context();
+  auto renderer = Renderer::create(*context, {kWidth, kHeight});
+  REQUIRE(renderer);
+  Scene scene = demo_scene();
+  auto stroke_pixels = [&](const Image& image) {
+    size_t n = 0;
+    for (uint32_t y = 0; y < kHeight; ++y)
+      for (uint32_t x = 0; x < kWidth; ++x) n += near(image.pixel(x, y), Palette::stroke, 30);
+    return n;
+  };
+  CHECK(stroke_pixels(render_scene(*context, **renderer, scene, View::top)) == 0);
+  // From the middle of a curve a fifth of the object's width outwards, as a stroke that ended off the network.
+  Mesh& net = scene.network;
+  uint32_t curve = 0;
+  while (!net.edge_alive(curve) || net.edges.point_count[curve] < 3) ++curve;
+  const Box box = box_of(scene);
+  const Vec3 from = net.polyline(curve)[net.edges.point_count[curve] / 2];
+  const Vec3 to = from + Vec3(0.2 * double(box.hi.x - box.lo.x), 0, 0);
+  std::vector<Vec3> piece;
+  for (int k = 0; k <= 8; ++k) piece.push_back(from + (to - from) * (k / 8.0));
+  piece.back() = to;
+  net.begin_frame(net.frame() + 1);
+  const uint32_t e = net.add_edge(net.add_vertex(from), net.add_vertex(to), piece);
+  net.set_edge_flag(e, kPendingEdge, true);
+  REQUIRE(net.validate() == "");
+  const Image image = render_scene(*context, **renderer, scene, View::top);
+  const size_t pending = stroke_pixels(image);
+  INFO("pixels in the stroke's colour " << pending);
+  CHECK(pending > 30);
+  // FIRE_RENDER_OUT=DIR writes the image there, to look at.
+  if (const char* out = std::getenv("FIRE_RENDER_OUT")) REQUIRE(write_png(image, std::string(out) + "/pending_top.png"));
+}
+
 TEST_CASE("uploads copy only what changed and the image equals a fresh upload's") {
   auto context = make_context();
   auto incremental = Renderer::create(*context, {kWidth, kHeight});

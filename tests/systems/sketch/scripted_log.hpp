@@ -1,5 +1,7 @@
 #pragma once
 // Input logs written line by line for the sketch tests, and their headless replay through every system.
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <string>
 
@@ -26,6 +28,28 @@ struct Log {
     return event("up");
   }
 };
+
+// A straight stroke from a to b, a sample every 5 mm.
+inline Log& line(Log& log, const Vec3& a, const Vec3& b) {
+  const int n = std::max(2, int(std::ceil((b - a).norm() / 0.005)));
+  log.event("down");
+  for (int k = 0; k <= n; ++k) {
+    const Vec3 p = a + (double(k) / n) * (b - a);
+    log.pen(p.x(), p.y(), p.z());
+  }
+  return log.event("up");
+}
+
+// A flat 30 x 10 cm rectangle cut into six strips by five curves at x = 5, 10, ..., 25 cm.
+inline Log strips() {
+  Log log;
+  line(log, {0, 0, 0}, {0.3, 0, 0});
+  line(log, {0.3, 0, 0}, {0.3, 0.1, 0});
+  line(log, {0.3, 0.1, 0}, {0, 0.1, 0});
+  line(log, {0, 0.1, 0}, {0.0005, 0.0005, 0});
+  for (double x : {0.05, 0.10, 0.15, 0.20, 0.25}) line(log, {x, 0, 0}, {x, 0.1, 0});
+  return log;
+}
 
 inline int64_t step_clock() {
   static int64_t t = 0;

@@ -108,10 +108,10 @@ TEST_CASE("a border drawn apart from the network starts a second part with its o
   CHECK(t.euler_characteristic == 2);  // two discs
 }
 
-TEST_CASE("a stroke with one end on a curve and the other nowhere is still refused in words", "[sketch][topology][reject]") {
+TEST_CASE("a stroke that starts away from every curve and ends on one is still refused in words", "[sketch][topology][reject]") {
   Log log;
   square(log);
-  arc(log, {0.05, 0, 0}, {0.05, 0.3, 0});
+  arc(log, {0.05, 0.3, 0}, {0.05, 0, 0});
   const auto w = replay(log);
   REQUIRE(w->rejections.size() == 1);
   CHECK_THAT(w->rejections[0].reason, Catch::Matchers::Contains("does not start and end on the boundary of one face"));
