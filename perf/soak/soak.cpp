@@ -118,6 +118,7 @@ int main(int argc, char** argv) {
 
   uint64_t applied = 0, rejected = 0, compactions = 0, borders = 1, checks = 0, refused_surfaces = 0;
   uint64_t closed = 0, holed = 0;  // operations after which the network had no border loop, or more than one
+  uint64_t crossings = 0, chained = 0;  // strokes across curves applied; operations after which a chain was pending
   const double rss_start = resident_mib();
   const double t0 = seconds_now();
   double next_report = t0 + 10;
@@ -143,12 +144,14 @@ int main(int argc, char** argv) {
     } else {
       const bool split = mesh.face_count() < s.min_faces || (mesh.face_count() < s.max_faces && dice < 550);
       if (auto edit = test::random_edit(mesh, history, rng, split, dice, 750, 900)) r = std::move(*edit);
+      crossings += split && r.ok() && history.last_applied()->kind == EditKind::CrossCurves;
     }
     (r.ok() ? applied : rejected) += 1;
     if (mesh.face_count() > 0) {
       const size_t loops = mesh.border_loop_count();
       closed += loops == 0;
       holed += loops > 1;
+      chained += !mesh.pending_chains().empty();
     }
     if (auto bad = mesh.validate(); !bad.empty()) return fail(op, "pools: " + bad);
     snap.sync(mesh);
@@ -190,8 +193,9 @@ int main(int argc, char** argv) {
               "network the method refuses)\n",
               (unsigned long long)applied, (unsigned long long)rejected, (unsigned long long)compactions,
               (unsigned long long)borders, (unsigned long long)checks, (unsigned long long)refused_surfaces);
-  std::printf("  topology: closed after %llu operations, with more than one border loop (holes) after %llu\n",
-              (unsigned long long)closed, (unsigned long long)holed);
+  std::printf("  topology: closed after %llu operations, with more than one border loop (holes) after %llu; %llu strokes "
+              "across curves applied, a stroke in pieces pending after %llu\n",
+              (unsigned long long)closed, (unsigned long long)holed, (unsigned long long)crossings, (unsigned long long)chained);
   std::printf("  %.1f s, %.0f operations per second; resident memory %.1f MiB at the start, %.1f MiB at the end, "
               "peak %.1f MiB\n",
               elapsed, double(s.operations) / elapsed, rss_start, resident_mib(), peak_mib());

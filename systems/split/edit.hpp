@@ -43,6 +43,8 @@ class EditHistory {
   // The newest command on the undo stack that drew a curve (a border or split kind); nullptr when none:
   // what "the curve drawn last" means to a command that has no cursor to pick with (the command pad).
   const EditCommand* last_drawn() const;
+  // The newest command on the undo stack; nullptr when none.
+  const EditCommand* last_applied() const { return undo_.empty() ? nullptr : &undo_.back().command; }
   // Forgets everything (needed after Mesh::compact, which cannot be undone).
   void clear(Mesh& mesh);
   // A snapshot of the history (engine/SESSION.md): each undoable command with its marks into the

@@ -48,7 +48,7 @@ TEST_CASE("random edits: incremental reconstruction equals a rebuild after every
     if (!edit) continue;
     const Status& r = *edit;
     applied += r.ok();
-    crossed += r.ok() && dice < 60 && history.last_drawn() && history.last_drawn()->kind == EditKind::CrossCurves;
+    crossed += r.ok() && dice < 60 && history.last_applied()->kind == EditKind::CrossCurves;
     INFO("step " << step << " (" << (r.ok() ? "applied" : r.error) << "), " << net.face_count() << " faces");
     REQUIRE(net.validate() == "");
 
