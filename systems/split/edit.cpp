@@ -55,6 +55,8 @@ Status check_continues_border(const Mesh& m, const EditCommand& c) {
 
 Status start_border(Mesh& m, const EditCommand& c) {
   if (m.border_in_progress()) return Status::failure("a border polygon is being drawn; close it before starting another part");
+  // A border is found by its vertices of one curve, as a pending chain's ends are.
+  if (!m.pending_chains().empty()) return Status::failure("a stroke in pieces is pending; finish it or undo it before starting another part");
   if (auto ok = check_points(c.points); !ok.ok()) return ok;
   if (c.points.front() == c.points.back()) return Status::failure("the first border curve ends where it starts");
   uint32_t a = m.add_vertex(c.points.front());
@@ -562,6 +564,7 @@ void remove_chain(Mesh& m, const std::vector<uint32_t>& chain) {
 Status toggle_sharp(Mesh& m, const EditCommand& c) {
   const uint32_t e = c.edge;
   if (!m.edge_alive(e)) return Status::failure("edge " + str(e) + " does not exist");
+  if (m.is_pending(e)) return Status::failure("edge " + str(e) + " is a piece of a stroke still pending, not a curve yet");
   if (m.is_border_edge(e))
     return Status::failure("edge " + str(e) + " is on the border polygon, which is always a crease; only curves inside it can be marked sharp");
   m.set_edge_flag(e, kSharpEdge, !(m.edges.flags[e] & kSharpEdge));

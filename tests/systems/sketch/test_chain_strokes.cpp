@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 
 #include "scripted_log.hpp"
+#include "systems/split/edit.hpp"
 
 using namespace fire;
 using fire::test::line;
@@ -91,4 +92,25 @@ TEST_CASE("a chain never finished stays, and a stroke that starts nowhere near i
   CHECK_THAT(w->rejections[0].reason, Catch::Matchers::Contains("from the free end of the pending stroke"));
   CHECK(w->mesh.same_pools(pending->mesh));
   CHECK(w->surface.level > 0);  // the network's surface is shown while the chain waits
+}
+
+TEST_CASE("a pending piece is no curve: delete and sharp refuse it in words, and no new part starts while it waits", "[sketch][chain][reject]") {
+  Log log = strips();
+  line(log, {0.03, 0, 0}, {0.03, 0.05, 0});
+  const auto pending = replay(log);
+  REQUIRE(pending_pieces(pending->mesh) == 1);
+  log.event("cmd delete 0.03 0.03 0");
+  log.event("cmd sharp 0.03 0.03 0");
+  const auto w = replay(log);
+  REQUIRE(w->rejections.size() == 2);
+  CHECK_THAT(w->rejections[0].reason, Catch::Matchers::Contains("still pending"));
+  CHECK_THAT(w->rejections[1].reason, Catch::Matchers::Contains("still pending"));
+  CHECK(w->mesh.same_pools(pending->mesh));
+  Mesh m = pending->mesh;
+  EditCommand part;
+  part.kind = EditKind::StartBorder;
+  part.points = {{1, 0, 0}, {1.1, 0, 0}};
+  const Status refused = execute_edit(m, part);
+  CHECK_THAT(refused.error, Catch::Matchers::Contains("a stroke in pieces is pending"));
+  CHECK(m.same_pools(pending->mesh));
 }
