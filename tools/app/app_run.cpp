@@ -452,6 +452,7 @@ int run_app(const AppOptions& a) {
   out["events"] = w.log.forgotten + w.log.events.size();
   out["edges"] = w.mesh.edge_count();
   out["faces"] = w.mesh.face_count();
+  out["border_loops"] = w.mesh.border_loop_count();
   out["surface_quads"] = w.surface.quad_count();
   out["hash"] = hex;
   if (live) {

@@ -36,7 +36,7 @@ void add_app_commands(CLI::App& app, Registry& registry) {
       "(10 ms of log time) as the wall clock advances; vsync paces the display. Edits made with keys are "
       "commands appended to the session's input log, so `fire replay` of the --session folder or of the "
       "--record log reproduces the session bit for bit. Needs a display (DISPLAY or WAYLAND_DISPLAY); without one it exits 1 and points "
-      "to `fire render`. On exit prints one JSON line: display_frames, system_frames, events, edges, faces, "
+      "to `fire render`. On exit prints one JSON line: display_frames, system_frames, events, edges, faces, border_loops, "
       "surface_quads, hash (as `fire replay --hash`), device, validation. FIRE_VK_VALIDATION=1 turns the "
       "validation layer on; any message then fails the command. While a stroke is drawn, the face it would split "
       "is tinted magenta and the point its end would snap to is marked cyan; on an open border, its first vertex "

@@ -358,6 +358,29 @@ TEST_CASE("fire app: with no reference, strokes draw on the view plane, then on 
   fs::remove_all(dir);
 }
 
+TEST_CASE("fire app: strokes across two curves each and O over a face that touches no border: a hole, replayed bit for bit",
+          "[app][window][sketch][topology]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("cross_and_hole");
+  const std::string record = (dir / "draw.log").string();
+  const Run app = run_app(190, "--size 960x720 --script " + quote(FIRE_WINDOW_TEST_DIR "/cross_and_hole.script") + " --record " + quote(record),
+                          dir);
+  INFO("xvfb-run exit: " << app.runner_exit << "\nstdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  const auto json = nlohmann::json::parse(app.out);
+  CHECK(json["faces"] == 8);         // a grid of 3 x 3 cells, the middle one a hole
+  CHECK(json["border_loops"] == 2);  // the square's and the hole's
+  CHECK(json["surface_quads"].get<int>() > 0);
+  const auto log = fire::read_text_file(record);
+  REQUIRE(log);
+  CHECK(log->find(" cmd hole ") != std::string::npos);
+  const Run replay = run(quote(FIRE_BINARY) + " replay " + quote(record) + " --hash", dir);
+  INFO(replay.err);
+  REQUIRE(replay.exit_code == 0);
+  CHECK(replay.out == json["hash"].get<std::string>() + "\n");
+  fs::remove_all(dir);
+}
+
 TEST_CASE("fire app: the whole pawn drawn with the mouse, one split undone, replays bit for bit and measures within 1 percent",
           "[app][window][sketch][whole-drawing]") {
   REQUIRE(has_xvfb());
