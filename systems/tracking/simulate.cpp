@@ -1048,7 +1048,31 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
       if (pick) break;
     }
     const auto strokes = std::count_if(plan.begin(), plan.end(), [](const Step& s) { return s.kind == Step::Stroke; });
-    if (!pick || (d.max_strokes > 0 && strokes >= d.max_strokes)) break;
+    if (d.max_strokes > 0 && strokes >= d.max_strokes) break;
+    if (!pick) {
+      // Nothing left it can draw: done when every curve is drawn, else it says which curve stopped it and why.
+      const auto first = std::find(curve_drawn.begin(), curve_drawn.end(), 0);
+      if (first == curve_drawn.end()) break;
+      const auto k = static_cast<uint32_t>(first - curve_drawn.begin());
+      auto reaches = [&](const Chain& c) { return std::any_of(c.begin(), c.end(), [&](const Leg& l) { return l.curve == k; }); };
+      bool reached = false, seen_whole = false;
+      for (const auto& [key, c] : candidates) {
+        if (!reaches(c)) continue;
+        reached = true;
+        for (int j = 0; j < d.turns; ++j) seen_whole = seen_whole || shown(j, c);
+      }
+      const std::string why =
+          !reached ? "no stroke of up to " + std::to_string(kMaxLegs) + " curves from what is drawn reaches it (it lies farther, or on another border "
+                                                                              "loop, part or handle: the simulated person draws one border and chains of up to " +
+                         std::to_string(kMaxLegs) + " curves inside it)"
+          : !seen_whole ? "both cameras see no stroke that would draw it whole in any pose (try another --tilt or --turns)"
+                        : "every stroke that would draw it runs between two points of one curve already drawn";
+      const Vec3& a = net.vertices[net.curves[k].a];
+      const size_t done = static_cast<size_t>(std::count(curve_drawn.begin(), curve_drawn.end(), 1));
+      return R::failure("the simulated person cannot draw curve " + std::to_string(k) + " (from (" + format_double(a.x()) + ", " +
+                        format_double(a.y()) + ", " + format_double(a.z()) + ")): " + why + "; " + std::to_string(done) + " of " +
+                        std::to_string(net.curves.size()) + " curves drawn");
+    }
     if (pick->first != pose) plan.push_back({Step::Register, pick->first, {}});
     pose = pick->first;
     plan.push_back({Step::Stroke, pose, chain_points(net, pick->second)});

@@ -552,7 +552,8 @@ void add_tracking_commands(CLI::App& app, Registry& registry) {
       "several curves makes a chord there, a later curve meant to end at that corner misses it and is rejected, and "
       "the curves that depend on it after it. "
       "Prints one JSON line: the session's report counts, strokes (border and split), undos, registrations, mark touches, "
-      "curves drawn of the network's total.");
+      "curves drawn of the network's total. When it cannot draw every curve (--max-strokes aside), it writes nothing and "
+      "exits 1, naming the first curve it could not draw and why.");
   dr->callback([drawing, &registry] { registry.exit_code = run_simulate_drawing(*drawing); });
 
   // calibrate

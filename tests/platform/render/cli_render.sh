@@ -85,9 +85,11 @@ expect_error "a bad size" "--size must be WIDTHxHEIGHT" "$tmp/s.png" "$fire" ren
 expect_error "a network that does not load" "missing.fnet" "$tmp/n.png" "$fire" render "$tmp/missing.fnet" -o "$tmp/n.png"
 
 # A log of Wii Remote reports (the demo's kind): drawn through the triangulation system with --rig, refused
-# without one. The simulated person draws the border of the pawn's --unrefine 4 network (24 curves made 18 edges).
+# without one. The simulated person draws the border of the pawn's --unrefine 4 network (24 curves made 18 edges)
+# and stops there (--max-strokes: it could draw no more of that network, and would say so with exit 1).
 "$fire" simulate wand -o "$tmp/wand.log" >/dev/null && "$fire" calibrate "$tmp/wand.log" -o "$tmp/rig.json" >/dev/null 2>&1 &&
-  "$fire" simulate drawing -o "$tmp/drawing.log" --marks-out "$tmp/marks.json" --object-out "$tmp/pawn.obj" --unrefine 4 >/dev/null
+  "$fire" simulate drawing -o "$tmp/drawing.log" --marks-out "$tmp/marks.json" --object-out "$tmp/pawn.obj" --unrefine 4 \
+    --max-strokes 18 >/dev/null
 check "a simulated rig and drawing" "[ -s '$tmp/rig.json' ] && [ -s '$tmp/drawing.log' ]"
 out=$("$fire" render "$tmp/drawing.log" --rig "$tmp/rig.json" -o "$tmp/tracked.png" --size 320x180 2>"$tmp/err"); rc=$?
 check "a log of reports rendered with --rig: its tracked border and the surface inside it" \
