@@ -119,6 +119,12 @@ bool Mesh::border_in_progress() const {
   return false;
 }
 
+size_t Mesh::pending_piece_count() const {
+  size_t n = 0;
+  for (uint32_t e = 0; e < edge_slots(); ++e) n += edge_alive(e) && is_pending(e);
+  return n;
+}
+
 std::vector<std::vector<uint32_t>> Mesh::pending_chains() const {
   std::vector<std::vector<uint32_t>> chains;
   for (uint32_t e = 0; e < edge_slots(); ++e) {

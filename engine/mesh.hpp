@@ -157,6 +157,8 @@ class Mesh {
   // The pending chains (kPendingEdge), each as its pieces in drawing order (edge i ends where i + 1 starts):
   // the first starts on the network where the chain began, the last ends at the chain's free end.
   std::vector<std::vector<uint32_t>> pending_chains() const;
+  // Pieces of pending chains (kPendingEdge), without walking them.
+  size_t pending_piece_count() const;
   // The oriented edge that walks border edge e as the hole beside it would: against its one face.
   uint32_t hole_side(uint32_t e) const { return make_oriented(e, edges.face[e][1] == kNone); }
   // The border loop through border edge e as the hole beside it walks it, starting with e; empty when e has

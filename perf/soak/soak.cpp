@@ -151,7 +151,7 @@ int main(int argc, char** argv) {
       const size_t loops = mesh.border_loop_count();
       closed += loops == 0;
       holed += loops > 1;
-      chained += !mesh.pending_chains().empty();
+      chained += mesh.pending_piece_count() > 0;
     }
     if (auto bad = mesh.validate(); !bad.empty()) return fail(op, "pools: " + bad);
     snap.sync(mesh);

@@ -56,7 +56,7 @@ Status check_continues_border(const Mesh& m, const EditCommand& c) {
 Status start_border(Mesh& m, const EditCommand& c) {
   if (m.border_in_progress()) return Status::failure("a border polygon is being drawn; close it before starting another part");
   // A border is found by its vertices of one curve, as a pending chain's ends are.
-  if (!m.pending_chains().empty()) return Status::failure("a stroke in pieces is pending; finish it or undo it before starting another part");
+  if (m.pending_piece_count() > 0) return Status::failure("a stroke in pieces is pending; finish it or undo it before starting another part");
   if (auto ok = check_points(c.points); !ok.ok()) return ok;
   if (c.points.front() == c.points.back()) return Status::failure("the first border curve ends where it starts");
   uint32_t a = m.add_vertex(c.points.front());

@@ -202,7 +202,7 @@ SnapshotCoverage reopen_from_each_snapshot(const WrittenSession& s, uint64_t exp
     c.pen_down += w.sketch.pen_down;
     c.pending += !w.sketch.pending.empty();
     c.redo += w.history.redo_depth() > 0;
-    c.chains += !w.mesh.pending_chains().empty();
+    c.chains += w.mesh.pending_piece_count() > 0;
     // Taken while a fit ran: the reopened session starts it over (engine/SESSION.md).
     c.provisional += !w.surface.settled;
 

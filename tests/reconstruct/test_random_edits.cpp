@@ -76,7 +76,7 @@ TEST_CASE("random edits: incremental reconstruction equals a rebuild after every
     }
     closed_steps += net.border_loop_count() == 0;
     holed_steps += net.border_loop_count() > 1;
-    chained_steps += !net.pending_chains().empty();
+    chained_steps += net.pending_piece_count() > 0;
     net.begin_frame(net.frame() + 1);
   }
   // The mix really edited the network, the topology too (closed by curves across the border's hole, opened

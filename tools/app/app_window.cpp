@@ -128,8 +128,7 @@ bool AppWindow::display(const render::Orbit& orbit, render::Image* capture) {
   hud_data.border_mode = w.mesh.face_count() == 0 || w.mesh.border_in_progress();
   hud_data.border_loops = w.mesh.border_loop_count();
   hud_data.pending_bridges = w.mesh.pending_bridge_count();
-  hud_data.pending_pieces = 0;
-  for (const std::vector<uint32_t>& chain : w.mesh.pending_chains()) hud_data.pending_pieces += chain.size();
+  hud_data.pending_pieces = w.mesh.pending_piece_count();
   hud_->build(hud_data);
   stages_.hud = ms_since(mark);
   auto shown = presenter_->frame(*renderer_, camera_, hud_data.view, [&](VkCommandBuffer cmd) { hud_->draw(cmd); },
