@@ -620,3 +620,18 @@ bool LimitCurves::sample_chain(std::span<const uint32_t> chain, std::vector<Vec3
 }
 
 }  // namespace fire
+
+namespace fire {
+
+Result<PolygonMesh> limit_mesh(const PolygonMeshView& control, int levels) {
+  Result<subdivide::SubdividedMesh> sub =
+      subdivide::subdivide({control.positions, control.face_offsets, control.face_vertices, {}}, levels);
+  if (!sub) return Result<PolygonMesh>::failure(std::string(control.source) + ": " + sub.error());
+  PolygonMesh out;
+  out.positions = std::move(sub->limit_positions);
+  out.face_vertices = std::move(sub->quads);
+  for (size_t f = 1; f <= out.face_vertices.size() / 4; ++f) out.face_offsets.push_back(static_cast<uint32_t>(4 * f));
+  return out;
+}
+
+}  // namespace fire

@@ -34,6 +34,10 @@ inline constexpr uint32_t kMinSamplesPerEdge = 8;
 // coarse that a merged region is not a disk. The result is compact and passes Mesh::validate().
 Result<Mesh> network_from_mesh(const PolygonMeshView& control, const UnrefineOptions& options);
 
+// The control mesh's Catmull-Clark limit surface as quads: the level-`levels` mesh with every vertex at its
+// limit position. What the simulated cameras see the object as.
+Result<PolygonMesh> limit_mesh(const PolygonMeshView& control, int levels);
+
 // The polyline of one chain of control vertices: each control edge contributes `samples_per_edge` points
 // spaced linearly from its first end (inclusive) to its second (exclusive), then the chain's last vertex.
 // Appends chain_size-1 times samples_per_edge plus one points to `out`.

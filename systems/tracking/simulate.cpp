@@ -2,15 +2,18 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <functional>
 #include <limits>
 #include <numbers>
+#include <numeric>
 #include <optional>
 #include <random>
 
 #include "engine/ir_report.hpp"
+#include "systems/tracking/drawing_plan.hpp"
 #include "systems/tracking/registration.hpp"
 #include "systems/tracking/rig_io.hpp"
 
@@ -729,14 +732,17 @@ namespace {
 struct Pose {
   Eigen::Matrix3d R;
   Vec3 t;
-  Triangles triangles;  // the control mesh, placed
+  Triangles triangles;  // the object's surface, placed
   Vec3 operator()(const Vec3& object) const { return R * object + t; }
 };
 
-// A light on the limit surface lies inside the control mesh wherever the surface is convex: the object hides
-// it only beyond this distance toward the camera.
+// A light on the limit surface lies within a millimetre of the object's faces (its limit surface, finely), on
+// either side: the object hides it only beyond this distance toward the camera.
 constexpr double kSurfaceClearance = 0.006;
 constexpr double kImageMargin = 16;  // pixels: a blob this close to the image's edge may leave it
+constexpr double kMarkSpacing = 0.02;  // metres between marks the person adds: registration needs them apart
+// How much further than --tilt the object leans where that tilt shows too little (into a vessel, under a base).
+constexpr std::array<double, 4> kFurtherTilt_deg{0, 35, 60, 80};
 
 bool hidden(const Pose& pose, const Vec3& light, const Vec3& centre) {
   const Vec3 u = (centre - light).normalized();
@@ -756,40 +762,11 @@ bool seen_by_both(const SimulatedRig& rig, const Pose& pose, const Vec3& object_
   return true;
 }
 
-// A stroke along network curves: each curve walked from a to b (forward) or back.
-struct Leg {
-  uint32_t curve;
-  bool forward;
-};
-using Chain = std::vector<Leg>;
-
-std::vector<Vec3> chain_points(const DrawingNetwork& net, const Chain& chain) {
-  std::vector<Vec3> out;
-  for (const Leg& leg : chain) {
-    const std::vector<Vec3>& p = net.curves[leg.curve].points;
-    const size_t skip = out.empty() ? 0 : 1;  // the joint is the previous leg's last point
-    if (leg.forward)
-      out.insert(out.end(), p.begin() + static_cast<std::ptrdiff_t>(skip), p.end());
-    else
-      out.insert(out.end(), p.rbegin() + static_cast<std::ptrdiff_t>(skip), p.rend());
-  }
-  return out;
-}
-
-uint32_t chain_start(const DrawingNetwork& net, const Chain& c) {
-  const DrawingCurve& k = net.curves[c.front().curve];
-  return c.front().forward ? k.a : k.b;
-}
-uint32_t chain_end(const DrawingNetwork& net, const Chain& c) {
-  const DrawingCurve& k = net.curves[c.back().curve];
-  return c.back().forward ? k.b : k.a;
-}
-
 // What the person does, in order.
 struct Step {
-  enum Kind { Register, Stroke, Undo } kind;
+  enum Kind { Register, Stroke, Undo, Hole } kind;
   int pose = 0;
-  std::vector<Vec3> points;  // Stroke: object frame
+  std::vector<Vec3> points;  // Stroke: object frame; Hole: the point touched
 };
 
 Status check_drawing(const DrawingOptions& d, const PolygonMeshView& object, const DrawingNetwork& net) {
@@ -816,46 +793,6 @@ Status check_drawing(const DrawingOptions& d, const PolygonMeshView& object, con
   return Status::success();
 }
 
-// The border as strokes, in cycle order starting at `first`: runs between the border's corners (vertices
-// where only two curves meet), each curve a stroke of its own when there are fewer than 3 corners.
-Result<std::vector<Chain>> border_strokes(const DrawingNetwork& net, const std::vector<std::vector<uint32_t>>& at) {
-  using R = Result<std::vector<Chain>>;
-  std::vector<uint32_t> border;
-  for (uint32_t k = 0; k < net.curves.size(); ++k)
-    if (net.curves[k].border) border.push_back(k);
-  if (border.size() < 2) return R::failure("the network has no border to draw first");
-  Chain cycle{{border[0], true}};
-  std::vector<char> used(net.curves.size(), 0);
-  used[border[0]] = 1;
-  for (;;) {
-    const uint32_t v = chain_end(net, cycle);
-    if (v == chain_start(net, cycle)) break;
-    std::optional<Leg> next;
-    for (uint32_t k : at[v])
-      if (net.curves[k].border && !used[k]) next = Leg{k, net.curves[k].a == v};
-    if (!next) return R::failure("the network's border is not one closed loop");
-    used[next->curve] = 1;
-    cycle.push_back(*next);
-  }
-  if (cycle.size() != border.size()) return R::failure("the network's border is more than one loop");
-  auto corner = [&](const Leg& leg) { return at[leg.forward ? net.curves[leg.curve].a : net.curves[leg.curve].b].size() == 2; };
-  const size_t corners = static_cast<size_t>(std::count_if(cycle.begin(), cycle.end(), corner));
-  // Start the cycle at a corner.
-  if (corners >= 3) std::rotate(cycle.begin(), std::find_if(cycle.begin(), cycle.end(), corner), cycle.end());
-  std::vector<Chain> strokes;
-  for (const Leg& leg : cycle) {
-    if (strokes.empty() || corners < 3 || corner(leg)) strokes.emplace_back();
-    strokes.back().push_back(leg);
-  }
-  return strokes;
-}
-
-Chain reversed(const DrawingNetwork&, const Chain& c) {
-  Chain r;
-  for (auto it = c.rbegin(); it != c.rend(); ++it) r.push_back({it->curve, !it->forward});
-  return r;
-}
-
 }  // namespace
 
 Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOptions& d, const PolygonMeshView& object,
@@ -879,214 +816,119 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
       triangles.push_back({object.positions[object.face_vertices[first]], object.positions[object.face_vertices[k]],
                            object.positions[object.face_vertices[k + 1]]});
   }
-  Eigen::Matrix3d standing;
-  standing << 1, 0, 0, 0, 0, -1, 0, 1, 0;
-  const Eigen::Matrix3d lean = Eigen::AngleAxisd(d.tilt_deg * std::numbers::pi / 180, Vec3::UnitX()).toRotationMatrix();
+  // The poses: standing, turned by 360/turns degrees about its up axis, leaning its top toward the cameras,
+  // its middle where they converge; and, where the object needs it (a closed one always), the same upside down
+  // (poses turns..2 turns-1), turned over about its x axis.
   std::vector<Pose> poses;
-  for (int j = 0; j < d.turns; ++j) {
-    const double turn = 2 * std::numbers::pi * j / d.turns;
-    Pose pose;
-    pose.R = lean * standing * Eigen::AngleAxisd(-turn, Vec3::UnitZ()).toRotationMatrix();
-    pose.t = Vec3(0, 0, o.target_distance_m) - pose.R * Vec3(0, 0, 0.5 * top);
-    for (const auto& tri : triangles) pose.triangles.push_back({pose(tri[0]), pose(tri[1]), pose(tri[2])});
-    poses.push_back(std::move(pose));
-  }
-
-  // Six marks among the network's vertices: around the object every 60 degrees, at a fifth and at half its height.
-  constexpr int kMarks = 6;
-  std::vector<uint32_t> mark_vertex;
-  for (int k = 0; k < kMarks; ++k) {
-    const double azimuth = 2 * k * std::numbers::pi / kMarks, height = (k % 2 ? 0.5 : 0.2) * top;
-    double best = std::numeric_limits<double>::infinity();
-    uint32_t pick = 0;
-    for (uint32_t v = 0; v < net.vertices.size(); ++v) {
-      const Vec3& p = net.vertices[v];
-      if (std::find(mark_vertex.begin(), mark_vertex.end(), v) != mark_vertex.end() || std::hypot(p.x(), p.y()) < 1e-6) continue;
-      double off = std::abs(std::remainder(std::atan2(p.x(), -p.y()) - azimuth, 2 * std::numbers::pi));
-      off += 3 * std::abs(p.z() - height) / top;
-      if (off < best) best = off, pick = v;
-    }
-    mark_vertex.push_back(pick);
-  }
-  std::vector<std::vector<uint32_t>> marks_seen(poses.size());
-  for (size_t j = 0; j < poses.size(); ++j)
-    for (uint32_t m = 0; m < mark_vertex.size(); ++m)
-      if (seen_by_both(*rig, poses[j], net.vertices[mark_vertex[m]])) marks_seen[j].push_back(m);
-
-  // Which curves each pose shows whole to both cameras (on a pose with at least 3 marks to register on).
-  std::vector<std::vector<char>> shows(poses.size(), std::vector<char>(net.curves.size(), 0));
-  for (size_t j = 0; j < poses.size(); ++j)
-    if (marks_seen[j].size() >= 3)
-      for (size_t k = 0; k < net.curves.size(); ++k)
-        shows[j][k] = std::all_of(net.curves[k].points.begin(), net.curves[k].points.end(),
-                                  [&](const Vec3& p) { return seen_by_both(*rig, poses[j], p); });
-  auto shown = [&](int pose, const Chain& c) {
-    return std::all_of(c.begin(), c.end(), [&](const Leg& l) { return shows[static_cast<size_t>(pose)][l.curve] != 0; });
-  };
-  // Poses nearest the current one first.
-  auto pose_order = [&](int current) {
-    std::vector<int> order{current};
-    for (int step = 1; step <= d.turns / 2; ++step)
-      for (int j : {(current + step) % d.turns, (current - step + d.turns) % d.turns})
-        if (std::find(order.begin(), order.end(), j) == order.end()) order.push_back(j);
-    return order;
-  };
-
-  std::vector<std::vector<uint32_t>> at(net.vertices.size());
-  for (uint32_t k = 0; k < net.curves.size(); ++k) {
-    at[net.curves[k].a].push_back(k);
-    at[net.curves[k].b].push_back(k);
-  }
-  Result<std::vector<Chain>> border = border_strokes(net, at);
-  if (!border) return R::failure(border.error());
-
-  // The border: the start and direction that need the fewest turns of the object.
-  std::vector<Step> plan;
-  {
-    std::optional<std::pair<size_t, std::vector<int>>> best;  // turns, pose per stroke
-    std::vector<Chain> best_strokes;
-    for (int dir = 0; dir < 2; ++dir)
-      for (size_t s = 0; s < border->size(); ++s) {
-        std::vector<Chain> strokes;
-        for (size_t k = 0; k < border->size(); ++k) {
-          const size_t i = dir == 0 ? (s + k) % border->size() : (s + border->size() - k) % border->size();
-          strokes.push_back(dir == 0 ? (*border)[i] : reversed(net, (*border)[i]));
-        }
-        std::vector<int> pose_of;
-        size_t changes = 0;
-        for (const Chain& c : strokes) {
-          std::optional<int> pick;
-          for (int j : pose_order(pose_of.empty() ? 0 : pose_of.back()))
-            if (shown(j, c)) {
-              pick = j;
-              break;
-            }
-          if (!pick) break;
-          if (!pose_of.empty() && *pick != pose_of.back()) ++changes;
-          pose_of.push_back(*pick);
-        }
-        if (pose_of.size() == strokes.size() && (!best || changes < best->first)) {
-          best.emplace(changes, pose_of);
-          best_strokes = strokes;
+  std::vector<Vec3> marks;
+  std::vector<std::vector<uint32_t>> marks_seen;
+  std::vector<std::vector<char>> shows;
+  std::vector<std::vector<std::vector<char>>> seen;
+  const bool closed = network_closed(net);
+  auto attempt = [&](int sides, int tilts) -> Result<DrawingPlan> {
+    Eigen::Matrix3d standing;
+    standing << 1, 0, 0, 0, 0, -1, 0, 1, 0;
+    const Eigen::Matrix3d over = Eigen::AngleAxisd(std::numbers::pi, Vec3::UnitX()).toRotationMatrix();
+    poses.clear();
+    for (int side = 0; side < sides; ++side)
+      for (int tilt = 0; tilt < tilts; ++tilt) {
+        const double lean_deg = d.tilt_deg + kFurtherTilt_deg[static_cast<size_t>(tilt)];
+        const Eigen::Matrix3d lean = Eigen::AngleAxisd(lean_deg * std::numbers::pi / 180, Vec3::UnitX()).toRotationMatrix();
+        for (int j = 0; j < d.turns; ++j) {
+          const double turn = 2 * std::numbers::pi * j / d.turns;
+          Pose pose;
+          pose.R = lean * standing * (side ? over : Eigen::Matrix3d::Identity()) * Eigen::AngleAxisd(-turn, Vec3::UnitZ()).toRotationMatrix();
+          pose.t = Vec3(0, 0, o.target_distance_m) - pose.R * Vec3(0, 0, 0.5 * top);
+          for (const auto& tri : triangles) pose.triangles.push_back({pose(tri[0]), pose(tri[1]), pose(tri[2])});
+          poses.push_back(std::move(pose));
         }
       }
-    if (!best) return R::failure("part of the network's border is seen whole by both cameras in no pose (try another --tilt or --turns)");
-    for (size_t k = 0; k < best_strokes.size(); ++k) {
-      if (k == 0 || best->second[k] != best->second[k - 1]) plan.push_back({Step::Register, best->second[k], {}});
-      plan.push_back({Step::Stroke, best->second[k], chain_points(net, best_strokes[k])});
-    }
-  }
 
-  // The splits: an ear decomposition. Every vertex on a drawn curve is drawn; stroke ends are the mesh's vertices.
-  std::vector<char> curve_drawn(net.curves.size(), 0), drawn(net.vertices.size(), 0), end_vertex(net.vertices.size(), 0);
-  for (const Chain& c : *border)
-    for (const Leg& l : c) {
-      curve_drawn[l.curve] = 1;
-      drawn[net.curves[l.curve].a] = drawn[net.curves[l.curve].b] = 1;
-    }
-  for (const Chain& c : *border) end_vertex[chain_start(net, c)] = 1;
-  // Whether a and b lie on one edge of the sketch's mesh (a chain of drawn curves between stroke ends): the
-  // faces on both sides of it would hold both ends of a stroke between them, and the sketch picks the wrong one
-  // as often as the right one.
-  auto same_edge = [&](uint32_t a, uint32_t b) {
-    std::vector<uint32_t> stack{a};
-    std::vector<char> seen(net.vertices.size(), 0);
-    seen[a] = 1;
-    while (!stack.empty()) {
-      const uint32_t v = stack.back();
-      stack.pop_back();
-      if (v == b) return true;
-      if (v != a && end_vertex[v]) continue;
-      for (uint32_t k : at[v]) {
-        if (!curve_drawn[k]) continue;
-        const uint32_t w = net.curves[k].a == v ? net.curves[k].b : net.curves[k].a;
-        if (!seen[w]) seen[w] = 1, stack.push_back(w);
+    // Six marks among the network's vertices: around the object every 60 degrees, at a fifth and at half its
+    // height; on a closed object at a third and two thirds, where it is seen both ways up and rests on neither.
+    constexpr int kMarks = 6;
+    const double low = closed ? 1.0 / 3 : 0.2, high = closed ? 2.0 / 3 : 0.5;
+    marks.clear();
+    for (int k = 0; k < kMarks; ++k) {
+      const double azimuth = 2 * k * std::numbers::pi / kMarks, height = (k % 2 ? high : low) * top;
+      double best = std::numeric_limits<double>::infinity();
+      const Vec3* pick = &net.vertices.front();
+      for (const Vec3& p : net.vertices) {
+        if (std::find(marks.begin(), marks.end(), p) != marks.end() || std::hypot(p.x(), p.y()) < 1e-6) continue;
+        double off = std::abs(std::remainder(std::atan2(p.x(), -p.y()) - azimuth, 2 * std::numbers::pi));
+        off += 3 * std::abs(p.z() - height) / top;
+        if (off < best) best = off, pick = &p;
       }
+      marks.push_back(*pick);
     }
-    return false;
-  };
-  auto length = [&](const Chain& c) {
-    double sum = 0;
-    for (const Leg& l : c) {
-      const auto& p = net.curves[l.curve].points;
-      for (size_t i = 1; i < p.size(); ++i) sum += (p[i] - p[i - 1]).norm();
-    }
-    return sum;
-  };
-  constexpr size_t kMaxLegs = 4;
-  int pose = plan.back().pose, splits = 0;
-  for (;;) {
-    std::vector<std::pair<double, Chain>> candidates;  // (legs * 1e6 + length: fewest legs, then shortest)
-    for (uint32_t a = 0; a < net.vertices.size(); ++a) {
-      if (!drawn[a]) continue;
-      std::vector<Chain> stack{{}};
-      while (!stack.empty()) {
-        Chain c = std::move(stack.back());
-        stack.pop_back();
-        const uint32_t v = c.empty() ? a : chain_end(net, c);
-        for (uint32_t k : at[v]) {
-          if (curve_drawn[k] || std::any_of(c.begin(), c.end(), [&](const Leg& l) { return l.curve == k; })) continue;
-          Chain next = c;
-          next.push_back({k, net.curves[k].a == v});
-          const uint32_t w = chain_end(net, next);
-          if (drawn[w]) {
-            if (w != a) candidates.emplace_back(double(next.size()) * 1e6 + length(next), std::move(next));
-          } else if (next.size() < kMaxLegs) {
-            stack.push_back(std::move(next));
+    // A pose that sees fewer than 3 of them gets more, on its curves where both cameras see them and away from
+    // where the object rests in it (its base, or its top upside down), each as far as can be from the marks it
+    // sees already.
+    auto marks_in = [&](size_t pose) {
+      std::vector<uint32_t> out;
+      for (uint32_t m = 0; m < marks.size(); ++m)
+        if (seen_by_both(*rig, poses[pose], marks[m])) out.push_back(m);
+      return out;
+    };
+    for (size_t j = 0; j < poses.size(); ++j) {
+      const bool upside_down = sides == 2 && j >= poses.size() / 2;
+      for (std::vector<uint32_t> now = marks_in(j); now.size() < 3; now = marks_in(j)) {
+        double best = kMarkSpacing;
+        std::optional<Vec3> pick;
+        for (const DrawingCurve& c : net.curves)
+          for (const Vec3& p : c.points) {
+            if (upside_down ? p.z() > 0.9 * top : p.z() < 0.1 * top) continue;
+            double spread = std::numeric_limits<double>::infinity();
+            for (const Vec3& m : marks) spread = std::min(spread, (p - m).norm());
+            if (spread > best && seen_by_both(*rig, poses[j], p)) best = spread, pick = p;
           }
-        }
+        if (!pick) break;
+        marks.push_back(*pick);
       }
     }
-    std::stable_sort(candidates.begin(), candidates.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-    std::optional<std::pair<int, Chain>> pick;
-    for (int j : pose_order(pose)) {
-      for (const auto& [key, c] : candidates)
-        if (shown(j, c) && !same_edge(chain_start(net, c), chain_end(net, c))) {
-          pick.emplace(j, c);
-          break;
-        }
-      if (pick) break;
-    }
-    const auto strokes = std::count_if(plan.begin(), plan.end(), [](const Step& s) { return s.kind == Step::Stroke; });
-    if (d.max_strokes > 0 && strokes >= d.max_strokes) break;
-    if (!pick) {
-      // Nothing left it can draw: done when every curve is drawn, else it says which curve stopped it and why.
-      const auto first = std::find(curve_drawn.begin(), curve_drawn.end(), 0);
-      if (first == curve_drawn.end()) break;
-      const auto k = static_cast<uint32_t>(first - curve_drawn.begin());
-      auto reaches = [&](const Chain& c) { return std::any_of(c.begin(), c.end(), [&](const Leg& l) { return l.curve == k; }); };
-      bool reached = false, seen_whole = false;
-      for (const auto& [key, c] : candidates) {
-        if (!reaches(c)) continue;
-        reached = true;
-        for (int j = 0; j < d.turns; ++j) seen_whole = seen_whole || shown(j, c);
+    marks_seen.assign(poses.size(), {});
+    for (size_t j = 0; j < poses.size(); ++j) marks_seen[j] = marks_in(j);
+
+    // Which points of each curve both cameras see in each pose (on a pose with at least 3 marks to register on).
+    seen.assign(poses.size(), std::vector<std::vector<char>>(net.curves.size()));
+    shows.assign(poses.size(), std::vector<char>(net.curves.size(), 0));
+    for (size_t j = 0; j < poses.size(); ++j)
+      for (size_t k = 0; k < net.curves.size(); ++k) {
+        seen[j][k].assign(net.curves[k].points.size(), 0);
+        if (marks_seen[j].size() >= 3)
+          for (size_t i = 0; i < net.curves[k].points.size(); ++i) seen[j][k][i] = seen_by_both(*rig, poses[j], net.curves[k].points[i]);
+        shows[j][k] = std::all_of(seen[j][k].begin(), seen[j][k].end(), [](char c) { return c != 0; });
       }
-      const std::string why =
-          !reached ? "no stroke of up to " + std::to_string(kMaxLegs) + " curves from what is drawn reaches it (it lies farther, or on another border "
-                                                                              "loop, part or handle: the simulated person draws one border and chains of up to " +
-                         std::to_string(kMaxLegs) + " curves inside it)"
-          : !seen_whole ? "both cameras see no stroke that would draw it whole in any pose (try another --tilt or --turns)"
-                        : "every stroke that would draw it runs between two points of one curve already drawn";
-      const Vec3& a = net.vertices[net.curves[k].a];
-      const size_t done = static_cast<size_t>(std::count(curve_drawn.begin(), curve_drawn.end(), 1));
-      return R::failure("the simulated person cannot draw curve " + std::to_string(k) + " (from (" + format_double(a.x()) + ", " +
-                        format_double(a.y()) + ", " + format_double(a.z()) + ")): " + why + "; " + std::to_string(done) + " of " +
-                        std::to_string(net.curves.size()) + " curves drawn");
-    }
-    if (pick->first != pose) plan.push_back({Step::Register, pick->first, {}});
-    pose = pick->first;
-    plan.push_back({Step::Stroke, pose, chain_points(net, pick->second)});
-    for (const Leg& l : pick->second) {
-      curve_drawn[l.curve] = 1;
-      drawn[net.curves[l.curve].a] = drawn[net.curves[l.curve].b] = 1;
-    }
-    end_vertex[chain_start(net, pick->second)] = end_vertex[chain_end(net, pick->second)] = 1;
-    if (++splits == d.undo_after) {
-      Step again = plan.back();
-      plan.push_back({Step::Undo, pose, {}});
-      plan.push_back(std::move(again));
-    }
-  }
+    PoseQuestions questions;
+    // Poses nearest the current one first: the same way up and lean, then the other lean, then turned over.
+    questions.order = [&](int current) {
+      const int side = current / (tilts * d.turns), tilt = current / d.turns % tilts, turn = current % d.turns;
+      std::vector<int> order;
+      for (int s : {side, 1 - side}) {
+        if (s >= sides) continue;
+        std::vector<int> by_lean(static_cast<size_t>(tilts));
+        std::iota(by_lean.begin(), by_lean.end(), 0);
+        std::stable_sort(by_lean.begin(), by_lean.end(), [&](int x, int y) { return std::abs(x - tilt) < std::abs(y - tilt); });
+        for (int t : by_lean) {
+          const int base = (s * tilts + t) * d.turns;
+          order.push_back(base + turn);
+          for (int step = 1; step <= d.turns / 2; ++step)
+            for (int j : {(turn + step) % d.turns, (turn - step + d.turns) % d.turns})
+              if (std::find(order.begin(), order.end(), base + j) == order.end()) order.push_back(base + j);
+        }
+      }
+      return order;
+    };
+    questions.sees = [&](int pose, uint32_t curve, size_t point) { return seen[static_cast<size_t>(pose)][curve][point] != 0; };
+    return plan_drawing(net, questions, d.max_strokes, d.undo_after);
+  };
+  // Upside down, and leaning further, only where the object needs it.
+  Result<DrawingPlan> planned = attempt(closed ? 2 : 1, 1);
+  if (!planned && !closed) planned = attempt(2, 1);
+  if (!planned) planned = attempt(2, static_cast<int>(kFurtherTilt_deg.size()));
+  if (!planned) return R::failure(planned.error());
+  std::vector<Step> plan;
+  for (const PlanStep& s : planned->steps) plan.push_back({static_cast<Step::Kind>(s.kind), s.pose, s.points});
 
   // The timeline: where the pen is, lit or not, and when each command is logged.
   constexpr double kAccel = 2.0;     // m/s^2, a hand drawing with care
@@ -1099,7 +941,7 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
   std::vector<std::pair<double, int>> pose_from{{0.0, plan.front().pose}};
   DrawingStats stats;
   stats.curves_total = net.curves.size();
-  stats.curves_drawn = static_cast<size_t>(std::count(curve_drawn.begin(), curve_drawn.end(), 1));
+  stats.curves_drawn = planned->curves_drawn;
   double t = 0.5;
   Vec3 pen = poses[static_cast<size_t>(plan.front().pose)].t;
   auto command = [&](double at, CommandKind kind, uint32_t mark = 0, const Vec3& p = Vec3::Zero()) {
@@ -1131,7 +973,7 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
         }
         first = false;
         for (uint32_t m : marks_seen[static_cast<size_t>(step.pose)]) {
-          const Vec3& mark = net.vertices[mark_vertex[m]];
+          const Vec3& mark = marks[m];
           travel_to(placed(mark), kTravel_s);
           hold(d.mark_hold_s);
           command(t - 0.2, CommandKind::Mark, m, mark);
@@ -1161,9 +1003,21 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
         command(t, CommandKind::Undo);
         ++stats.undos;
         break;
+      case Step::Hole:
+        // The pen touches the face, unlit, and the pad's hole button is pressed.
+        travel_to(placed(step.points.front()), kTravel_s);
+        hold(d.mark_hold_s);
+        command(t - 0.2, CommandKind::Hole, 0, step.points.front());
+        ++stats.holes;
+        break;
     }
   }
-  stats.border_strokes = static_cast<int>(border->size());
+  std::vector<int> used;
+  for (const Step& step : plan) used.push_back(step.pose);
+  std::sort(used.begin(), used.end());
+  stats.poses = static_cast<int>(std::unique(used.begin(), used.end()) - used.begin());
+  stats.border_strokes = planned->border_strokes;
+  stats.pieces = planned->pieces;
   stats.split_strokes = stats.strokes - stats.border_strokes;
   const double duration = t + 1.0;
   if (duration > 3600) return R::failure("the drawing would last more than an hour (" + std::to_string(duration) + " s)");
@@ -1185,7 +1039,7 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
   SimulatedDrawing out;
   out.session = run_session(o, kDrawingScenario, *rig, duration, scene, occluded, std::move(header), commands);
   out.session.stats.strokes = stats.strokes;
-  for (uint32_t v : mark_vertex) out.marks.push_back(net.vertices[v]);
+  out.marks = marks;
   out.drawing = stats;
   return out;
 }
@@ -1399,11 +1253,18 @@ Result<RigErrors> compare_rig(const CalibrationResult& rig, const SessionTruth& 
 
 DrawingNetwork drawing_network(const Mesh& m) {
   DrawingNetwork net;
+  std::vector<uint32_t> curve_of(m.edge_slots(), 0);
   for (uint32_t v = 0; v < m.vertex_slots(); ++v) net.vertices.push_back(m.vertices.position[v]);
   for (uint32_t e = 0; e < m.edge_slots(); ++e) {
     if (!m.edge_alive(e)) continue;
     const std::span<const Vec3> points = m.polyline(e);
+    curve_of[e] = static_cast<uint32_t>(net.curves.size());
     net.curves.push_back({m.edges.vertex[e][0], m.edges.vertex[e][1], {points.begin(), points.end()}, m.is_border_edge(e)});
+  }
+  for (uint32_t f = 0; f < m.face_slots(); ++f) {
+    if (!m.face_alive(f)) continue;
+    Chain& loop = net.faces.emplace_back();
+    for (uint32_t oe : m.face_loop(f)) loop.push_back({curve_of[edge_of(oe)], !is_reversed(oe)});
   }
   return net;
 }

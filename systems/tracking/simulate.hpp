@@ -106,9 +106,16 @@ struct DrawingCurve {
   std::vector<Vec3> points;
   bool border = false;
 };
+// A walk along network curves: each curve walked from a to b (forward) or back.
+struct Leg {
+  uint32_t curve;
+  bool forward;
+};
+using Chain = std::vector<Leg>;
 struct DrawingNetwork {
   std::vector<Vec3> vertices;
   std::vector<DrawingCurve> curves;
+  std::vector<Chain> faces;  // each face's boundary, in loop order
 };
 
 struct DrawingStats {
@@ -116,7 +123,10 @@ struct DrawingStats {
   int border_strokes = 0;
   int split_strokes = 0;
   int undos = 0;
-  int registrations = 0;    // one per pose the object was drawn in
+  int registrations = 0;    // one each time the object is put in a pose
+  int poses = 0;            // how many different poses it was drawn in
+  int holes = 0;            // faces opened with cmd hole
+  int pieces = 0;           // strokes that end off the network: a curve drawn in pieces, turning the object between
   int mark_touches = 0;
   size_t curves_drawn = 0;  // of the network's curves
   size_t curves_total = 0;
@@ -128,17 +138,23 @@ struct SimulatedDrawing {
   DrawingStats drawing;
 };
 
+// How finely simulate_drawing's `object` follows the limit surface: 1 level keeps it within a millimetre of
+// the surface on the reference meshes, well inside the clearance a lit pen tip keeps from what hides it.
+inline constexpr int kOccluderLevels = 1;
+
 // The object's own frame: `positions` scaled to `height_m` along +z, the centre of its base at the origin.
 Result<std::vector<Vec3>> object_frame(std::span<const Vec3> positions, double height_m);
 
-// `object` (control mesh, object frame, metres) placed before the rig in one of `turns` poses at a time.
-// Six marks are picked among the network's vertices, spread around the object at two heights. The person
-// touches the marks visible in the first pose (a `cmd mark` each, then `cmd register`), draws the border
-// stroke by stroke, then splitting curves, each a chain of the network's curves between two points already
-// drawn whose inner vertices are new (an ear decomposition, shortest chains first), in a face of its own; when
-// no stroke left is seen whole by both cameras in the current pose, the object is turned to the pose that
-// sees one and registered again on the marks visible there. One split stroke is undone and drawn again. The
-// LED sits at the pen's tip, on the limit surface, where the network's points are.
+// `object` (its surface, object frame, metres: the control mesh's limit surface, limit_mesh() at
+// kOccluderLevels, which is what hides the pen from a camera) placed before the rig in one of `turns` poses at
+// a time, and, where it needs them, upside down and leaning further. Six marks are picked among the network's
+// vertices, spread around the object at two heights, and more where a pose sees fewer than 3. The person
+// touches the marks visible in the first pose (a `cmd mark` each, then `cmd register`), draws each part's first
+// border loop stroke by stroke, then splitting curves, opening holes and drawing across the far side as
+// drawing_plan.hpp lays out; when no stroke left is seen whole by both cameras in the current pose, the object
+// is turned to the pose that sees one and registered again on the marks visible there, and a chain no pose
+// sees whole is drawn in pieces. One split stroke is undone and drawn again. The LED sits at the pen's tip, on
+// the limit surface, where the network's points are.
 Result<SimulatedDrawing> simulate_drawing(const RigOptions& rig, const DrawingOptions& drawing, const PolygonMeshView& object,
                                           const DrawingNetwork& network);
 // The network to draw from a curve network (the object's K-unrefined one on its limit surface, systems/synth).

@@ -105,8 +105,9 @@ Result<std::unique_ptr<FakeDrawingRig>> FakeDrawingRig::create(uint64_t seed, in
   if (!network) return R::failure("--fake-rig: " + network.error());
   tracking::RigOptions rig;
   rig.seed = rig.rig_seed = seed;
-  auto drawing = tracking::simulate_drawing(rig, options, {*placed, pawn->face_offsets, pawn->face_vertices},
-                                            tracking::drawing_network(*network));
+  auto surface = limit_mesh({*placed, pawn->face_offsets, pawn->face_vertices, FIRE_DEFAULT_MESH}, tracking::kOccluderLevels);
+  if (!surface) return R::failure("--fake-rig: " + surface.error());
+  auto drawing = tracking::simulate_drawing(rig, options, surface->view(), tracking::drawing_network(*network));
   if (!drawing) return R::failure("--fake-rig: " + drawing.error());
   auto rig_json = tracking::true_rig_json(rig);
   if (!rig_json) return R::failure("--fake-rig: " + rig_json.error());

@@ -194,7 +194,9 @@ int run_simulate_drawing(const SimulateArgs& a) {
   if (!network) return fail(command, network.error());
   DrawingOptions options = a.drawing;
   options.mesh_name = a.mesh_path.substr(a.mesh_path.find_last_of('/') + 1);
-  Result<SimulatedDrawing> drawing = simulate_drawing(a.rig, options, control, drawing_network(*network));
+  Result<PolygonMesh> surface = limit_mesh(control, kOccluderLevels);
+  if (!surface) return fail(command, surface.error());
+  Result<SimulatedDrawing> drawing = simulate_drawing(a.rig, options, surface->view(), drawing_network(*network));
   if (!drawing) return fail(command, a.mesh_path + ": " + drawing.error());
 
   const std::string marks = marks_to_json(drawing->marks);
@@ -211,6 +213,9 @@ int run_simulate_drawing(const SimulateArgs& a) {
   out["split_strokes"] = st.split_strokes;
   out["undos"] = st.undos;
   out["registrations"] = st.registrations;
+  out["poses"] = st.poses;
+  out["pieces"] = st.pieces;
+  out["holes"] = st.holes;
   out["mark_touches"] = st.mark_touches;
   out["curves_drawn"] = st.curves_drawn;
   out["curves_total"] = st.curves_total;
@@ -541,18 +546,24 @@ void add_tracking_commands(CLI::App& app, Registry& registry) {
   dr->add_option("--max-strokes", drawing->drawing.max_strokes, "stop after this many strokes, the border always whole (0: the whole network)")
       ->capture_default_str();
   dr->footer(
-      "The object stands before the rig, its middle where the cameras converge (--distance). Six marks are network vertices "
-      "around it at a fifth and half its height. The person touches the marks both cameras see (the pen resting on each, "
-      "cmd mark N X Y Z logged), logs cmd register, draws the border corner to corner, then splitting curves: chains of the "
-      "network's curves between points already drawn, shortest first, each inside one face (an ear decomposition), the "
-      "pen lifted between strokes. When no stroke left is seen whole by both cameras, the object is turned to a pose that "
-      "shows one and registered again on the marks seen there. The pen's LED is at its tip, on the limit surface. "
+      "The object stands before the rig, its middle where the cameras converge (--distance), and is turned, leaned "
+      "further and set upside down only as far as it needs to be (a closed object always goes upside down). Six marks are "
+      "network vertices around it at a fifth and half its height (a third and two thirds on a closed object), and more "
+      "on its curves where a pose sees fewer than 3. The person touches the marks both cameras see (the pen resting on "
+      "each, cmd mark N X Y Z logged), logs cmd register, and draws each part's first border loop (the lowest border, "
+      "or on a closed object a loop round its top faces or a handle), then splitting curves: chains of the network's "
+      "curves between points already drawn, shortest first, each inside one face (an ear decomposition). The other "
+      "border loops and a handle's ends are drawn round and opened with cmd hole; a handle and a closed object's "
+      "top are drawn last, across the hole, from loop to loop. When no stroke left is seen whole by both cameras, the "
+      "object is turned to a pose that shows one and registered again on the marks seen there; a chain no pose shows "
+      "whole is drawn in pieces, turning the object between them. The pen's LED is at its tip, on the limit surface, "
+      "which is what hides it from a camera. "
       "The stray reflection (--stray) as in every session. Hand occlusions (--occlusion) are off by default: while one "
       "camera follows the pen the tracker emits no samples, so a hand passing a corner of a stroke that runs along "
       "several curves makes a chord there, a later curve meant to end at that corner misses it and is rejected, and "
       "the curves that depend on it after it. "
-      "Prints one JSON line: the session's report counts, strokes (border and split), undos, registrations, mark touches, "
-      "curves drawn of the network's total. When it cannot draw every curve (--max-strokes aside), it writes nothing and "
+      "Prints one JSON line: the session's report counts, strokes (border and split), undos, registrations, poses, "
+      "pieces, holes, mark touches, curves drawn of the network's total. When it cannot draw every curve (--max-strokes aside), it writes nothing and "
       "exits 1, naming the first curve it could not draw and why.");
   dr->callback([drawing, &registry] { registry.exit_code = run_simulate_drawing(*drawing); });
 
