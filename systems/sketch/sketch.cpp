@@ -221,29 +221,6 @@ std::vector<FaceRun> face_runs(const std::vector<Vec3>& stroke, FaceBySide& face
   return runs;
 }
 
-// Of the faces that hold both ends of a stroke, the one most of its told samples are over; `nearest` (the
-// face whose curves pass closest to its ends) where there is one face, or the samples favour none of them.
-Snap face_run_over(const Mesh& m, const SnapIndex& index, const std::vector<Vec3>& stroke, double limit, const Snap& nearest) {
-  const std::vector<Snap> all = snaps_to_faces(m, index, stroke.front(), stroke.back(), limit);
-  if (all.size() < 2) return nearest;
-  FaceBySide face_of(m, index, limit);
-  std::vector<size_t> over(all.size(), 0);
-  for (const Vec3& p : stroke) {
-    const uint32_t f = face_of(p);
-    for (size_t i = 0; i < all.size(); ++i) over[i] += all[i].face == f;
-  }
-  const size_t most = static_cast<size_t>(std::max_element(over.begin(), over.end()) - over.begin());
-  const size_t at_nearest = static_cast<size_t>(std::find_if(all.begin(), all.end(), [&](const Snap& s) { return s.face == nearest.face; }) - all.begin());
-  return over[most] > over[at_nearest] ? all[most] : nearest;
-}
-
-// Whether every sample of a stroke told to be over a face is off the surface (and some are told).
-bool off_the_surface(const Mesh& m, const SnapIndex& index, const std::vector<Vec3>& stroke, double radius) {
-  FaceBySide face_of(m, index, radius);
-  const std::vector<FaceRun> runs = face_runs(stroke, face_of);
-  return !runs.empty() && std::all_of(runs.begin(), runs.end(), [](const FaceRun& r) { return r.face == kNone; });
-}
-
 // Whether faces a and b share a corner (and so maybe a curve).
 bool faces_touch(const Mesh& m, uint32_t a, uint32_t b) {
   const std::span<const uint32_t> la = m.face_loop(a), lb = m.face_loop(b);
@@ -361,14 +338,6 @@ std::optional<EditCommand> plan_crossing(const Mesh& m, const SnapIndex& index, 
 }  // namespace
 
 Snap snap_to_face(const Mesh& m, const SnapIndex& index, const Vec3& start, const Vec3& end, double limit) {
-  const std::vector<Snap> all = snaps_to_faces(m, index, start, end, limit);
-  Snap best;
-  for (const Snap& s : all)
-    if (best.face == kNone || s.start_distance + s.end_distance < best.start_distance + best.end_distance) best = s;
-  return best;
-}
-
-std::vector<Snap> snaps_to_faces(const Mesh& m, const SnapIndex& index, const Vec3& start, const Vec3& end, double limit) {
   // Only faces with a boundary point within `limit` of both ends can be chosen: those of the edges near both.
   std::vector<SnapHit> near_start, near_end;
   index.nearest_per_edge(start, limit, near_start);
@@ -386,13 +355,19 @@ std::vector<Snap> snaps_to_faces(const Mesh& m, const SnapIndex& index, const Ve
   std::vector<uint32_t> candidates;
   std::set_intersection(a_faces.begin(), a_faces.end(), b_faces.begin(), b_faces.end(), std::back_inserter(candidates));
 
-  std::vector<Snap> out;
+  Snap best;
+  double best_cost = std::numeric_limits<double>::infinity();
   for (uint32_t f : candidates) {
     if (!m.face_alive(f)) continue;
     const SnapHit a = index.nearest_on_face(m, f, start, limit), b = index.nearest_on_face(m, f, end, limit);
-    if (a.found() && b.found()) out.push_back({f, {a.edge, a.point}, {b.edge, b.point}, a.distance, b.distance});
+    if (!a.found() || !b.found()) continue;
+    const double cost = a.distance + b.distance;
+    if (cost < best_cost) {
+      best_cost = cost;
+      best = {f, {a.edge, a.point}, {b.edge, b.point}, a.distance, b.distance};
+    }
   }
-  return out;
+  return best;
 }
 
 uint32_t pick_edge(const SnapIndex& index, const Vec3& p, double limit) { return index.nearest(p, limit).edge; }
@@ -582,12 +557,7 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           // A face holding both ends takes the stroke, as the thesis's sketch model has it. Else the stroke may run
           // over several faces, cross a border loop's hole (the far side of the surface), or, far from every
           // curve, start a new part.
-          Snap s = snap_to_face(mesh, snap, r.command.points.front(), r.command.points.back(), both_snap);
-          // Of several faces that hold both ends, the one the stroke runs over.
-          if (s.face != kNone && settings.topology_strokes) s = face_run_over(mesh, snap, r.command.points, both_snap, s);
-          // Not when the stroke runs off the surface all the way (a handle's far side, between two border loops
-          // that one face also reaches): the face's curves only hold its ends.
-          if (s.face != kNone && settings.topology_strokes && off_the_surface(mesh, snap, r.command.points, both_snap)) s = Snap{};
+          const Snap s = snap_to_face(mesh, snap, r.command.points.front(), r.command.points.back(), both_snap);
           // A stroke over several faces is cut where it crosses curves.
           if (s.face == kNone && settings.topology_strokes) {
             std::string refusal;

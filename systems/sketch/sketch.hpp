@@ -58,8 +58,6 @@ struct Snap {
 // The face whose boundary passes closest to both points (sum of distances), each within `limit`; on equal
 // sums the lowest face slot, and on each boundary the point first in loop order. `index` is in step with `mesh`.
 Snap snap_to_face(const Mesh& mesh, const SnapIndex& index, const Vec3& start, const Vec3& end, double limit);
-// Every face whose boundary passes within `limit` of both points, each with its nearest points, by slot.
-std::vector<Snap> snaps_to_faces(const Mesh& mesh, const SnapIndex& index, const Vec3& start, const Vec3& end, double limit);
 // The live edge with a polyline point nearest to p within `limit` (the lowest slot on ties), or kNone.
 uint32_t pick_edge(const SnapIndex& index, const Vec3& p, double limit);
 

@@ -583,8 +583,8 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
   // else the cells that get surface (none for a bridge that waits).
   auto across = [&](const Chain& c) -> std::optional<std::vector<uint32_t>> {
     const uint32_t a = chain_start(net, c), b = chain_end(net, c);
-    // A face may hold both ends: the stroke runs off the surface, so the sketch does not take it for that face's.
-    if (drawing.loop[a] == kNoLoop || drawing.loop[b] == kNoLoop) return std::nullopt;
+    // No face may hold both ends: the sketch would take the stroke for that face's split.
+    if (drawing.loop[a] == kNoLoop || drawing.loop[b] == kNoLoop || drawing.faces_holding(a, b) != 0) return std::nullopt;
     const std::vector<char> none(net.curves.size(), 0);
     std::vector<char> cut(net.curves.size(), 0);
     for (const Leg& l : c) cut[l.curve] = 1;
@@ -717,23 +717,22 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
       bool bridge;  // waits for a second one between the same two loops
     };
     // Whether the sketch would take chain c as planned, and what it does to the far side.
-    // Relaxed: where other faces hold both ends too, the sketch takes the face the stroke runs over.
-    auto takes = [&](const Chain& c, bool relaxed) -> std::optional<std::pair<std::vector<uint32_t>, bool>> {
+    auto takes = [&](const Chain& c) -> std::optional<std::pair<std::vector<uint32_t>, bool>> {
       const uint32_t a = chain_start(net, c), b = chain_end(net, c);
       if (drawing.surface[g.beside[c[0].curve][0]]) {
-        if (!relaxed && (same_edge(a, b) || drawing.faces_holding(a, b) != 1)) return std::nullopt;
+        if (same_edge(a, b) || drawing.faces_holding(a, b) != 1) return std::nullopt;
         return std::pair{std::vector<uint32_t>{}, false};
       }
       std::optional<std::vector<uint32_t>> surfaced = across(c);
       if (!surfaced) return std::nullopt;
       return std::pair{*surfaced, surfaced->empty()};
     };
-    auto choose = [&](const std::vector<std::pair<double, Chain>>& candidates, bool relaxed) {
+    auto choose = [&](const std::vector<std::pair<double, Chain>>& candidates) {
     std::optional<Pick> pick;
     for (int j : poses.order(pose)) {
       for (const auto& [key, c] : candidates) {
         if (!shown(j, c)) continue;
-        const auto took = takes(c, relaxed);
+        const auto took = takes(c);
         if (!took) continue;
         const std::vector<Vec3> points = chain_points(net, c);
         pick.emplace(Pick{c, {{j, 0, points.size() - 1}}, took->first, took->second});
@@ -744,7 +743,7 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
     // A chain no pose shows whole is drawn in pieces, the object turned between them.
     for (size_t i = 0; i < candidates.size() && !pick; ++i) {
       const Chain& c = candidates[i].second;
-      const auto took = takes(c, relaxed);
+      const auto took = takes(c);
       if (!took) continue;
       std::optional<std::vector<Piece>> pieces = in_pieces(c, pose, drawing.curve);
       if (pieces) pick.emplace(Pick{c, std::move(*pieces), took->first, took->second});
@@ -753,13 +752,11 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
     };
     // Longer chains only where the short ones all end on one curve drawn, or cannot be seen.
     std::vector<std::pair<double, Chain>> candidates = chains(kMaxLegs);
-    std::optional<Pick> pick = choose(candidates, false);
+    std::optional<Pick> pick = choose(candidates);
     if (!pick) {
       candidates = chains(kMaxLegsStuck);
-      pick = choose(candidates, false);
+      pick = choose(candidates);
     }
-    // Only where nothing else is left: a stroke whose ends several faces hold.
-    if (!pick) pick = choose(candidates, true);
     const auto strokes = std::count_if(steps.begin(), steps.end(), [](const PlanStep& s) { return s.kind == PlanStep::Stroke; });
     if (max_strokes > 0 && strokes >= max_strokes) break;
     if (!pick && next_part < parts->size()) {
