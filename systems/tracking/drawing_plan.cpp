@@ -34,6 +34,9 @@ constexpr uint32_t kNoLoop = ~0u;
 constexpr size_t kMaxLegs = 4;
 constexpr size_t kMaxLegsStuck = 8;
 constexpr size_t kMaxPieces = 4;
+// A tracked stroke shorter than this is taken for a touch of the pen, or loses its middle to the pauses at its
+// ends (metres: the sketch's 3 mm at each end, and 2 mm to draw).
+constexpr double kShortestStroke = 0.005;
 constexpr size_t kPieceMargin = 2;  // points
 // How far a piece's free end stays from every curve drawn (metres): twice the sketch's snap distance, so the
 // tracked end is not taken for one on the network.
@@ -700,7 +703,8 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
           next.push_back({k, net.curves[k].a == v});
           const uint32_t w = chain_end(net, next);
           if (drawing.vertex[w]) {
-            if (w != a) candidates.emplace_back(double(next.size()) * 1e6 + chain_length(net, next), std::move(next));
+            const double length = chain_length(net, next);
+            if (w != a && length >= kShortestStroke) candidates.emplace_back(double(next.size()) * 1e6 + length, std::move(next));
           } else if (next.size() < max_legs) {
             stack.push_back(std::move(next));
           }
@@ -788,7 +792,11 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
         for (int j : poses.order(0)) seen_whole = seen_whole || shown(j, c);
       }
       const std::string why =
-          !reached ? "no stroke of up to " + std::to_string(kMaxLegsStuck) + " curves from what is drawn reaches it"
+          chain_length(net, {{k, true}}) < kShortestStroke && !reached
+              ? "it is " + format_double(1000 * chain_length(net, {{k, true}})) + " mm long, and no stroke of up to " +
+                    std::to_string(kMaxLegsStuck) + " curves through it is " + format_double(1000 * kShortestStroke) +
+                    " mm long, the shortest a tracked pen draws"
+          : !reached ? "no stroke of up to " + std::to_string(kMaxLegsStuck) + " curves from what is drawn reaches it"
           : !seen_whole ? "both cameras see no stroke that would draw it whole in any pose (try another --tilt or --turns)"
                         : "every stroke that would draw it is one the sketch would take otherwise (between two points of one curve "
                           "drawn, or on a face it was not meant for)";
