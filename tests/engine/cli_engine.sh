@@ -38,6 +38,13 @@ expect_error "truncated log" "trunc.log:3: truncated" "$fire" replay "$tmp/trunc
 printf 'FIRE-LOG 9\n' >"$tmp/v9.log"
 expect_error "unknown log version" "unknown input log version '9'" "$fire" replay "$tmp/v9.log"
 expect_error "missing log" "cannot open" "$fire" replay "$tmp/nope.log"
+# Usage errors exit 2 and name the command; --version prints the version.
+usage_exit() { "$@" >/dev/null 2>"$tmp/err"; [ $? -eq 2 ]; }
+check "an unknown command exits 2, named" "usage_exit '$fire' frobnicate && grep -q \"fire: 'frobnicate' is not a command\" '$tmp/err'"
+check "an unknown option exits 2, naming the command" "usage_exit '$fire' replay --bogus && grep -q '^fire replay: .*--bogus' '$tmp/err'"
+check "a malformed value exits 2, naming the subcommand" "usage_exit '$fire' simulate drawing --seed x && grep -q '^fire simulate drawing: ' '$tmp/err'"
+check "no command exits 2" "usage_exit '$fire'"
+check "--version" "'$fire' --version | grep -q '^fire [0-9]'"
 head -c 300 "$tmp/demo.fnet" >"$tmp/trunc.fnet"
 expect_error "truncated network" "trunc.fnet: not valid JSON" "$fire" export-network "$tmp/trunc.fnet" -o "$tmp/x.obj"
 sed 's/"version":1/"version":3/' "$tmp/demo.fnet" >"$tmp/v3.fnet"
