@@ -16,6 +16,8 @@
 namespace fire {
 
 Result<std::string> read_text_file(const std::string& path) {
+  // An ifstream opens a folder and reads nothing from it: the file would pass for an empty one.
+  if (is_directory(path)) return Result<std::string>::failure(path + ": is a folder, not a file");
   std::ifstream in(path, std::ios::binary);
   if (!in) return Result<std::string>::failure(path + ": cannot open (" + std::strerror(errno) + ")");
   std::ostringstream ss;

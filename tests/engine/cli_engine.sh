@@ -38,6 +38,7 @@ expect_error "truncated log" "trunc.log:3: truncated" "$fire" replay "$tmp/trunc
 printf 'FIRE-LOG 9\n' >"$tmp/v9.log"
 expect_error "unknown log version" "unknown input log version '9'" "$fire" replay "$tmp/v9.log"
 expect_error "missing log" "cannot open" "$fire" replay "$tmp/nope.log"
+expect_error "a folder given as a network" "is a folder, not a file" "$fire" reconstruct "$tmp" -o "$tmp/x.obj"
 # Usage errors exit 2 and name the command; --version prints the version.
 usage_exit() { "$@" >/dev/null 2>"$tmp/err"; [ $? -eq 2 ]; }
 check "an unknown command exits 2, named" "usage_exit '$fire' frobnicate && grep -q \"fire: 'frobnicate' is not a command\" '$tmp/err'"
