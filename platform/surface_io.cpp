@@ -411,8 +411,61 @@ Result<SurfaceMesh> decode_ply(std::string_view bytes, const std::string& source
   return s;
 }
 
+// ASCII STL: `solid NAME`, then per triangle `facet normal N N N`, `outer loop`, three `vertex X Y Z`, `endloop`,
+// `endfacet`, and `endsolid`. Errors name the line.
+Result<SurfaceMesh> decode_ascii_stl(std::string_view text, const std::string& source) {
+  size_t at = 0, line = 1;
+  std::string_view word;
+  auto next = [&]() -> bool {
+    while (at < text.size() && std::isspace(static_cast<unsigned char>(text[at]))) line += text[at++] == '\n';
+    const size_t start = at;
+    while (at < text.size() && !std::isspace(static_cast<unsigned char>(text[at]))) ++at;
+    word = text.substr(start, at - start);
+    return !word.empty();
+  };
+  auto fail = [&](const std::string& why) {
+    return Result<SurfaceMesh>::failure(source + ":" + std::to_string(line) + ": ASCII STL: " + why);
+  };
+  auto expect = [&](std::string_view w) { return next() && word == w; };
+  auto number = [&](double& v) {
+    if (!next()) return false;
+    const auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), v);
+    return ec == std::errc() && end == word.data() + word.size() && std::isfinite(v);
+  };
+  auto vec = [&](Vec3& p) { return number(p.x()) && number(p.y()) && number(p.z()); };
+  if (!expect("solid")) return fail("does not start with 'solid'");
+  // The name runs to the end of the line.
+  while (at < text.size() && text[at] != '\n') ++at;
+  SurfaceMesh s;
+  for (;;) {
+    if (!next()) return fail("ends before 'endsolid'");
+    if (word == "endsolid") break;
+    if (word != "facet") return fail("expected 'facet' or 'endsolid', found '" + std::string(word.substr(0, 32)) + "'");
+    Vec3 normal;
+    if (!expect("normal") || !vec(normal)) return fail("expected 'normal' and three finite numbers");
+    if (!expect("outer") || !expect("loop")) return fail("expected 'outer loop'");
+    for (int k = 0; k < 3; ++k) {
+      Vec3 p;
+      if (!expect("vertex") || !vec(p)) return fail("expected 'vertex' and three finite numbers");
+      s.face_vertices.push_back(static_cast<uint32_t>(s.positions.size()));
+      s.positions.push_back(p);
+      s.normals.push_back(normal);
+    }
+    if (!expect("endloop")) return fail("expected 'endloop' after three vertices (only triangles are STL facets)");
+    if (!expect("endfacet")) return fail("expected 'endfacet'");
+    s.face_offsets.push_back(static_cast<uint32_t>(s.face_vertices.size()));
+  }
+  if (s.face_offsets.size() < 2) return fail("no triangles");
+  return s;
+}
+
 Result<SurfaceMesh> decode_stl(std::string_view bytes, const std::string& source) {
   auto fail = [&](const std::string& why) { return Result<SurfaceMesh>::failure(source + ": " + why); };
+  // A binary file's 80-byte header may begin with "solid" too: its size decides.
+  const bool binary_size = bytes.size() >= kStlHeaderBytes + 4 &&
+                           bytes.size() == kStlHeaderBytes + 4 + kStlTriangleBytes * size_t{get<uint32_t>(bytes, kStlHeaderBytes)};
+  const size_t first = bytes.find_first_not_of(" \t\r\n");
+  if (!binary_size && first != std::string_view::npos && bytes.substr(first, 5) == "solid") return decode_ascii_stl(bytes.substr(first), source);
   if (bytes.size() < kStlHeaderBytes + 4) return fail("too short for a binary STL file (" + std::to_string(bytes.size()) + " bytes)");
   const uint32_t count = get<uint32_t>(bytes, kStlHeaderBytes);
   const size_t expected = kStlHeaderBytes + 4 + kStlTriangleBytes * size_t{count};

@@ -27,7 +27,7 @@ Result<std::string> encode_surface(const SurfaceMesh& surface, SurfaceFormat for
 Status write_surface(const SurfaceMesh& surface, const std::string& path);
 
 // Reads .obj (through parse_obj; normals are kept when the file has one `vn` per `v`, as written here),
-// .ply and .stl in the binary layouts written here, and .glb after check_glb. STL has no shared
+// .ply and .stl in the binary layouts written here, ASCII STL too, and .glb after check_glb. STL has no shared
 // vertices: each triangle gets its own three vertices, with the facet normal.
 Result<SurfaceMesh> decode_surface(std::string_view bytes, SurfaceFormat format, const std::string& source);
 Result<SurfaceMesh> read_surface(const std::string& path);

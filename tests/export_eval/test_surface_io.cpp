@@ -170,6 +170,37 @@ TEST_CASE("binary STL holds the fan triangles with facet normals", "[export]") {
   }
 }
 
+TEST_CASE("ASCII STL reads as the binary one does, and a binary header that starts with solid stays binary", "[export]") {
+  const std::string ascii =
+      "solid two\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   vertex 0 1 0\n  endloop\n endfacet\n"
+      " facet normal 0 0 -1\n  outer loop\n   vertex 0 0 0\n   vertex 0 1 0\n   vertex 1 0 0.5e-1\n  endloop\n endfacet\n"
+      "endsolid two\n";
+  auto r = decode_surface(ascii, SurfaceFormat::stl, "two.stl");
+  INFO((r.ok() ? "" : r.error()));
+  REQUIRE(r.ok());
+  REQUIRE(r->face_count() == 2);
+  CHECK(r->positions.size() == 6);
+  CHECK(r->positions[5] == Vec3(1, 0, 0.05));
+  CHECK(r->normals[3] == Vec3(0, 0, -1));
+  // A binary file whose 80-byte header happens to begin with "solid": its size matches the binary layout.
+  TempDir dir;
+  REQUIRE(write_surface(house(), dir.file("a.stl")).ok());
+  std::string binary = read_bytes(dir.file("a.stl"));
+  binary.replace(0, 5, "solid");
+  auto b = decode_surface(binary, SurfaceFormat::stl, "b.stl");
+  REQUIRE(b.ok());
+  CHECK(b->face_count() == 6);
+  auto refuse = [](const std::string& text, const char* part) {
+    auto bad = decode_surface(text, SurfaceFormat::stl, "bad.stl");
+    REQUIRE_FALSE(bad.ok());
+    CHECK_THAT(bad.error(), Contains(part));
+  };
+  refuse("solid\nendsolid\n", "bad.stl:2: ASCII STL: no triangles");
+  refuse(ascii.substr(0, ascii.size() - 13), "ends before 'endsolid'");
+  refuse(std::string(ascii).replace(ascii.find("1 0 0\n"), 5, "1 nan"), "bad.stl:5: ASCII STL: expected 'vertex' and three finite numbers");
+  refuse(std::string(ascii).replace(ascii.find("endloop"), 7, "vertex 1 1 1\n  endloop"), "only triangles are STL facets");
+}
+
 TEST_CASE("glTF binary passes the structural check and reads back", "[export][gltf]") {
   TempDir dir;
   const SurfaceMesh s = house();
