@@ -63,6 +63,11 @@ expect_replay_error "replay of device reports without a rig" "give the rig they 
 { head -1 occluded.log; echo "0 meta device 0 00:1F:32:AA:BB:07 camera0 0306"; tail -n +2 occluded.log; } > other.log
 sed '0,/{/s//{"remotes": [{"address": "00:1f:32:aa:bb:01", "role": "camera0"}],/' rig.json > other_rig.json
 expect_replay_error "replay with the rig of other remotes" "was calibrated with 00:1F:32:AA:BB:01 as camera 0" other.log --rig other_rig.json
+# Calibrating again over a rig file whose remotes a person assigned keeps them when the wand log names none.
+cp other_rig.json recalibrated.json
+"$fire" calibrate w.log -o recalibrated.json >/dev/null 2>err.txt || fail "calibrate over an existing rig failed: $(cat err.txt)"
+grep -q '"address": "00:1f:32:aa:bb:01"' recalibrated.json || fail "calibrate dropped the rig's remotes: $(cat recalibrated.json)"
+grep -q 'kept its "remotes"' err.txt || fail "calibrate did not say it kept the remotes: $(cat err.txt)"
 
 # Written as a session, the drawing keeps its rig: reopening it (last snapshot, then the tail) needs no
 # --rig and gives the same hash; a session whose rig.json is gone is refused by name.

@@ -335,10 +335,20 @@ int run_calibrate(const CalibrateArgs& a) {
   Result<WandCalibration> cal = calibrate_wand_streams(std::move(streams), options);
   if (!cal) return fail(command, (a.live ? a.live_options.session_dir : a.log_path) + ": " + cal.error());
   std::string rig_text = rig_to_json(cal->rig);
-  if (!remotes.empty()) {
-    // The remotes the wand was seen by, so tracking can refuse a log drawn with other ones.
+  // The remotes the wand was seen by, so tracking can refuse a log drawn with other ones; a log that names none
+  // (a simulated wand) keeps those of the rig file it replaces, which assign the cameras' roles by address.
+  ordered_json kept;
+  if (remotes.empty() && !is_directory(a.out_path))
+    if (Result<std::string> old = read_text_file(a.out_path); old) {
+      const ordered_json previous = ordered_json::parse(*old, nullptr, false);
+      if (previous.is_object() && previous.contains("remotes")) {
+        kept = previous["remotes"];
+        std::cerr << "fire calibrate: " << a.out_path << ": kept its \"remotes\" (the wand log names none)\n";
+      }
+    }
+  if (!remotes.empty() || !kept.is_null()) {
     ordered_json rig = ordered_json::parse(rig_text);
-    rig["remotes"] = remotes;
+    rig["remotes"] = remotes.empty() ? kept : remotes;
     rig_text = rig.dump(2) + "\n";
   }
   if (Status w = write_file_atomic(a.out_path, rig_text); !w) return fail(command, w.error);
