@@ -1,5 +1,7 @@
 #include "platform/network_file.hpp"
 
+#include <cctype>
+
 #include "engine/network_io.hpp"
 #include "platform/files.hpp"
 
@@ -19,6 +21,12 @@ Result<Mesh> load_network(const std::string& path) {
 }
 
 Status export_network_obj(const Mesh& mesh, const std::string& path) {
+  // OBJ text under another format's name would be read as that format, and fail there.
+  const size_t dot = path.find_last_of('.'), slash = path.find_last_of('/');
+  std::string extension = dot == std::string::npos || (slash != std::string::npos && dot < slash) ? "" : path.substr(dot + 1);
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension != "obj")
+    return Status::failure(path + ": the network's polylines are written as OBJ lines; give a name ending in .obj");
   return write_file_atomic(path, network_to_obj(mesh));
 }
 

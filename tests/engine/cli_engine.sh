@@ -39,6 +39,8 @@ printf 'FIRE-LOG 9\n' >"$tmp/v9.log"
 expect_error "unknown log version" "unknown input log version '9'" "$fire" replay "$tmp/v9.log"
 expect_error "missing log" "cannot open" "$fire" replay "$tmp/nope.log"
 expect_error "a folder given as a network" "is a folder, not a file" "$fire" reconstruct "$tmp" -o "$tmp/x.obj"
+expect_error "export-network to another format's name" "give a name ending in .obj" "$fire" export-network "$tmp/demo.fnet" -o "$tmp/x.ply"
+check "and writes nothing there" "[ ! -e '$tmp/x.ply' ]"
 # Usage errors exit 2 and name the command; --version prints the version.
 usage_exit() { "$@" >/dev/null 2>"$tmp/err"; [ $? -eq 2 ]; }
 check "an unknown command exits 2, named" "usage_exit '$fire' frobnicate && grep -q \"fire: 'frobnicate' is not a command\" '$tmp/err'"
