@@ -19,6 +19,8 @@ check "export-network --help" "'$fire' export-network --help | grep -q OBJ"
 h1=$("$fire" replay "$src/tools/demo/sketch.log" --hash 2>/dev/null)
 h2=$("$fire" replay "$src/tools/demo/sketch.log" --hash 2>/dev/null)
 check "replay hash is stable ($h1)" "[ -n '$h1' ] && [ '$h1' = '$h2' ]"
+check "replay --progress says how far it is on stderr, every 10 %, and prints the same hash" \
+  "[ \"\$('$fire' replay '$src/tools/demo/sketch.log' --hash --progress 2>'$tmp/progress')\" = '$h1' ] && grep -q '^fire replay: 100 % of the log' '$tmp/progress' && [ \$(grep -c '% of the log' '$tmp/progress') -eq 11 ]"
 # The hash of the pools and the surface every build on every machine must print for the bundled demo
 # (regenerate it only when the demo log, the pools or the surface change on purpose).
 golden=$(cat "$src/tests/engine/demo.hash")

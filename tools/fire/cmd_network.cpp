@@ -4,6 +4,8 @@
 #include <iostream>
 #include <memory>
 
+#include <unistd.h>
+
 #include "engine/text.hpp"
 #include "platform/clock.hpp"
 #include "platform/files.hpp"
@@ -19,11 +21,45 @@ namespace fire::cli {
 
 namespace {
 
+// How far through its log a replay is, on stderr: every 10 % with --progress; on a terminal, once the replay has
+// run a second, at most four times a second, on one line.
+ReplayHooks progress_hooks(bool asked) {
+  const bool terminal = ::isatty(STDERR_FILENO) != 0;
+  if (!asked && !terminal) return {};
+  struct State {
+    int64_t start_ns = monotonic_ns(), shown_ns = 0;
+    int last_tenth = -1;
+    bool printed = false, finished = false;
+  };
+  auto state = std::make_shared<State>();
+  ReplayHooks hooks;
+  hooks.after_frame = [state, asked, terminal](const World& w) {
+    const size_t total = w.log.events.size();
+    const size_t done = std::min(w.cursor.next, total);
+    const int percent = total ? int(100 * done / total) : 100;
+    const int64_t now = monotonic_ns();
+    if (asked && !terminal) {
+      if (percent / 10 == state->last_tenth) return;
+      state->last_tenth = percent / 10;
+      std::fprintf(stderr, "fire replay: %d %% of the log's events (frame %" PRIu64 ")\n", percent, w.frame.index);
+      return;
+    }
+    // The line ends once every event is read (the frames after it only settle the surface).
+    const bool last = done == total && state->printed && !state->finished;
+    if (!last && (state->finished || now - state->start_ns < 1'000'000'000 || now - state->shown_ns < 250'000'000)) return;
+    state->shown_ns = now;
+    state->printed = true;
+    state->finished = done == total;
+    std::fprintf(stderr, "\rfire replay: %d %% of the log's events (frame %" PRIu64 ")%s", percent, w.frame.index, done == total ? "\n" : "");
+  };
+  return hooks;
+}
+
 struct ReplayOptions {
   std::string log_path, out_path, obj_path, session_dir, rig_path;
   std::vector<std::string> surface_paths;
   uint64_t snapshot_every = 0;
-  bool hash = false, timings = false, no_surface = false, schedule = false;
+  bool hash = false, timings = false, no_surface = false, schedule = false, progress = false;
   bool settings_given = false;  // --snap, a surface option or --no-surface on the command line
   double snap = SketchSettings{}.snap_distance;
   SurfaceArgs surface_args;
@@ -120,7 +156,7 @@ int run_replay(const ReplayOptions& o) {
     world->surface_options = o.surface;
     scheduler_owner = std::make_unique<Scheduler>(make_scheduler(*world, monotonic_ns));
     if (o.session_dir.empty()) {
-      replay_headless(*world, *scheduler_owner);
+      replay_headless(*world, *scheduler_owner, progress_hooks(o.progress));
     } else {
       auto writer = SessionWriter::create(o.session_dir, settings_json(*world), rig_text, {}, world->log.version);
       if (!writer) {
@@ -237,6 +273,8 @@ void add_network_commands(CLI::App& app, Registry& registry) {
                      "repeat it for more than one file")
       ->allow_extra_args(false);
   replay->add_flag("--no-surface", o->no_surface, "run only input, sketch and split (no refine and subdivide)");
+  replay->add_flag("--progress", o->progress,
+                   "say how far through the log it is, every 10 % (on a terminal it always does, after a second)");
   add_surface_options(*replay, o->surface_args);
   replay->add_flag("--hash", o->hash,
                    "print a 64-bit hash of the final pools and surface (identical on every run and machine)");
