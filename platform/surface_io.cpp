@@ -228,6 +228,11 @@ constexpr uint32_t kGlbJsonChunk = 0x4E4F534A;  // "JSON"
 constexpr uint32_t kGlbBinChunk = 0x004E4942;   // "BIN\0"
 constexpr int kGlFloat = 5126, kGlUnsignedInt = 5125;
 
+// glTF is +Y up (glTF 2.0, 3.4); FIRE's frame is +Z up. Written turned -90 degrees about X, read turned back,
+// so the object stands in Blender and three.js as it stood on the table.
+Vec3 to_gltf(const Vec3& p) { return {p.x(), p.z(), -p.y()}; }
+Vec3 from_gltf(const Vec3& p) { return {p.x(), -p.z(), p.y()}; }
+
 Result<std::string> encode_glb(const SurfaceMesh& s, const std::vector<Vec3>& normals) {
   const std::vector<uint32_t> tris = fan_triangles(s);
   const size_t vertex_bytes = 12 * s.positions.size(), index_bytes = 4 * tris.size();
@@ -237,12 +242,13 @@ Result<std::string> encode_glb(const SurfaceMesh& s, const std::vector<Vec3>& no
   bin.reserve(bin_length);
   Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::max()), hi = -lo;
   for (const Vec3& p : s.positions) {
-    const Eigen::Vector3f pf = p.cast<float>();  // min/max of the values stored, as the validator checks
+    const Vec3 q = to_gltf(p);
+    const Eigen::Vector3f pf = q.cast<float>();  // min/max of the values stored, as the validator checks
     lo = lo.cwiseMin(pf);
     hi = hi.cwiseMax(pf);
-    put_vec3f(bin, p);
+    put_vec3f(bin, q);
   }
-  for (const Vec3& n : normals) put_vec3f(bin, n);
+  for (const Vec3& n : normals) put_vec3f(bin, to_gltf(n));
   for (uint32_t i : tris) put(bin, i);
 
   using json = nlohmann::ordered_json;
@@ -650,11 +656,11 @@ Result<SurfaceMesh> decode_glb(std::string_view bytes, const std::string& source
   SurfaceMesh s;
   s.positions.resize(parts.summary.vertex_count);
   for (uint32_t v = 0; v < parts.summary.vertex_count; ++v)
-    s.positions[v] = get_vec3f(parts.bin, parts.position_offset + 12 * size_t{v});
+    s.positions[v] = from_gltf(get_vec3f(parts.bin, parts.position_offset + 12 * size_t{v}));
   if (parts.has_normals) {
     s.normals.resize(parts.summary.vertex_count);
     for (uint32_t v = 0; v < parts.summary.vertex_count; ++v) {
-      s.normals[v] = get_vec3f(parts.bin, parts.normal_offset + 12 * size_t{v});
+      s.normals[v] = from_gltf(get_vec3f(parts.bin, parts.normal_offset + 12 * size_t{v}));
       if (!is_finite(s.normals[v])) return Result<SurfaceMesh>::failure(source + ": NORMAL " + std::to_string(v) + " is not finite");
     }
   }

@@ -213,9 +213,13 @@ TEST_CASE("glTF binary passes the structural check and reads back", "[export][gl
   CHECK(summary->bin_length == 8 * 12 * 2 + 6 * 3 * 4);  // positions, normals, uint32 indices
   CHECK(summary->vertex_count == 8);
   CHECK(summary->index_count == 18);
+  // Stored +Y up, as glTF has it: FIRE's z is glTF's y, FIRE's y is glTF's -z.
   CHECK(summary->position_min.x() == 0);
   CHECK(summary->position_max.x() == Approx(1.1).epsilon(1e-7));
-  CHECK(summary->position_min.z() == Approx(-1.3).epsilon(1e-7));
+  CHECK(summary->position_min.y() == Approx(-1.3).epsilon(1e-7));
+  CHECK(summary->position_max.y() == Approx(0.2).epsilon(1e-7));
+  CHECK(summary->position_min.z() == Approx(-1.6).epsilon(1e-7));
+  CHECK(summary->position_max.z() == Approx(0.7).epsilon(1e-7));
 
   auto [doc, bin] = split_glb(bytes);
   CHECK(doc["asset"]["version"] == "2.0");
