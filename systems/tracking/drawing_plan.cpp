@@ -111,7 +111,6 @@ struct Cells {
     add(loop);
   }
   size_t count() const { return curves.size(); }
-  bool is_cap(uint32_t c) const { return c >= faces; }
   uint32_t other(uint32_t k, uint32_t v) const { return net.curves[k].a == v ? net.curves[k].b : net.curves[k].a; }
 };
 
