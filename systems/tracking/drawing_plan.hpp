@@ -9,7 +9,9 @@
 // the two faces at its top. Strokes split the disc (an ear decomposition, fewest curves and shortest first,
 // each inside one face); a cap, once a face of its own, becomes a hole; then strokes across the far side, with
 // both ends on border loops, turn it into faces: one from a loop back to itself (a hole split), two between
-// the rims of a band (a bridge, then the wall).
+// the rims of a band (a bridge, then the wall). Each stroke is drawn in the pose nearest the current one that
+// shows it whole; one no pose shows whole is drawn in pieces, each ending off the network, the object turned
+// and registered again between them. Parts are drawn one after another, each from its own border loop.
 #include <functional>
 #include <vector>
 
