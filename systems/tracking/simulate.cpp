@@ -733,8 +733,41 @@ struct Pose {
   Eigen::Matrix3d R;
   Vec3 t;
   Triangles triangles;  // the object's surface, placed
+  // Bounds of each run of kTrianglesPerBox triangles: a segment that misses them misses every one.
+  std::vector<std::pair<Vec3, Vec3>> boxes;
   Vec3 operator()(const Vec3& object) const { return R * object + t; }
+  void place(const Triangles& object);
 };
+
+constexpr size_t kTrianglesPerBox = 32;
+
+void Pose::place(const Triangles& object) {
+  for (const auto& tri : object) triangles.push_back({(*this)(tri[0]), (*this)(tri[1]), (*this)(tri[2])});
+  constexpr double kPad = 1e-6;  // metres: keeps the test conservative against rounding
+  for (size_t first = 0; first < triangles.size(); first += kTrianglesPerBox) {
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (size_t k = first; k < std::min(triangles.size(), first + kTrianglesPerBox); ++k)
+      for (const Vec3& p : triangles[k]) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    boxes.push_back({lo - Vec3::Constant(kPad), hi + Vec3::Constant(kPad)});
+  }
+}
+
+// Whether the segment from + s dir, s in [0, len], meets the box (slab test).
+bool segment_meets_box(const Vec3& from, const Vec3& dir, double len, const std::pair<Vec3, Vec3>& box) {
+  double near = 0, far = len;
+  for (int a = 0; a < 3; ++a) {
+    if (std::abs(dir[a]) < 1e-12) {
+      if (from[a] < box.first[a] || from[a] > box.second[a]) return false;
+      continue;
+    }
+    double t0 = (box.first[a] - from[a]) / dir[a], t1 = (box.second[a] - from[a]) / dir[a];
+    if (t0 > t1) std::swap(t0, t1);
+    near = std::max(near, t0);
+    far = std::min(far, t1);
+    if (near > far) return false;
+  }
+  return true;
+}
 
 // A light on the limit surface lies within a millimetre of the object's faces (its limit surface, finely), on
 // either side: the object hides it only beyond this distance toward the camera.
@@ -746,7 +779,17 @@ constexpr std::array<double, 4> kFurtherTilt_deg{0, 35, 60, 80};
 
 bool hidden(const Pose& pose, const Vec3& light, const Vec3& centre) {
   const Vec3 u = (centre - light).normalized();
-  return segment_blocked(pose.triangles, light + kSurfaceClearance * u, centre);
+  const Vec3 from = light + kSurfaceClearance * u;
+  const double len = (centre - from).norm();
+  const Vec3 dir = (centre - from) / len;
+  for (size_t b = 0; b < pose.boxes.size(); ++b) {
+    if (!segment_meets_box(from, dir, len, pose.boxes[b])) continue;
+    for (size_t k = b * kTrianglesPerBox; k < std::min(pose.triangles.size(), (b + 1) * kTrianglesPerBox); ++k) {
+      const auto t = intersect(from, dir, pose.triangles[k]);
+      if (t && *t > 0 && *t < len) return true;
+    }
+  }
+  return false;
 }
 
 bool seen_by_both(const SimulatedRig& rig, const Pose& pose, const Vec3& object_point) {
@@ -839,7 +882,7 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
           Pose pose;
           pose.R = lean * standing * (side ? over : Eigen::Matrix3d::Identity()) * Eigen::AngleAxisd(-turn, Vec3::UnitZ()).toRotationMatrix();
           pose.t = Vec3(0, 0, o.target_distance_m) - pose.R * Vec3(0, 0, 0.5 * top);
-          for (const auto& tri : triangles) pose.triangles.push_back({pose(tri[0]), pose(tri[1]), pose(tri[2])});
+          pose.place(triangles);
           poses.push_back(std::move(pose));
         }
       }
