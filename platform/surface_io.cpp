@@ -433,10 +433,13 @@ Result<SurfaceMesh> decode_ascii_stl(std::string_view text, const std::string& s
     return Result<SurfaceMesh>::failure(source + ":" + std::to_string(line) + ": ASCII STL: " + why);
   };
   auto expect = [&](std::string_view w) { return next() && word == w; };
+  // STL holds floats: a number is kept as the float it becomes, and one beyond a float's range is refused.
   auto number = [&](double& v) {
     if (!next()) return false;
     const auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), v);
-    return ec == std::errc() && end == word.data() + word.size() && std::isfinite(v);
+    if (ec != std::errc() || end != word.data() + word.size() || !(std::abs(v) <= std::numeric_limits<float>::max())) return false;
+    v = static_cast<float>(v);
+    return true;
   };
   auto vec = [&](Vec3& p) { return number(p.x()) && number(p.y()) && number(p.z()); };
   if (!expect("solid")) return fail("does not start with 'solid'");
@@ -448,11 +451,11 @@ Result<SurfaceMesh> decode_ascii_stl(std::string_view text, const std::string& s
     if (word == "endsolid") break;
     if (word != "facet") return fail("expected 'facet' or 'endsolid', found '" + std::string(word.substr(0, 32)) + "'");
     Vec3 normal;
-    if (!expect("normal") || !vec(normal)) return fail("expected 'normal' and three finite numbers");
+    if (!expect("normal") || !vec(normal)) return fail("expected 'normal' and three numbers a float holds");
     if (!expect("outer") || !expect("loop")) return fail("expected 'outer loop'");
     for (int k = 0; k < 3; ++k) {
       Vec3 p;
-      if (!expect("vertex") || !vec(p)) return fail("expected 'vertex' and three finite numbers");
+      if (!expect("vertex") || !vec(p)) return fail("expected 'vertex' and three numbers a float holds");
       s.face_vertices.push_back(static_cast<uint32_t>(s.positions.size()));
       s.positions.push_back(p);
       s.normals.push_back(normal);

@@ -180,7 +180,7 @@ TEST_CASE("ASCII STL reads as the binary one does, and a binary header that star
   REQUIRE(r.ok());
   REQUIRE(r->face_count() == 2);
   CHECK(r->positions.size() == 6);
-  CHECK(r->positions[5] == Vec3(1, 0, 0.05));
+  CHECK(r->positions[5] == Vec3(1, 0, double(0.05f)));  // kept as the float STL holds
   CHECK(r->normals[3] == Vec3(0, 0, -1));
   // A binary file whose 80-byte header happens to begin with "solid": its size matches the binary layout.
   TempDir dir;
@@ -197,7 +197,8 @@ TEST_CASE("ASCII STL reads as the binary one does, and a binary header that star
   };
   refuse("solid\nendsolid\n", "bad.stl:2: ASCII STL: no triangles");
   refuse(ascii.substr(0, ascii.size() - 13), "ends before 'endsolid'");
-  refuse(std::string(ascii).replace(ascii.find("1 0 0\n"), 5, "1 nan"), "bad.stl:5: ASCII STL: expected 'vertex' and three finite numbers");
+  refuse(std::string(ascii).replace(ascii.find("1 0 0\n"), 5, "1 nan"), "bad.stl:5: ASCII STL: expected 'vertex' and three numbers a float holds");
+  refuse(std::string(ascii).replace(ascii.find("1 0 0\n"), 5, "1e39 0"), "bad.stl:5: ASCII STL: expected 'vertex' and three numbers a float holds");
   refuse(std::string(ascii).replace(ascii.find("endloop"), 7, "vertex 1 1 1\n  endloop"), "only triangles are STL facets");
 }
 
