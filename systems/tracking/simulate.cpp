@@ -113,15 +113,19 @@ std::optional<double> intersect(const Vec3& origin, const Vec3& dir, const std::
 
 using Triangles = std::vector<std::array<Vec3, 3>>;
 
-bool segment_blocked(const Triangles& tris, const Vec3& from, const Vec3& to) {
-  const Vec3 d = to - from;
-  const double len = d.norm();
-  const Vec3 dir = d / len;
-  for (const auto& tri : tris) {
-    const auto t = intersect(from, dir, tri);
+// Whether one of triangles [first, last) crosses the segment from + s dir, s in (0, len).
+bool crossed(const Triangles& tris, size_t first, size_t last, const Vec3& from, const Vec3& dir, double len) {
+  for (size_t k = first; k < last; ++k) {
+    const auto t = intersect(from, dir, tris[k]);
     if (t && *t > 0 && *t < len) return true;
   }
   return false;
+}
+
+bool segment_blocked(const Triangles& tris, const Vec3& from, const Vec3& to) {
+  const Vec3 d = to - from;
+  const double len = d.norm();
+  return crossed(tris, 0, tris.size(), from, d / len, len);
 }
 
 // What one camera exposes at one instant: lit LEDs in the world, and the truth line to log.
@@ -782,13 +786,10 @@ bool hidden(const Pose& pose, const Vec3& light, const Vec3& centre) {
   const Vec3 from = light + kSurfaceClearance * u;
   const double len = (centre - from).norm();
   const Vec3 dir = (centre - from) / len;
-  for (size_t b = 0; b < pose.boxes.size(); ++b) {
-    if (!segment_meets_box(from, dir, len, pose.boxes[b])) continue;
-    for (size_t k = b * kTrianglesPerBox; k < std::min(pose.triangles.size(), (b + 1) * kTrianglesPerBox); ++k) {
-      const auto t = intersect(from, dir, pose.triangles[k]);
-      if (t && *t > 0 && *t < len) return true;
-    }
-  }
+  for (size_t b = 0; b < pose.boxes.size(); ++b)
+    if (segment_meets_box(from, dir, len, pose.boxes[b]) &&
+        crossed(pose.triangles, b * kTrianglesPerBox, std::min(pose.triangles.size(), (b + 1) * kTrianglesPerBox), from, dir, len))
+      return true;
   return false;
 }
 
