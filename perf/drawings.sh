@@ -13,7 +13,7 @@
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 fire="${1:-$here/build/fire}"
-meshes_dir="$here/../shared/data/meshes"
+meshes_dir="$here/tests/data/meshes"
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 field() { sed -n "s/.*\"$1\": *\([-+0-9.eE]*\).*/\1/p" "$2" | head -1; }

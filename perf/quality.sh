@@ -20,7 +20,7 @@ set -u
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 fire="${1:-$here/build/fire}"
 baseline="${BASELINE:-}"
-meshes_dir="$here/../shared/data/meshes"
+meshes_dir="$here/tests/data/meshes"
 repeat="${REPEAT:-3}"
 correlation="${CORRELATION:-50}"
 read -r -a extra <<<"${RECONSTRUCT_ARGS:-}"

@@ -137,4 +137,20 @@ Status AppendFile::sync() {
   return Status::success();
 }
 
+Result<std::string> bundled_data_file(const std::string& relative) {
+  std::error_code ec;
+  std::filesystem::path dir = std::filesystem::read_symlink("/proc/self/exe", ec).parent_path();
+  if (ec) return Result<std::string>::failure(relative + ": cannot find the running executable (/proc/self/exe: " + ec.message() + ")");
+  std::string looked;
+  for (int up = 0; up <= 3 && !dir.empty(); ++up, dir = dir.parent_path()) {
+    for (const char* root : {"share/fire", "tests/data"}) {
+      const std::filesystem::path candidate = dir / root / relative;
+      if (std::filesystem::is_regular_file(candidate, ec)) return candidate.lexically_normal().string();
+      looked += (looked.empty() ? "" : ", ") + candidate.string();
+    }
+    if (dir == dir.root_path()) break;
+  }
+  return Result<std::string>::failure(relative + ": not found beside the executable (looked in " + looked + ")");
+}
+
 }  // namespace fire

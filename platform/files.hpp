@@ -26,6 +26,14 @@ Result<std::vector<std::string>> list_directory(const std::string& path);
 Status sync_directory(const std::string& path);
 Status remove_file(const std::string& path);
 
+// A file of the data FIRE bundles (the meshes, under tests/data/ in the repository and share/fire/ once
+// installed), found from the running executable, so no path is compiled in: in its folder or up to three
+// above it, `share/fire/RELATIVE` (an install: bin/fire) or `tests/data/RELATIVE` (a checkout: build/fire,
+// or a test under build/tests/). The error names the file and where it looked.
+Result<std::string> bundled_data_file(const std::string& relative);
+// The default object of the simulated person and of the fake rig: the pawn.
+inline constexpr const char* kDefaultMesh = "meshes/pawn.obj";
+
 // A file that only grows, written with write(2): what was appended is in the kernel as soon as append()
 // returns (a killed process loses none of it) and on the disk once sync() returns (a power cut loses none).
 class AppendFile {

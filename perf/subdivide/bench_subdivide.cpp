@@ -253,11 +253,11 @@ void run_case(const Mesh& mesh, int levels, int repetitions, Order order) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::string shared = argc > 1 ? argv[1] : FIRE_SHARED_DIR;
+  const std::string data = argc > 1 ? argv[1] : FIRE_DATA_DIR;
   const int repetitions = argc > 2 ? std::atoi(argv[2]) : 11;
   const std::string order_name = argc > 3 ? argv[3] : "interleaved";
   if (repetitions < 1 || (order_name != "interleaved" && order_name != "warm")) {
-    std::fprintf(stderr, "usage: bench_subdivide [SHARED_DIR] [REPETITIONS >= 1] [interleaved|warm]\n");
+    std::fprintf(stderr, "usage: bench_subdivide [DATA_DIR] [REPETITIONS >= 1] [interleaved|warm]\n");
     return 1;
   }
   const Order order = order_name == "warm" ? Order::warm : Order::interleaved;
@@ -265,7 +265,7 @@ int main(int argc, char** argv) {
   // faults depend on what ran before it; keep freed memory for both libraries alike.
   mallopt(M_MMAP_THRESHOLD, 256 << 20);
   mallopt(M_TRIM_THRESHOLD, 512 << 20);
-  auto pawn = fire::read_obj(shared + "/data/meshes/pawn.obj");
+  auto pawn = fire::read_obj(data + "/meshes/pawn.obj");
   if (!pawn) {
     std::fprintf(stderr, "bench_subdivide: %s\n", pawn.error().c_str());
     return 1;

@@ -29,7 +29,7 @@ for layout in "${layouts[@]}"; do
   for ((run = 1; run <= runs; ++run)); do
     # Table rows of bench_subdivide: | mesh | level | vertices | (a) ours | (a) OSD | (a) ratio | ... | (b) ours |
     # ... | (b) OSD level by level | (b) ratio | max diff |
-    "$dir/perf/subdivide/bench_subdivide" "$root/../shared" 11 interleaved |
+    "$dir/perf/subdivide/bench_subdivide" "$root/tests/data" 11 interleaved |
       awk -F'|' -v layout="${flags:-default}" -v run="$run" \
         'NR > 2 { gsub(/^ +| +$/, "", $2); printf "| %s | %d | %s |%s|%s|%s|%s|%s|%s|%s|\n", layout, run, $2, $3, $5, $6, $7, $11, $16, $17 }'
   done

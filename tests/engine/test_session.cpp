@@ -515,7 +515,7 @@ TEST_CASE("a tracked drawing's snapshots hold the triangulation system's state",
   // Wii Remote reports of a pen drawing on the pawn, simulated, with the true cameras as the rig: each
   // snapshot, taken while the system holds reports waiting for their frame numbers, an open stroke and
   // its filter, reopens to what a clean `fire replay --rig` gives.
-  auto pawn = read_obj(FIRE_SHARED_DIR "/data/meshes/pawn.obj");
+  auto pawn = read_obj(FIRE_DATA_DIR "/meshes/pawn.obj");
   REQUIRE(pawn.ok());
   tracking::RigOptions rig_options;
   rig_options.occlusion_per_s = 0.5;

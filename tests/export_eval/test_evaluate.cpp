@@ -19,7 +19,7 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-const std::string kMeshes = std::string(FIRE_SHARED_DIR) + "/data/meshes/";
+const std::string kMeshes = std::string(FIRE_DATA_DIR) + "/meshes/";
 
 // An independent closest point: the projection onto the plane when it falls inside (signed areas),
 // else the nearest of the three edges.

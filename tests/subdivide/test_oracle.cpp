@@ -16,7 +16,7 @@ namespace sd = fire::subdivide;
 namespace osd = fire::osd_reference;
 using fire::Vec3;
 
-const std::string kMeshDir = std::string(FIRE_SHARED_DIR) + "/data/meshes/";
+const std::string kMeshDir = std::string(FIRE_DATA_DIR) + "/meshes/";
 
 fire::PolygonMesh load(const std::string& name) {
   auto mesh = fire::read_obj(kMeshDir + name + ".obj");

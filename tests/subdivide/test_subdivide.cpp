@@ -135,7 +135,7 @@ TEST_CASE("n-gons become n quads and the face point is their centroid", "[subdiv
 }
 
 TEST_CASE("explicit and factorized stencil tables equal level-by-level evaluation", "[subdivide]") {
-  auto mesh = fire::read_obj(std::string(FIRE_SHARED_DIR) + "/data/meshes/rook.obj");
+  auto mesh = fire::read_obj(std::string(FIRE_DATA_DIR) + "/meshes/rook.obj");
   REQUIRE(mesh.ok());
   // Some sharp edges, so that crease and corner rows are exercised too.
   auto base = sd::build_refinement({uint32_t(mesh->positions.size()), mesh->face_offsets, mesh->face_vertices, {}},
@@ -193,7 +193,7 @@ TEST_CASE("evaluate equals the explicit stencil rows on every shared mesh, level
   // level before, with and without sharp edges (creases, darts, corners), after the base points move.
   for (const char* name : {"cube", "pyramid", "torus", "pawn", "rook"}) {
     INFO(name);
-    auto mesh = fire::read_obj(std::string(FIRE_SHARED_DIR) + "/data/meshes/" + name + ".obj");
+    auto mesh = fire::read_obj(std::string(FIRE_DATA_DIR) + "/meshes/" + name + ".obj");
     REQUIRE(mesh.ok());
     const uint32_t n = uint32_t(mesh->positions.size());
     auto base = sd::build_refinement({n, mesh->face_offsets, mesh->face_vertices, {}}, {0, true});
@@ -250,7 +250,7 @@ TEST_CASE("evaluate equals the explicit stencil rows on every shared mesh, level
 
 TEST_CASE("bad topology is rejected with a message naming the problem", "[subdivide]") {
   SECTION("a non-manifold edge (fan.obj)") {
-    auto fan = fire::read_obj(std::string(FIRE_SHARED_DIR) + "/data/meshes/fan.obj");
+    auto fan = fire::read_obj(std::string(FIRE_DATA_DIR) + "/meshes/fan.obj");
     REQUIRE(fan.ok());
     const std::string error =
         error_of({uint32_t(fan->positions.size()), fan->face_offsets, fan->face_vertices, {}});

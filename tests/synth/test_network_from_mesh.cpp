@@ -15,7 +15,7 @@ using namespace fire;
 
 namespace {
 
-const std::string kMeshes = std::string(FIRE_SHARED_DIR) + "/data/meshes/";
+const std::string kMeshes = std::string(FIRE_DATA_DIR) + "/meshes/";
 
 PolygonMesh load(const std::string& name) {
   auto pm = read_obj(kMeshes + name);

@@ -64,7 +64,7 @@ std::string rig_json_of(const tracking::RigOptions& rig_options) {
 // Strokes on the pawn.
 const Scenario& sketch() {
   static const Scenario s = [] {
-    auto pawn = read_obj(FIRE_SHARED_DIR "/data/meshes/pawn.obj");
+    auto pawn = read_obj(FIRE_DATA_DIR "/meshes/pawn.obj");
     REQUIRE(pawn.ok());
     tracking::RigOptions rig_options;
     tracking::SketchOptions options;
@@ -82,7 +82,7 @@ const Scenario& sketch() {
 // The start of `fire simulate drawing`: the pawn at 20 cm registered on three marks, then its border drawn.
 const Scenario& drawing() {
   static const Scenario s = [] {
-    auto pawn = read_obj(FIRE_SHARED_DIR "/data/meshes/pawn.obj");
+    auto pawn = read_obj(FIRE_DATA_DIR "/meshes/pawn.obj");
     REQUIRE(pawn.ok());
     tracking::DrawingOptions options;
     options.max_strokes = 2;

@@ -18,7 +18,7 @@ namespace {
 
 const PolygonMesh& pawn() {
   static const PolygonMesh mesh = [] {
-    Result<PolygonMesh> m = read_obj(std::string(FIRE_SHARED_DIR) + "/data/meshes/pawn.obj");
+    Result<PolygonMesh> m = read_obj(std::string(FIRE_DATA_DIR) + "/meshes/pawn.obj");
     REQUIRE(m.ok());
     return *m;
   }();

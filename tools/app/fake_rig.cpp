@@ -5,6 +5,7 @@
 #include <iterator>
 #include <nlohmann/json.hpp>
 
+#include "platform/files.hpp"
 #include "platform/obj.hpp"
 #include "systems/synth/network_from_mesh.hpp"
 #include "engine/ir_report.hpp"
@@ -94,18 +95,20 @@ std::vector<PadPress> pad_presses_for(const std::vector<InputEvent>& commands, s
 
 Result<std::unique_ptr<FakeDrawingRig>> FakeDrawingRig::create(uint64_t seed, int max_strokes) {
   using R = Result<std::unique_ptr<FakeDrawingRig>>;
-  auto pawn = read_obj(FIRE_DEFAULT_MESH);
+  auto pawn_path = bundled_data_file(kDefaultMesh);
+  if (!pawn_path) return R::failure("--fake-rig: " + pawn_path.error());
+  auto pawn = read_obj(*pawn_path);
   if (!pawn) return R::failure("--fake-rig: " + pawn.error());
   tracking::DrawingOptions options;
   options.max_strokes = max_strokes;
   auto placed = tracking::object_frame(pawn->positions, options.height_m);
   if (!placed) return R::failure("--fake-rig: " + placed.error());
-  auto network = network_from_mesh({*placed, pawn->face_offsets, pawn->face_vertices, FIRE_DEFAULT_MESH},
+  auto network = network_from_mesh({*placed, pawn->face_offsets, pawn->face_vertices, *pawn_path},
                                    UnrefineOptions{.unrefine = 2, .limit = true});
   if (!network) return R::failure("--fake-rig: " + network.error());
   tracking::RigOptions rig;
   rig.seed = rig.rig_seed = seed;
-  auto surface = limit_mesh({*placed, pawn->face_offsets, pawn->face_vertices, FIRE_DEFAULT_MESH}, tracking::kOccluderLevels);
+  auto surface = limit_mesh({*placed, pawn->face_offsets, pawn->face_vertices, *pawn_path}, tracking::kOccluderLevels);
   if (!surface) return R::failure("--fake-rig: " + surface.error());
   auto drawing = tracking::simulate_drawing(rig, options, surface->view(), tracking::drawing_network(*network));
   if (!drawing) return R::failure("--fake-rig: " + drawing.error());

@@ -24,10 +24,6 @@
 #include "tools/app/session_rig.hpp"
 #include "tools/app/session_store.hpp"
 
-#ifndef FIRE_DEFAULT_MESH
-#define FIRE_DEFAULT_MESH "../shared/data/meshes/pawn.obj"
-#endif
-
 namespace fire::cli {
 namespace {
 
@@ -64,7 +60,7 @@ struct SimulateArgs {
   DrawingOptions drawing;
   uint32_t unrefine = 2;
   std::string out_path, session_dir, rig_path, marks_path, object_path;
-  std::string mesh_path = FIRE_DEFAULT_MESH;
+  std::string mesh_path;  // empty: the bundled pawn
 };
 
 void add_rig_options(CLI::App* cmd, SimulateArgs& a) {
@@ -161,12 +157,22 @@ int run_simulate_wand(const SimulateArgs& a) {
   return write_simulation("wand", a, simulate_wand(a.rig, a.wand));
 }
 
+// --mesh, or the bundled pawn.
+Result<std::string> object_path(const SimulateArgs& a) {
+  if (!a.mesh_path.empty()) return a.mesh_path;
+  auto path = bundled_data_file(kDefaultMesh);
+  if (!path) return Result<std::string>::failure(path.error() + "; choose the object with --mesh");
+  return path;
+}
+
 int run_simulate_sketch(const SimulateArgs& a) {
   if (!output_chosen("sketch", a)) return 1;
-  Result<PolygonMesh> mesh = read_obj(a.mesh_path);
+  auto path = object_path(a);
+  if (!path) return fail("simulate sketch", path.error());
+  Result<PolygonMesh> mesh = read_obj(*path);
   if (!mesh) return fail("simulate sketch", mesh.error() + " (choose the object with --mesh)");
   SketchOptions sketch = a.sketch;
-  sketch.mesh_name = a.mesh_path.substr(a.mesh_path.find_last_of('/') + 1);
+  sketch.mesh_name = path->substr(path->find_last_of('/') + 1);
   return write_simulation("sketch", a, simulate_sketch(a.rig, sketch, mesh->view()));
 }
 
@@ -185,19 +191,22 @@ int run_simulate_drawing(const SimulateArgs& a) {
   const std::string command = "simulate drawing";
   if (!output_chosen("drawing", a)) return 1;
   if (!std::isfinite(a.drawing.height_m) || !(a.drawing.height_m > 0)) return fail(command, "--height must be a positive number of metres");
-  Result<PolygonMesh> mesh = read_obj(a.mesh_path);
+  auto object_file = object_path(a);
+  if (!object_file) return fail(command, object_file.error());
+  const std::string& mesh_path = *object_file;
+  Result<PolygonMesh> mesh = read_obj(mesh_path);
   if (!mesh) return fail(command, mesh.error() + " (choose the object with --mesh)");
   Result<std::vector<Vec3>> placed = object_frame(mesh->positions, a.drawing.height_m);
-  if (!placed) return fail(command, a.mesh_path + ": " + placed.error());
-  const PolygonMeshView control{*placed, mesh->face_offsets, mesh->face_vertices, a.mesh_path};
+  if (!placed) return fail(command, mesh_path + ": " + placed.error());
+  const PolygonMeshView control{*placed, mesh->face_offsets, mesh->face_vertices, mesh_path};
   Result<Mesh> network = network_from_mesh(control, UnrefineOptions{.unrefine = a.unrefine, .limit = true});
   if (!network) return fail(command, network.error());
   DrawingOptions options = a.drawing;
-  options.mesh_name = a.mesh_path.substr(a.mesh_path.find_last_of('/') + 1);
+  options.mesh_name = mesh_path.substr(mesh_path.find_last_of('/') + 1);
   Result<PolygonMesh> surface = limit_mesh(control, kOccluderLevels);
   if (!surface) return fail(command, surface.error());
   Result<SimulatedDrawing> drawing = simulate_drawing(a.rig, options, surface->view(), drawing_network(*network));
-  if (!drawing) return fail(command, a.mesh_path + ": " + drawing.error());
+  if (!drawing) return fail(command, mesh_path + ": " + drawing.error());
 
   const std::string marks = marks_to_json(drawing->marks);
   const std::string object = obj_text(*placed, *mesh, options.mesh_name + " scaled to " + format_double(options.height_m) +
@@ -526,7 +535,7 @@ void add_tracking_commands(CLI::App& app, Registry& registry) {
   s->add_option("--speed", sketch->sketch.speed_m_s, "pen speed along a stroke, m/s")->capture_default_str();
   s->add_option("--hold-s", sketch->sketch.hold_s, "seconds the lit pen rests at both ends of every stroke")->capture_default_str();
   s->add_option("--height", sketch->sketch.height_m, "the object is scaled to this height, metres (its +z is up)")->capture_default_str();
-  s->add_option("--mesh", sketch->mesh_path, "the object, OBJ")->capture_default_str();
+  s->add_option("--mesh", sketch->mesh_path, "the object, OBJ (default: the bundled pawn, tests/data/meshes/pawn.obj)");
   s->footer("Prints one JSON line: reports written and dropped per camera, LED images, occluded, out of view, merged, stray frames, strokes.");
   s->callback([sketch, &registry] { registry.exit_code = run_simulate_sketch(*sketch); });
 
@@ -539,7 +548,7 @@ void add_tracking_commands(CLI::App& app, Registry& registry) {
   dr->add_option("--object-out", drawing->object_path,
                  "the control mesh as drawn on, OBJ in metres in the object's frame (scaled, not posed): fire eval's --reference")
       ->required();
-  dr->add_option("--mesh", drawing->mesh_path, "the object, OBJ with +z up")->capture_default_str();
+  dr->add_option("--mesh", drawing->mesh_path, "the object, OBJ with +z up (default: the bundled pawn, tests/data/meshes/pawn.obj)");
   dr->add_option("--height", drawing->drawing.height_m, "the object is scaled to this height, metres")->capture_default_str();
   dr->add_option("--unrefine", drawing->unrefine, "K: the network drawn keeps every K-th edge loop of the control mesh (fire network-from-mesh)")
       ->check(CLI::Range(1u, 64u))

@@ -4,6 +4,7 @@
 #include <iostream>
 #include <string>
 
+#include "fire_version.hpp"
 #include "tools/fire/commands.hpp"
 
 namespace {
@@ -26,7 +27,7 @@ std::string command_path(const CLI::App& app) {
 int main(int argc, char** argv) {
   CLI::App app{"FIRE: Fast Interactive Reverse Engineering. Curves drawn on an object become a smooth 3D surface."};
   app.require_subcommand(1);
-  app.set_version_flag("--version", std::string("fire ") + FIRE_VERSION);
+  app.set_version_flag("--version", std::string("fire ") + FIRE_VERSION + " (commit " + FIRE_COMMIT + ")");
   fire::cli::Registry registry;
   fire::cli::add_network_commands(app, registry);
   fire::cli::add_synth_commands(app, registry);

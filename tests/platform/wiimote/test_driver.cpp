@@ -329,7 +329,7 @@ TEST_CASE("status reports mid-drawing and garbage from a remote lose no drawing"
 namespace {
 
 SimulatedBlobs simulated_blobs() {
-  Result<PolygonMesh> mesh = read_obj(std::string(FIRE_SHARED_DIR) + "/data/meshes/pawn.obj");
+  Result<PolygonMesh> mesh = read_obj(std::string(FIRE_DATA_DIR) + "/meshes/pawn.obj");
   REQUIRE(mesh.ok());
   tracking::SketchOptions sketch;
   sketch.strokes = 2;

@@ -25,7 +25,7 @@ field() { sed -n "s/.*\"$1\":\([-+0-9.eE]*\)[,}].*/\1/p" <<<"$2"; }
 "$fire" simulate wand -o w.log >/dev/null
 "$fire" calibrate w.log -o rig.json >/dev/null
 grep -q '"marks": \[' marks.json || fail "marks.json lists no marks: $(cat marks.json)"
-[ "$(grep -c '^v ' pawn20.obj)" -eq "$(grep -c '^v ' "$(dirname "$0")/../../../../shared/data/meshes/pawn.obj")" ] ||
+[ "$(grep -c '^v ' pawn20.obj)" -eq "$(grep -c '^v ' "$(dirname "$0")/../../data/meshes/pawn.obj")" ] ||
   fail "pawn20.obj is not the pawn's control mesh"
 
 # The whole network, every stroke accepted, the same hash twice.
