@@ -4,6 +4,7 @@
 
 #include "engine/text.hpp"
 #include "platform/files.hpp"
+#include "platform/surface_io.hpp"
 
 namespace fire {
 
@@ -13,6 +14,7 @@ Result<PolygonMesh> parse_obj(std::string_view text, const std::string& source) 
   auto fail = [&](size_t line, const std::string& why) {
     return Result<PolygonMesh>::failure(source + ":" + std::to_string(line) + ": " + why);
   };
+  LengthUnit unit = LengthUnit::m;
   size_t pos = 0, line_no = 0;
   while (pos < text.size()) {
     size_t end = text.find('\n', pos);
@@ -21,6 +23,13 @@ Result<PolygonMesh> parse_obj(std::string_view text, const std::string& source) 
     pos = end + 1;
     ++line_no;
     auto f = split_fields(line);
+    if (f.size() >= 3 && f[0] == "#" && f[1] == "units:") {
+      const std::string_view word = f[2].substr(0, f[2].find(','));
+      auto named = length_unit_of(word);
+      if (!named) return fail(line_no, named.error());
+      unit = *named;
+      continue;
+    }
     if (f.empty() || f[0][0] == '#') continue;
     if (f[0] == "v") {
       if (f.size() < 4) return fail(line_no, "vertex needs three coordinates");
@@ -55,6 +64,8 @@ Result<PolygonMesh> parse_obj(std::string_view text, const std::string& source) 
   }
   if (mesh.positions.empty()) return Result<PolygonMesh>::failure(source + ": no vertices (empty or not an OBJ file)");
   if (mesh.face_count() == 0) return Result<PolygonMesh>::failure(source + ": no faces");
+  if (unit != LengthUnit::m)
+    for (Vec3& p : mesh.positions) p /= units_per_metre(unit);
   return mesh;
 }
 

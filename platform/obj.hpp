@@ -1,6 +1,7 @@
 #pragma once
 // Wavefront OBJ polygon meshes: `v` and `f` lines (f accepts v, v/vt, v//vn, v/vt/vn and negative indices);
-// every other statement is ignored. Errors name the file, the line and the problem.
+// every other statement is ignored, except FIRE's `# units: mm` comment (platform/surface_io.hpp's LengthUnit):
+// positions come back in metres. Errors name the file, the line and the problem.
 #include <string>
 #include <string_view>
 

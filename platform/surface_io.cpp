@@ -144,9 +144,10 @@ std::vector<uint32_t> fan_triangles(const SurfaceMesh& s) {
 
 // ---------------------------------------------------------------- encoders
 
-std::string encode_obj(const SurfaceMesh& s, const std::vector<Vec3>& normals) {
+std::string encode_obj(const SurfaceMesh& s, const std::vector<Vec3>& normals, LengthUnit unit) {
   std::string out = "# FIRE surface: " + std::to_string(s.positions.size()) + " vertices, " +
-                    std::to_string(s.face_count()) + " faces; vertex i has normal i\n";
+                    std::to_string(s.face_count()) + " faces; vertex i has normal i\n# units: " + unit_name(unit) +
+                    ", up: +Z\n";
   out.reserve(out.size() + 60 * s.positions.size() * 2 + 12 * s.face_vertices.size());
   auto line3 = [&](const char* tag, const Vec3& p) {
     out += tag;
@@ -177,13 +178,13 @@ constexpr std::string_view kPlyVertexHeader =
     "property float nx\nproperty float ny\nproperty float nz\n";
 constexpr std::string_view kPlyFaceProperty = "property list uchar int vertex_indices\n";
 
-Result<std::string> encode_ply(const SurfaceMesh& s, const std::vector<Vec3>& normals) {
+Result<std::string> encode_ply(const SurfaceMesh& s, const std::vector<Vec3>& normals, LengthUnit unit) {
   for (size_t f = 0; f < s.face_count(); ++f)
     if (s.face_size(f) > 255)
       return Result<std::string>::failure("face " + std::to_string(f) + " has " + std::to_string(s.face_size(f)) +
                                           " vertices; a PLY uchar list holds at most 255");
-  std::string out = "ply\nformat binary_little_endian 1.0\ncomment FIRE surface\nelement vertex " +
-                    std::to_string(s.positions.size()) + "\n";
+  std::string out = "ply\nformat binary_little_endian 1.0\ncomment FIRE surface\ncomment units " +
+                    std::string(unit_name(unit)) + "\ncomment up +Z\nelement vertex " + std::to_string(s.positions.size()) + "\n";
   out += kPlyVertexHeader;
   out += "element face " + std::to_string(s.face_count()) + "\n";
   out += kPlyFaceProperty;
@@ -202,13 +203,13 @@ Result<std::string> encode_ply(const SurfaceMesh& s, const std::vector<Vec3>& no
 
 constexpr size_t kStlHeaderBytes = 80, kStlTriangleBytes = 50;
 
-Result<std::string> encode_stl(const SurfaceMesh& s) {
+Result<std::string> encode_stl(const SurfaceMesh& s, LengthUnit unit) {
   const std::vector<uint32_t> tris = fan_triangles(s);
   const size_t count = tris.size() / 3;
   if (count > std::numeric_limits<uint32_t>::max())
     return Result<std::string>::failure("too many triangles for STL (" + std::to_string(count) + ")");
   // The header must not start with "solid", which would make readers take the file for ASCII STL.
-  std::string out = "FIRE binary STL surface";
+  std::string out = std::string("FIRE binary STL surface; units: ") + unit_name(unit) + "; up: +Z";
   out.resize(kStlHeaderBytes, ' ');
   put(out, static_cast<uint32_t>(count));
   out.reserve(out.size() + kStlTriangleBytes * count);
@@ -308,6 +309,26 @@ std::vector<std::string_view> split_fields(std::string_view line) {
   return out;
 }
 
+// The unit a FIRE file names after `key` in `text` (a header line or comment): metres when it names none.
+Result<LengthUnit> named_unit(std::string_view text, std::string_view key, const std::string& source) {
+  const size_t at = text.find(key);
+  if (at == std::string_view::npos) return LengthUnit::m;
+  size_t begin = at + key.size();
+  while (begin < text.size() && text[begin] == ' ') ++begin;
+  size_t end = begin;
+  while (end < text.size() && std::isalpha(static_cast<unsigned char>(text[end]))) ++end;
+  auto unit = length_unit_of(text.substr(begin, end - begin));
+  if (!unit) return Result<LengthUnit>::failure(source + ": " + unit.error());
+  return unit;
+}
+
+// Divided by the exact count of units in a metre, the one rounding a reader adds to the writer's.
+Result<SurfaceMesh> in_metres(SurfaceMesh s, LengthUnit unit) {
+  if (unit != LengthUnit::m)
+    for (Vec3& p : s.positions) p /= units_per_metre(unit);
+  return s;
+}
+
 Result<SurfaceMesh> decode_obj(std::string_view text, const std::string& source) {
   auto polygons = parse_obj(text, source);
   if (!polygons) return Result<SurfaceMesh>::failure(polygons.error());
@@ -350,11 +371,17 @@ Result<SurfaceMesh> decode_ply(std::string_view bytes, const std::string& source
   // Only the layout encode_ply writes is read: same lines in the same order, comments aside.
   std::string canonical;
   size_t vertex_count = 0, face_count = 0;
+  LengthUnit unit = LengthUnit::m;
   size_t pos = 0;
   while (pos < header.size()) {
     const size_t end = header.find('\n', pos);
     std::string_view line = header.substr(pos, end - pos);
     pos = end + 1;
+    if (line.starts_with("comment units ")) {
+      auto named = named_unit(line, "comment units ", source);
+      if (!named) return Result<SurfaceMesh>::failure(named.error());
+      unit = *named;
+    }
     if (line.starts_with("comment")) continue;
     auto f = split_fields(line);
     if (f.size() == 3 && f[0] == "element" && (f[1] == "vertex" || f[1] == "face")) {
@@ -414,7 +441,7 @@ Result<SurfaceMesh> decode_ply(std::string_view bytes, const std::string& source
     s.face_offsets.push_back(static_cast<uint32_t>(s.face_vertices.size()));
   }
   if (at != bytes.size()) return fail(std::to_string(bytes.size() - at) + " bytes after the last face");
-  return s;
+  return in_metres(std::move(s), unit);
 }
 
 // ASCII STL: `solid NAME`, then per triangle `facet normal N N N`, `outer loop`, three `vertex X Y Z`, `endloop`,
@@ -482,6 +509,10 @@ Result<SurfaceMesh> decode_stl(std::string_view bytes, const std::string& source
     return fail("binary STL with " + std::to_string(count) + " triangles must have " + std::to_string(expected) +
                 " bytes, found " + std::to_string(bytes.size()));
   if (count == 0) return fail("no triangles");
+  // Only FIRE's own header is read for a unit: other writers fill it with anything.
+  auto unit = bytes.starts_with("FIRE ") ? named_unit(bytes.substr(0, kStlHeaderBytes), "units:", source)
+                                         : Result<LengthUnit>(LengthUnit::m);
+  if (!unit) return Result<SurfaceMesh>::failure(unit.error());
   SurfaceMesh s;
   s.positions.reserve(3 * size_t{count});
   s.normals.reserve(3 * size_t{count});
@@ -498,7 +529,7 @@ Result<SurfaceMesh> decode_stl(std::string_view bytes, const std::string& source
     }
     s.face_offsets.push_back(static_cast<uint32_t>(s.face_vertices.size()));
   }
-  return s;
+  return in_metres(std::move(s), *unit);
 }
 
 // A glTF count, offset or index must be a JSON integer from 0 up; nlohmann's get<uint64_t>() would wrap a
@@ -684,6 +715,30 @@ Result<SurfaceMesh> decode_glb(std::string_view bytes, const std::string& source
 
 }  // namespace
 
+double units_per_metre(LengthUnit unit) {
+  switch (unit) {
+    case LengthUnit::mm: return 1000;
+    case LengthUnit::cm: return 100;
+    case LengthUnit::m: return 1;
+  }
+  return 1;
+}
+
+const char* unit_name(LengthUnit unit) {
+  switch (unit) {
+    case LengthUnit::mm: return "mm";
+    case LengthUnit::cm: return "cm";
+    case LengthUnit::m: return "m";
+  }
+  return "m";
+}
+
+Result<LengthUnit> length_unit_of(std::string_view name) {
+  for (LengthUnit u : {LengthUnit::mm, LengthUnit::cm, LengthUnit::m})
+    if (name == unit_name(u)) return u;
+  return Result<LengthUnit>::failure("unknown length unit '" + std::string(name.substr(0, 32)) + "' (mm, cm or m)");
+}
+
 Result<SurfaceFormat> surface_format_of(const std::string& path) {
   const size_t dot = path.find_last_of('.');
   const size_t slash = path.find_last_of('/');
@@ -697,25 +752,34 @@ Result<SurfaceFormat> surface_format_of(const std::string& path) {
                                         "' (the extension must be .obj, .ply, .stl or .glb)");
 }
 
-Result<std::string> encode_surface(const SurfaceMesh& surface, SurfaceFormat format, const std::string& source) {
+Result<std::string> encode_surface(const SurfaceMesh& metres, SurfaceFormat format, const std::string& source,
+                                   LengthUnit unit) {
+  if (format == SurfaceFormat::glb) unit = LengthUnit::m;
+  SurfaceMesh scaled;
+  if (unit != LengthUnit::m) {
+    scaled = metres;
+    for (Vec3& p : scaled.positions) p *= units_per_metre(unit);
+  }
+  const SurfaceMesh& surface = unit == LengthUnit::m ? metres : scaled;
   if (Status st = check_surface(surface, format != SurfaceFormat::obj); !st)
-    return Result<std::string>::failure(source + ": cannot export: " + st.error);
+    return Result<std::string>::failure(source + ": cannot export" + (unit == LengthUnit::m ? "" : std::string(" in ") + unit_name(unit)) +
+                                        ": " + st.error);
   const std::vector<Vec3> normals = export_normals(surface);
   Result<std::string> bytes = std::string();
   switch (format) {
-    case SurfaceFormat::obj: bytes = encode_obj(surface, normals); break;
-    case SurfaceFormat::ply: bytes = encode_ply(surface, normals); break;
-    case SurfaceFormat::stl: bytes = encode_stl(surface); break;
+    case SurfaceFormat::obj: bytes = encode_obj(surface, normals, unit); break;
+    case SurfaceFormat::ply: bytes = encode_ply(surface, normals, unit); break;
+    case SurfaceFormat::stl: bytes = encode_stl(surface, unit); break;
     case SurfaceFormat::glb: bytes = encode_glb(surface, normals); break;
   }
   if (!bytes) return Result<std::string>::failure(source + ": cannot export: " + bytes.error());
   return bytes;
 }
 
-Status write_surface(const SurfaceMesh& surface, const std::string& path) {
+Status write_surface(const SurfaceMesh& surface, const std::string& path, LengthUnit unit) {
   auto format = surface_format_of(path);
   if (!format) return Status::failure(format.error());
-  auto bytes = encode_surface(surface, *format, path);
+  auto bytes = encode_surface(surface, *format, path, unit);
   if (!bytes) return Status::failure(bytes.error());
   return write_file_atomic(path, *bytes);
 }

@@ -15,6 +15,19 @@ namespace fire {
 
 enum class SurfaceFormat { obj, ply, stl, glb };
 
+// The length unit of a mesh export. FIRE works in metres; OBJ, PLY and STL are written in the unit asked,
+// millimetres by default (what slicers and CAD importers assume of a file without one), and +Z up, each
+// saying so in a comment or header: OBJ `# units: mm, up: +Z`, PLY `comment units mm` and `comment up +Z`,
+// binary STL its 80-byte header. The readers here honour that and give metres back, so a file without it
+// is taken as metres (FIRE's files before units, the reference meshes). glB is always metres and +Y up, as
+// glTF 2.0 requires, whatever unit is asked.
+enum class LengthUnit : uint8_t { mm, cm, m };
+inline constexpr LengthUnit kDefaultExportUnit = LengthUnit::mm;
+double units_per_metre(LengthUnit unit);  // exact: 1000, 100 or 1
+const char* unit_name(LengthUnit unit);
+// "mm", "cm" or "m"; an error names the word and the units known.
+Result<LengthUnit> length_unit_of(std::string_view name);
+
 // From the file extension, case-insensitive; an error names the path and the extensions known.
 Result<SurfaceFormat> surface_format_of(const std::string& path);
 
@@ -22,10 +35,12 @@ Result<SurfaceFormat> surface_format_of(const std::string& path);
 // in range, finite coordinates and normals, normals empty or one per vertex) and encodes it. Normals
 // missing or of zero length are replaced by the area-weighted normal of the faces around the vertex;
 // all normals are written unit length. `source` names the output in messages.
-Result<std::string> encode_surface(const SurfaceMesh& surface, SurfaceFormat format, const std::string& source);
+Result<std::string> encode_surface(const SurfaceMesh& surface, SurfaceFormat format, const std::string& source,
+                                   LengthUnit unit = kDefaultExportUnit);
 // encode_surface for the format of `path`'s extension, then write_file_atomic.
-Status write_surface(const SurfaceMesh& surface, const std::string& path);
+Status write_surface(const SurfaceMesh& surface, const std::string& path, LengthUnit unit = kDefaultExportUnit);
 
+// Positions come back in metres (LengthUnit above); a unit the file names that is not one of ours is an error.
 // Reads .obj (through parse_obj; normals are kept when the file has one `vn` per `v`, as written here),
 // .ply and .stl in the binary layouts written here, ASCII STL too, and .glb after check_glb. STL has no shared
 // vertices: each triangle gets its own three vertices, with the facet normal.

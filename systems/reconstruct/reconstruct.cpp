@@ -75,6 +75,8 @@ struct ReconstructionCache {
   FitRun run;
   UpdateStats stats;
   std::vector<Vec3> scratch;
+  // The base points of the last surface written as settled: with `base`'s topology, the cage whose limit it is.
+  std::vector<Vec3> settled_points;
 };
 
 ReconstructionState::ReconstructionState() : cache_(std::make_unique<ReconstructionCache>()) {}
@@ -83,6 +85,7 @@ ReconstructionState::ReconstructionState(ReconstructionState&&) noexcept = defau
 ReconstructionState& ReconstructionState::operator=(ReconstructionState&&) noexcept = default;
 const UpdateStats& ReconstructionState::last_update() const { return cache_->stats; }
 const BaseMesh& ReconstructionState::base() const { return cache_->base; }
+std::span<const Vec3> ReconstructionState::settled_points() const { return cache_->settled_points; }
 bool ReconstructionState::fitting() const { return cache_->fit_waiting || cache_->run.running(); }
 uint32_t ReconstructionState::short_curves() const {
   const std::vector<double>& scale = cache_->edge_scale;
@@ -821,6 +824,7 @@ Result<SurfaceWrite> run_subdivide(const Options& options, ReconstructionCache& 
     c.pending_subdivide = false;
     if (options.method == Method::thesis) {
       evaluate_surface(c, c.base.positions, surface);
+      c.settled_points = c.base.positions;
       return SurfaceWrite::settled;
     }
     // The fit starts from the base mesh's points, the transfinite patches': their surface is shown until
@@ -847,6 +851,7 @@ Result<SurfaceWrite> run_subdivide(const Options& options, ReconstructionCache& 
   c.stats.fit_iterations = c.run.report().iterations;
   c.stats.fit_rms = c.run.report().rms;
   evaluate_surface(c, c.run.points(), surface);
+  c.settled_points = c.run.points();
   c.run = {};
   return SurfaceWrite::settled;
 }
@@ -874,6 +879,26 @@ Status reconstruct_update(const Mesh& net, const Options& options, Reconstructio
   if (auto r = refine_update(net, whole, state); !r) return Status::failure(r.error());
   if (auto r = subdivide_update(whole, state, surface); !r) return Status::failure(r.error());
   return Status::success();
+}
+
+Cage cage_of(const ReconstructionState& state, const Options& options, SurfaceMesh surface) {
+  const BaseMesh& base = state.base();
+  Cage cage;
+  cage.mesh.positions.assign(state.settled_points().begin(), state.settled_points().end());
+  cage.mesh.face_offsets = base.face_offsets;
+  cage.mesh.face_vertices = base.face_vertices;
+  cage.sharp_edges = base.sharp_edges;
+  cage.border_corners = base.border_corners;
+  cage.levels = options.levels;
+  cage.surface = std::move(surface);
+  return cage;
+}
+
+Result<Cage> reconstruct_cage(const Mesh& net, const Options& options) {
+  ReconstructionState state;
+  SurfaceMesh surface;
+  if (auto s = reconstruct_update(net, options, state, surface); !s) return Result<Cage>::failure(s.error);
+  return cage_of(state, options, std::move(surface));
 }
 
 Result<SurfaceMesh> reconstruct_surface(const Mesh& net, const Options& options) {

@@ -25,8 +25,10 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <span>
 #include <vector>
 
+#include "engine/cage.hpp"
 #include "engine/mesh.hpp"
 #include "engine/polygon_mesh.hpp"
 #include "engine/surface.hpp"
@@ -202,6 +204,9 @@ class ReconstructionState {
   ReconstructionState& operator=(ReconstructionState&&) noexcept;
   const UpdateStats& last_update() const;
   const BaseMesh& base() const;  // the base mesh of the last successful update
+  // The base points of the last settled surface (the fitted ones, for fire): with base()'s faces, sharp
+  // edges and border corners, the subdivision cage whose Catmull-Clark limit that surface is.
+  std::span<const Vec3> settled_points() const;
   bool fitting() const;          // a fit runs over the next subdivide_update calls
   // fire: how many curves the last update took nearer their chords as short noisy ones (kShortCurveNoises).
   uint32_t short_curves() const;
@@ -257,5 +262,13 @@ Result<SurfaceWrite> subdivide_update(const Options& options, ReconstructionStat
 
 // One reconstruction from scratch.
 Result<SurfaceMesh> reconstruct_surface(const Mesh& net, const Options& options);
+
+// The subdivision cage of a reconstruction: the base mesh with its settled (fitted) points, its infinitely
+// sharp edges and the border's corners. Catmull-Clark refined `levels` times and pushed to the limit, it
+// gives its `surface`, which is what reconstruct_surface returns.
+using Cage = fire::Cage;
+Result<Cage> reconstruct_cage(const Mesh& net, const Options& options);
+// The same from a state whose last update (reconstruct_update) wrote `surface`, settled.
+Cage cage_of(const ReconstructionState& state, const Options& options, SurfaceMesh surface);
 
 }  // namespace fire::reconstruct

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "platform/files.hpp"
+#include "platform/obj.hpp"
 #include "platform/surface_io.hpp"
 
 using namespace fire;
@@ -108,7 +109,7 @@ std::string make_glb(const nlohmann::json& doc, const std::string& bin) {
 TEST_CASE("OBJ export keeps polygons, exact positions and unit normals", "[export]") {
   TempDir dir;
   const SurfaceMesh s = house();
-  REQUIRE(write_surface(s, dir.file("house.obj")).ok());
+  REQUIRE(write_surface(s, dir.file("house.obj"), LengthUnit::m).ok());
   CHECK(dir.entries() == std::vector<std::string>{"house.obj"});  // no temporary file left behind
   auto back = read_surface(dir.file("house.obj"));
   REQUIRE(back.ok());
@@ -130,7 +131,7 @@ TEST_CASE("OBJ export keeps polygons, exact positions and unit normals", "[expor
 TEST_CASE("binary PLY round-trips at float precision with polygons kept", "[export]") {
   TempDir dir;
   const SurfaceMesh s = house();
-  REQUIRE(write_surface(s, dir.file("house.ply")).ok());
+  REQUIRE(write_surface(s, dir.file("house.ply"), LengthUnit::m).ok());
   const std::string bytes = read_bytes(dir.file("house.ply"));
   CHECK(bytes.starts_with("ply\nformat binary_little_endian 1.0\n"));
   const size_t header = bytes.find("end_header\n") + 11;
@@ -151,7 +152,7 @@ TEST_CASE("binary PLY round-trips at float precision with polygons kept", "[expo
 TEST_CASE("binary STL holds the fan triangles with facet normals", "[export]") {
   TempDir dir;
   const SurfaceMesh s = house();
-  REQUIRE(write_surface(s, dir.file("house.STL")).ok());  // extensions are case-insensitive
+  REQUIRE(write_surface(s, dir.file("house.STL"), LengthUnit::m).ok());  // extensions are case-insensitive
   const std::string bytes = read_bytes(dir.file("house.STL"));
   CHECK(bytes.substr(0, 5) != "solid");  // would read as ASCII STL
   const std::vector<uint32_t> tris = fan(s);
@@ -395,4 +396,43 @@ TEST_CASE("a surface without normals gets area-weighted ones", "[export]") {
   // Vertex 7 lies only on the triangle (0, 7, 5): its normal is that triangle's.
   const Vec3 triangle = (s.positions[7] - s.positions[0]).cross(s.positions[5] - s.positions[0]).normalized();
   CHECK((back->normals[7] - triangle).norm() < 1e-12);
+}
+
+TEST_CASE("mesh exports are in millimetres by default, say so, and read back in metres", "[export][units]") {
+  TempDir dir;
+  const SurfaceMesh s = house();
+  double height = 0;
+  for (const Vec3& p : s.positions) height = std::max(height, p.z());
+  for (const char* name : {"house.obj", "house.ply", "house.stl"}) {
+    INFO(name);
+    REQUIRE(write_surface(s, dir.file(name)).ok());
+    const std::string bytes = read_bytes(dir.file(name));
+    CHECK((bytes.find("units: mm") != std::string::npos || bytes.find("comment units mm\n") != std::string::npos));
+    CHECK((bytes.find("up: +Z") != std::string::npos || bytes.find("comment up +Z\n") != std::string::npos));
+    auto back = read_surface(dir.file(name));
+    REQUIRE(back.ok());
+    double back_height = 0;
+    for (const Vec3& p : back->positions) back_height = std::max(back_height, p.z());
+    CHECK(back_height == Approx(height).epsilon(1e-7));  // metres again, at float precision for PLY and STL
+  }
+  // The numbers in the file are millimetres.
+  const std::string obj = read_bytes(dir.file("house.obj"));
+  auto raw = parse_obj(obj.substr(obj.find("\nv ")), "body");  // without the units line: the numbers as written
+  REQUIRE(raw.ok());
+  for (size_t v = 0; v < s.positions.size(); ++v) CHECK((raw->positions[v] - 1000 * s.positions[v]).norm() <= 1e-12 * 1000);
+  REQUIRE(write_surface(s, dir.file("cm.obj"), LengthUnit::cm).ok());
+  CHECK(read_bytes(dir.file("cm.obj")).find("# units: cm, up: +Z\n") != std::string::npos);
+  // glTF is metres whatever is asked.
+  REQUIRE(write_surface(s, dir.file("a.glb"), LengthUnit::mm).ok());
+  auto glb = read_surface(dir.file("a.glb"));
+  REQUIRE(glb.ok());
+  for (size_t v = 0; v < s.positions.size(); ++v) CHECK((glb->positions[v] - s.positions[v]).norm() < 1e-6);
+}
+
+TEST_CASE("a unit a file names that is not one of ours is refused, naming it", "[export][units]") {
+  auto obj = parse_obj("# units: furlong, up: +Z\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "odd.obj");
+  REQUIRE(!obj.ok());
+  CHECK_THAT(obj.error(), Contains("odd.obj:1") && Contains("furlong"));
+  CHECK(length_unit_of("cm").ok());
+  CHECK(!length_unit_of("inch").ok());
 }

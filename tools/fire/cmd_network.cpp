@@ -64,6 +64,8 @@ struct ReplayOptions {
   double snap = SketchSettings{}.snap_distance;
   SurfaceArgs surface_args;
   reconstruct::Options surface;
+  std::string units = unit_name(kDefaultExportUnit);
+  LengthUnit unit = kDefaultExportUnit;
 };
 
 void print_timing(const SystemTiming& t) {
@@ -222,7 +224,7 @@ int run_replay(const ReplayOptions& o) {
     }
     const SurfaceMesh mesh = to_surface_mesh(surface);
     for (const std::string& path : o.surface_paths)
-      if (auto s = write_surface(mesh, path); !s) {
+      if (auto s = write_surface(mesh, path, o.unit); !s) {
         std::cerr << "fire replay: " << s.error << "\n";
         return 1;
       }
@@ -272,6 +274,7 @@ void add_network_commands(CLI::App& app, Registry& registry) {
                      "write the final surface here (.obj, .ply, .stl or .glb), as the frame's subdivide system left it; "
                      "repeat it for more than one file")
       ->allow_extra_args(false);
+  add_units_option(*replay, o->units);
   replay->add_flag("--no-surface", o->no_surface, "run only input, sketch and split (no refine and subdivide)");
   replay->add_flag("--progress", o->progress,
                    "say how far through the log it is, every 10 % (on a terminal it always does, after a second)");
@@ -304,6 +307,13 @@ void add_network_commands(CLI::App& app, Registry& registry) {
       return;
     }
     o->surface = *surface;
+    auto unit = export_unit(o->units, *replay, o->surface_paths);
+    if (!unit) {
+      std::cerr << "fire replay: " << unit.error() << "\n";
+      registry.exit_code = 1;
+      return;
+    }
+    o->unit = *unit;
     registry.exit_code = run_replay(*o);
   });
 

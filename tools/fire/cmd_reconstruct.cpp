@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "platform/clock.hpp"
+#include "platform/cage_io.hpp"
 #include "platform/network_file.hpp"
 #include "platform/surface_io.hpp"
 #include "systems/reconstruct/reconstruct.hpp"
@@ -16,6 +17,8 @@ namespace {
 
 struct ReconstructArgs {
   std::string network_path, out_path;
+  std::vector<std::string> cage_paths;
+  std::string units = unit_name(kDefaultExportUnit);
   SurfaceArgs surface;
 };
 
@@ -28,8 +31,17 @@ int run_reconstruct(const ReconstructArgs& a, const CLI::App& cmd) {
   auto parsed = surface_options(a.surface, cmd);
   if (!parsed) return fail(parsed.error());
   const reconstruct::Options& options = *parsed;
-  // The output's format is checked first, so a wrong extension costs no reconstruction.
-  if (auto format = surface_format_of(a.out_path); !format) return fail(format.error());
+  if (a.out_path.empty() && a.cage_paths.empty()) {
+    std::cerr << "fire reconstruct: nothing to write: give -o SURFACE, --cage CAGE or both\n";
+    return 2;
+  }
+  // The outputs' formats are checked first, so a wrong extension costs no reconstruction.
+  if (!a.out_path.empty())
+    if (auto format = surface_format_of(a.out_path); !format) return fail(format.error());
+  for (const std::string& path : a.cage_paths)
+    if (Status s = check_cage_path(path); !s) return fail(s.error);
+  auto unit = export_unit(a.units, cmd, {a.out_path});
+  if (!unit) return fail(unit.error());
   auto net = load_network(a.network_path);
   if (!net) return fail(net.error());
 
@@ -39,7 +51,13 @@ int run_reconstruct(const ReconstructArgs& a, const CLI::App& cmd) {
   const Status built = reconstruct::reconstruct_update(*net, options, state, surface);
   const double seconds = double(monotonic_ns() - start) * 1e-9;
   if (!built) return fail(a.network_path + ": " + built.error);
-  if (auto written = write_surface(surface, a.out_path); !written) return fail(written.error);
+  if (!a.out_path.empty())
+    if (auto written = write_surface(surface, a.out_path, *unit); !written) return fail(written.error);
+  if (!a.cage_paths.empty()) {
+    const Cage cage = reconstruct::cage_of(state, options, surface);
+    for (const std::string& path : a.cage_paths)
+      if (Status written = write_cage(cage, path, *unit); !written) return fail(written.error);
+  }
 
   nlohmann::ordered_json out;
   out["method"] = a.surface.method;
@@ -69,7 +87,7 @@ void add_reconstruct_commands(CLI::App& app, Registry& registry) {
       "thesis: triquadrification, Coons refinement and Catmull-Clark (thesis chapter 6). fire (default): n quads "
       "around a centre per face from an n-sided transfinite patch, then base points fitted so that the "
       "Catmull-Clark limit surface passes through the drawn curves. Writes the level-L quads at their limit "
-      "positions with limit normals, atomically; the format follows the extension (.obj .ply .stl .glb). Prints one "
+      "positions with limit normals, atomically; the format follows the extension (.obj .ply .stl .glb), in --units, +Z up (.glb: metres, +Y up). Prints one "
       "JSON line: method, coons_steps, levels, base_faces, faces, vertices, seconds (reconstruction only, no I/O) "
       "worst_quad_aspect (the base mesh's worst quad: longest side squared over area, 1 for a square), "
       "noise_estimate (the polylines' noise from their samples' third differences, a fraction of their mean "
@@ -82,7 +100,14 @@ void add_reconstruct_commands(CLI::App& app, Registry& registry) {
       "vertices where just two curves meet, which the surface runs through as through any curve sample "
       "instead of making them vertices of its base mesh).");
   cmd->add_option("NET", a->network_path, "curve network file (format: engine/NETWORK_FORMAT.md)")->required();
-  cmd->add_option("-o,--output", a->out_path, "surface file to write: .obj, .ply, .stl or .glb")->required();
+  cmd->add_option("-o,--output", a->out_path, "surface file to write: .obj, .ply, .stl or .glb");
+  cmd->add_option("--cage", a->cage_paths,
+                  "also (or instead) write the subdivision cage whose Catmull-Clark limit the surface is: the base mesh "
+                  "at its fitted points, for subdivision modellers; .obj with OpenSubdiv's tags (t interpolateboundary, "
+                  "t crease, t corner) or .usda (a USD Mesh prim with subdivisionScheme, interpolateBoundary, creases "
+                  "and corners; sharpness 10 is infinitely sharp); in --units; repeat it for both")
+      ->allow_extra_args(false);
+  add_units_option(*cmd, a->units);
   add_surface_options(*cmd, a->surface);
   cmd->callback([a, cmd, &registry] { registry.exit_code = run_reconstruct(*a, *cmd); });
 }

@@ -45,4 +45,22 @@ Result<reconstruct::Options> surface_options(const SurfaceArgs& a, const CLI::Ap
   return options;
 }
 
+void add_units_option(CLI::App& cmd, std::string& units) {
+  cmd.add_option("--units", units,
+                 "length unit of the .obj, .ply and .stl written: mm, cm or m (FIRE works in metres; the file says "
+                 "which unit it holds, and +Z up). A .glb is always in metres and +Y up, as glTF requires")
+      ->capture_default_str();
+}
+
+Result<LengthUnit> export_unit(const std::string& units, const CLI::App& cmd, const std::vector<std::string>& paths) {
+  auto unit = length_unit_of(units);
+  if (!unit) return Result<LengthUnit>::failure("--units: " + unit.error());
+  if (cmd.count("--units") > 0 && *unit != LengthUnit::m)
+    for (const std::string& path : paths)
+      if (auto format = surface_format_of(path); format && *format == SurfaceFormat::glb)
+        return Result<LengthUnit>::failure("--units " + units + " cannot apply to " + path +
+                                           ": a glTF file is in metres by its specification");
+  return unit;
+}
+
 }  // namespace fire::cli
