@@ -347,24 +347,32 @@ int run_calibrate(const CalibrateArgs& a) {
   // The remotes the wand was seen by, so tracking can refuse a log drawn with other ones; a log that names none
   // (a simulated wand) keeps those of the rig file it replaces, which assign the cameras' roles by address.
   ordered_json kept;
-  if (remotes.empty() && !is_directory(a.out_path))
-    if (Result<std::string> old = read_text_file(a.out_path); old) {
-      const ordered_json previous = ordered_json::parse(*old, nullptr, false);
-      if (previous.is_object() && previous.contains("remotes")) {
-        kept = previous["remotes"];
-        std::cerr << "fire calibrate: " << a.out_path << ": kept its \"remotes\" (the wand log names none)\n";
-      }
+  Result<std::string> old = is_directory(a.out_path) ? Result<std::string>::failure("") : read_text_file(a.out_path);
+  if (remotes.empty() && old) {
+    const ordered_json previous = ordered_json::parse(*old, nullptr, false);
+    if (previous.is_object() && previous.contains("remotes")) {
+      kept = previous["remotes"];
+      std::cerr << "fire calibrate: " << a.out_path << ": kept its \"remotes\" (the wand log names none)\n";
     }
+  }
   if (!remotes.empty() || !kept.is_null()) {
     ordered_json rig = ordered_json::parse(rig_text);
     rig["remotes"] = remotes.empty() ? kept : remotes;
     rig_text = rig.dump(2) + "\n";
+  }
+  // A rig is the work of a calibration: the one replaced is kept beside the new one, never dropped silently.
+  const std::string backup = a.out_path + ".bak";
+  const bool replaced = old && *old != rig_text;
+  if (replaced) {
+    if (Status w = write_file_atomic(backup, *old); !w) return fail(command, w.error + " (the old rig is left as it was)");
+    std::cerr << "fire calibrate: " << a.out_path << ": the rig it replaces is kept as " << backup << "\n";
   }
   if (Status w = write_file_atomic(a.out_path, rig_text); !w) return fail(command, w.error);
 
   const CalibrationResult& r = cal->rig;
   ordered_json out;
   out["rig"] = a.out_path;
+  if (replaced) out["previous_rig"] = backup;
   out["reprojection_rms_px"] = r.reprojection_rms_px;
   out["reprojection_rms_2d_px"] = r.reprojection_rms_2d_px;
   out["wand_length_error_mm"] = r.wand_length_error_mm;
@@ -605,7 +613,7 @@ void add_tracking_commands(CLI::App& app, Registry& registry) {
   c->add_option("--fake-rig", cal->live_options.fake_rig_seed,
                 "--live test and simulation hook, not for calibrating anything real: no hardware; two fake remotes stream "
                 "the simulated wand of fire simulate wand with this seed (rig and motion), faster than real time");
-  c->add_option("-o,--output", cal->out_path, "rig file to write (systems/tracking/README.md)")->required();
+  c->add_option("-o,--output", cal->out_path, "rig file to write (systems/tracking/README.md); a different rig already there is kept as FILE.bak")->required();
   c->add_option("--wand-length", cal->wand_length_m,
                 "distance between the wand's LEDs, metres (default: the log's meta wand_length_m, else 0.3)");
   c->add_option("--max-iterations", cal->max_iterations, "Levenberg-Marquardt iterations per calibration")
