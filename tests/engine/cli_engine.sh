@@ -49,7 +49,7 @@ check "an unknown command exits 2, named" "usage_exit '$fire' frobnicate && grep
 check "an unknown option exits 2, naming the command" "usage_exit '$fire' replay --bogus && grep -q '^fire replay: .*--bogus' '$tmp/err'"
 check "a malformed value exits 2, naming the subcommand" "usage_exit '$fire' simulate drawing --seed x && grep -q '^fire simulate drawing: ' '$tmp/err'"
 check "no command exits 2" "usage_exit '$fire'"
-check "--version" "'$fire' --version | grep -q '^fire [0-9]'"
+check "--version names the version and the commit" "'$fire' --version | grep -q '^fire [0-9][0-9.]* (commit [0-9a-f]'"
 head -c 300 "$tmp/demo.fnet" >"$tmp/trunc.fnet"
 expect_error "truncated network" "trunc.fnet: not valid JSON" "$fire" export-network "$tmp/trunc.fnet" -o "$tmp/x.obj"
 sed 's/"version":1/"version":3/' "$tmp/demo.fnet" >"$tmp/v3.fnet"

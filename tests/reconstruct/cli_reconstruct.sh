@@ -67,5 +67,22 @@ expect_error "level out of range" "fire reconstruct: .*subdivision level must be
   "$fire" reconstruct "$tmp/square.fnet" -o "$tmp/l9.obj" --levels 9
 expect_error "unknown method" "fire reconstruct: --method must be thesis or fire, not 'magic'" "$tmp/m.obj" \
   "$fire" reconstruct "$tmp/square.fnet" -o "$tmp/m.obj" --method magic
-check "nothing else was left in the folder" "[ -z \"\$(ls '$tmp' | grep -v -e '\\.fnet\$' -e '^square\\.' -e '^s\\.' -e '^digon\\.obj\$' -e '^stdout\$' -e '^err\$')\" ]"
+# Units: millimetres by default, said in the file, read back as metres; a glB stays metres.
+"$fire" reconstruct "$tmp/square.fnet" -o "$tmp/u.stl" >/dev/null
+"$fire" reconstruct "$tmp/square.fnet" -o "$tmp/u_m.obj" --units m >/dev/null
+"$fire" reconstruct "$tmp/square.fnet" -o "$tmp/u_mm.obj" >/dev/null
+check "an STL says millimetres in its header" "head -c 80 '$tmp/u.stl' | grep -q 'units: mm; up: +Z'"
+maxx() { awk '/^v / { if (!n++ || $2 + 0 > m) m = $2 + 0 } END { printf "%.17g", m }' "$1"; }
+check "an OBJ in mm holds 1000 times the metres, and says so" "awk -v a=\$(maxx '$tmp/u_mm.obj') -v b=\$(maxx '$tmp/u_m.obj') 'BEGIN { d = a - 1000 * b; exit !(d < 1e-9 && d > -1e-9) }' && grep -q '^# units: mm, up: +Z$' '$tmp/u_mm.obj'"
+rms() { "$fire" eval "$1" --reference "$tmp/u_m.obj" | sed 's/.*"rms":\([0-9.e+-]*\).*/\1/'; }
+check "fire eval measures the same in mm and m (to rounding)" "awk -v a=\$(rms '$tmp/u_mm.obj') -v b=\$(rms '$tmp/u_m.obj') 'BEGIN { d = a - b; exit !(b > 0 && d < 1e-12 * b && d > -1e-12 * b) }'"
+expect_error "--units cm with a glB" "a glTF file is in metres" "$tmp/u.glb" "$fire" reconstruct "$tmp/square.fnet" -o "$tmp/u.glb" --units cm
+expect_error "an unknown unit" "unknown length unit 'inch'" "$tmp/u_in.obj" "$fire" reconstruct "$tmp/square.fnet" -o "$tmp/u_in.obj" --units inch
+# The cage: OBJ with OpenSubdiv's tags and USDA, without a surface file too.
+"$fire" reconstruct "$tmp/square.fnet" --cage "$tmp/u_cage.obj" --cage "$tmp/u_cage.usda" >/dev/null
+check "--cage alone writes the OBJ and USDA cages" "grep -q '^t interpolateboundary 1/0/0 2$' '$tmp/u_cage.obj' && [ \$(grep -c '^f ' '$tmp/u_cage.obj') -eq 4 ] && grep -q 'subdivisionScheme = \"catmullClark\"' '$tmp/u_cage.usda' && grep -q 'metersPerUnit = 0.001' '$tmp/u_cage.usda'"
+expect_error "a cage in an unknown format" "unknown cage format 'fbx'" "$tmp/u_cage.fbx" "$fire" reconstruct "$tmp/square.fnet" --cage "$tmp/u_cage.fbx"
+"$fire" reconstruct "$tmp/square.fnet" >/dev/null 2>"$tmp/err"
+check "nothing to write is a usage error" "[ \$? -eq 2 ] && grep -q 'nothing to write' '$tmp/err'"
+check "nothing else was left in the folder" "[ -z \"\$(ls '$tmp' | grep -v -e '\\.fnet\$' -e '^square\\.' -e '^s\\.' -e '^digon\\.obj\$' -e '^u\\.stl\$' -e '^u_m\\.obj\$' -e '^u_mm\\.obj\$' -e '^u_cage\\.obj\$' -e '^u_cage\\.usda\$' -e '^stdout\$' -e '^err\$')\" ]"
 exit $fail

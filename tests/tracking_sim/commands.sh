@@ -68,6 +68,12 @@ cp other_rig.json recalibrated.json
 "$fire" calibrate w.log -o recalibrated.json >/dev/null 2>err.txt || fail "calibrate over an existing rig failed: $(cat err.txt)"
 grep -q '"address": "00:1f:32:aa:bb:01"' recalibrated.json || fail "calibrate dropped the rig's remotes: $(cat recalibrated.json)"
 grep -q 'kept its "remotes"' err.txt || fail "calibrate did not say it kept the remotes: $(cat err.txt)"
+# The rig it replaced is kept beside it, and said so; the same rig again replaces nothing.
+cmp -s other_rig.json recalibrated.json.bak || fail "calibrate did not keep the replaced rig as recalibrated.json.bak"
+grep -q "the rig it replaces is kept as recalibrated.json.bak" err.txt || fail "calibrate did not say where the old rig is: $(cat err.txt)"
+rm recalibrated.json.bak
+"$fire" calibrate w.log -o recalibrated.json >/dev/null 2>err.txt || fail "calibrating again failed: $(cat err.txt)"
+[ ! -e recalibrated.json.bak ] || fail "an unchanged rig was backed up"
 
 # Written as a session, the drawing keeps its rig: reopening it (last snapshot, then the tail) needs no
 # --rig and gives the same hash; a session whose rig.json is gone is refused by name.

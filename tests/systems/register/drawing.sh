@@ -29,7 +29,7 @@ grep -q '"marks": \[' marks.json || fail "marks.json lists no marks: $(cat marks
   fail "pawn20.obj is not the pawn's control mesh"
 
 # The whole network, every stroke accepted, the same hash twice.
-"$fire" replay d.log --rig rig.json -o net.fnet --surface d.obj --hash --timings >first.out 2>replay.err
+"$fire" replay d.log --rig rig.json -o net.fnet --surface d.obj --surface d.stl --hash --timings >first.out 2>replay.err
 "$fire" replay d.log --rig rig.json -o net2.fnet --surface d2.obj --hash --timings >second.out 2>/dev/null
 ! grep -q rejected replay.err || fail "strokes rejected: $(grep rejected replay.err | head -3)"
 if [ "$extent" = whole ]; then
@@ -47,6 +47,14 @@ if [ "$extent" = whole ]; then
   rms=$(field rms "$eval_out")
   awk -v r="$rms" 'BEGIN {exit !(r > 0 && r <= 0.005)}' || fail "rms $rms of the diagonal, at most 0.005 wanted: $eval_out"
   echo "eval: $eval_out"
+  # A default STL is in millimetres: the 20 cm pawn stands about 200 units tall in it.
+  height=$(python3 -c 'import struct, sys
+data = open(sys.argv[1], "rb").read()
+n = struct.unpack_from("<I", data, 80)[0]
+z = [struct.unpack_from("<f", data, 84 + 50 * t + 12 + 12 * k + 8)[0] for t in range(n) for k in range(3)]
+print(max(z) - min(z))' d.stl)
+  awk -v h="$height" 'BEGIN {exit !(h > 195 && h < 205)}' || fail "the STL of the 20 cm pawn is $height units tall, about 200 (mm) wanted"
+  echo "stl height: $height"
 fi
 
 # The first registration with its third mark left out: 2 marks, rejected in words, the log replays on.
