@@ -19,8 +19,8 @@ check "export-network --help" "'$fire' export-network --help | grep -q OBJ"
 h1=$("$fire" replay "$src/tools/demo/sketch.log" --hash 2>/dev/null)
 h2=$("$fire" replay "$src/tools/demo/sketch.log" --hash 2>/dev/null)
 check "replay hash is stable ($h1)" "[ -n '$h1' ] && [ '$h1' = '$h2' ]"
-check "replay --progress says how far it is on stderr, every 10 %, and prints the same hash" \
-  "[ \"\$('$fire' replay '$src/tools/demo/sketch.log' --hash --progress 2>'$tmp/progress')\" = '$h1' ] && grep -q '^fire replay: 100 % of the log' '$tmp/progress' && [ \$(grep -c '% of the log' '$tmp/progress') -eq 11 ]"
+check "replay --progress says how far it is on stderr, every 10 %, sums up, and prints the same hash" \
+  "[ \"\$('$fire' replay '$src/tools/demo/sketch.log' --hash --progress 2>'$tmp/progress')\" = '$h1' ] && grep -q '^fire replay: 100 % of the log' '$tmp/progress' && [ \$(grep -c '% of the log' '$tmp/progress') -eq 11 ] && grep -qE '^fire replay: [0-9]+ frames in [0-9.]+ s: [0-9]+ edits applied, [0-9]+ rejected, [0-9]+ curves$' '$tmp/progress'"
 # The hash of the pools and the surface every build on every machine must print for the bundled demo
 # (regenerate it only when the demo log, the pools or the surface change on purpose).
 golden=$(cat "$src/tests/engine/demo.hash")

@@ -85,6 +85,7 @@ Result<ReopenedSession> reopen(const std::string& command, const std::string& di
 }
 
 int run_replay(const ReplayOptions& o) {
+  const int64_t started_ns = monotonic_ns();
   const bool session_in = is_directory(o.log_path);
   if (session_in && o.settings_given) {
     std::cerr << "fire replay: " << o.log_path << " is a session folder: its settings.json sets --snap, the surface "
@@ -175,6 +176,11 @@ int run_replay(const ReplayOptions& o) {
     }
   }
   Scheduler& scheduler = *scheduler_owner;
+  // A replay that showed its progress (--progress, or a terminal once it ran two seconds) ends with a summary line.
+  if (o.progress || (::isatty(STDERR_FILENO) != 0 && monotonic_ns() - started_ns > 2'000'000'000))
+    std::fprintf(stderr, "fire replay: %" PRIu64 " frames in %.1f s: %zu edits applied, %zu rejected, %zu curves\n",
+                 scheduler.frames(), double(monotonic_ns() - started_ns) * 1e-9, world->history.undo_depth(),
+                 world->rejections.size(), world->mesh.edge_count());
 
   for (const Rejection& r : world->rejections)
     std::cerr << lines_of << ":" << r.line << ": rejected: " << r.reason << "\n";
@@ -277,7 +283,8 @@ void add_network_commands(CLI::App& app, Registry& registry) {
   add_units_option(*replay, o->units);
   replay->add_flag("--no-surface", o->no_surface, "run only input, sketch and split (no refine and subdivide)");
   replay->add_flag("--progress", o->progress,
-                   "say how far through the log it is, every 10 % (on a terminal it always does, after a second)");
+                   "say how far through the log it is, every 10 %, and end with a summary line (on a terminal it always does, after "
+                   "a second, and sums up a replay that took over two seconds)");
   add_surface_options(*replay, o->surface_args);
   replay->add_flag("--hash", o->hash,
                    "print a 64-bit hash of the final pools and surface (identical on every run and machine)");
