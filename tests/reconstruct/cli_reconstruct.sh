@@ -84,5 +84,12 @@ check "--cage alone writes the OBJ and USDA cages" "grep -q '^t interpolatebound
 expect_error "a cage in an unknown format" "unknown cage format 'fbx'" "$tmp/u_cage.fbx" "$fire" reconstruct "$tmp/square.fnet" --cage "$tmp/u_cage.fbx"
 "$fire" reconstruct "$tmp/square.fnet" >/dev/null 2>"$tmp/err"
 check "nothing to write is a usage error" "[ \$? -eq 2 ] && grep -q 'nothing to write' '$tmp/err'"
-check "nothing else was left in the folder" "[ -z \"\$(ls '$tmp' | grep -v -e '\\.fnet\$' -e '^square\\.' -e '^s\\.' -e '^digon\\.obj\$' -e '^u\\.stl\$' -e '^u_m\\.obj\$' -e '^u_mm\\.obj\$' -e '^u_cage\\.obj\$' -e '^u_cage\\.usda\$' -e '^stdout\$' -e '^err\$')\" ]"
+# CAD: B-spline patches in STEP and IGES, in millimetres; the square's 4 regular-bordered quads are exact.
+out=$("$fire" reconstruct "$tmp/square.fnet" -o "$tmp/u.step")
+check "STEP: patches, sewn into one shell with its border free, in mm" "grep -q '\"cad\":{\"patches\":[0-9]*,\"exact\":[0-9]*,\"fitted\":0,.*\"solids\":0,\"shells\":1,\"free_edges\":[1-9][0-9]*,\"units\":\"mm\"}' <<<'$out' && grep -q 'SI_UNIT(.MILLI.,.METRE.)' '$tmp/u.step'"
+"$fire" reconstruct "$tmp/square.fnet" -o "$tmp/u.IGES" --units m >/dev/null
+check "IGES in metres" "[ -s '$tmp/u.IGES' ] && grep -q '\"units\":\"m\"' <<<\"\$('$fire' reconstruct '$tmp/square.fnet' -o '$tmp/u.IGES' --units m)\""
+expect_error "STEP into a folder that is not there" "fire reconstruct: .*no/such/dir/x.step" "$tmp/no/such/dir/x.step" \
+  "$fire" reconstruct "$tmp/square.fnet" -o "$tmp/no/such/dir/x.step"
+check "nothing else was left in the folder" "[ -z \"\$(ls '$tmp' | grep -v -e '\\.fnet\$' -e '^square\\.' -e '^s\\.' -e '^digon\\.obj\$' -e '^u\\.stl\$' -e '^u_m\\.obj\$' -e '^u_mm\\.obj\$' -e '^u_cage\\.obj\$' -e '^u_cage\\.usda\$' -e '^u\\.step\$' -e '^u\\.IGES\$' -e '^stdout\$' -e '^err\$')\" ]"
 exit $fail

@@ -10,6 +10,7 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <thread>
 
 #define GLFW_INCLUDE_NONE
@@ -23,6 +24,7 @@
 #include "platform/surface_io.hpp"
 #include "systems/evaluate/evaluate.hpp"
 #include "tools/app/app_script.hpp"
+#include "tools/app/cad_export_job.hpp"
 #include "tools/app/app_window.hpp"
 #include "tools/app/mouse_pen.hpp"
 #include "tools/app/pad.hpp"
@@ -157,8 +159,9 @@ int run_app(const AppOptions& a) {
     if (!s) return fail("--script: " + s.error());
     script = std::move(*s);
   }
-  if (!a.export_path.empty())
-    if (auto format = surface_format_of(a.export_path); !format) return fail("--export: " + format.error());
+  if (!a.export_path.empty() && !is_cad_path(a.export_path))
+    if (auto format = surface_format_of(a.export_path); !format)
+      return fail("--export: " + format.error() + ", or .step, .stp, .igs or .iges for CAD");
   if (a.reference_levels < 0 || a.reference_levels > 5) return fail("--reference-levels must be 0 to 5");
   if (!(a.snap_pixels > 0) || a.snap_pixels > 200) return fail("--snap-pixels must be above 0 and at most 200");
   // The reference as drawn on: its Catmull-Clark limit surface (a control mesh), or its faces as fans (level 0).
@@ -276,6 +279,7 @@ int run_app(const AppOptions& a) {
     hud_data.status = std::move(message);
     std::cerr << "fire app: " << hud_data.status << "\n";
   };
+  CadExportJob cad_job;
   // The view frames the drawing as it grows, until the person moves it.
   bool view_moved = false;
   size_t framed_edges = w.mesh.edge_count();
@@ -382,6 +386,16 @@ int run_app(const AppOptions& a) {
         } else if (e.key == GLFW_KEY_E) {
           // The surface as the frames have built it so far; a failed write leaves the session untouched.
           if (w.surface.empty()) report("export: no surface yet (it needs a closed border)");
+          else if (is_cad_path(export_path)) {
+            // The cage of the settled surface, converted and sewn on a worker thread: the frames go on meanwhile.
+            if (cad_job.running()) report("export: " + export_path + " is still being written");
+            else if (!w.surface.settled) report("export: the surface is still settling; press E again in a moment");
+            else {
+              cad_job.start(reconstruct::cage_of(w.surface_build.state, w.surface_options, to_surface_mesh(w.surface)),
+                            export_path, kDefaultExportUnit);
+              report("exporting the surface to " + export_path + " in the background");
+            }
+          }
           else if (const Status s = write_surface(to_surface_mesh(w.surface), export_path); !s) report("export failed: " + s.error);
           else
             report("exported " + std::to_string(w.surface.quad_count()) + " surface quads to " + export_path +
@@ -409,12 +423,15 @@ int run_app(const AppOptions& a) {
       else window.inject(s.event);
     }
     window.poll();
+    if (std::optional<std::string> done = cad_job.finished()) report(std::move(*done));
     for (const window::WindowEvent& e : window.events()) handle(e);
     window.events().clear();
     if (!app.display(orbit) && app.status() && app.width() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(16));
     ++display_frame;
   }
   if (!app.status()) return fail("Vulkan: " + app.status().error);
+  if (cad_job.running()) std::cerr << "fire app: waiting for the export to " << export_path << " to be written\n";
+  if (std::optional<std::string> done = cad_job.wait()) report(std::move(*done));
 
   // Every logged event handled, as `fire replay` ends, and the session's last snapshot; then the last
   // picture, which --screenshot keeps.

@@ -69,8 +69,9 @@ void add_app_commands(CLI::App& app, Registry& registry) {
   cmd->add_option("-o,--output", o.out_path, "where Ctrl+S saves the network (default: INPUT-app.fnet beside the "
                                               "input, or fire-app.fnet)");
   cmd->add_option("--export", o.export_path,
-                  "where E exports the surface; the extension chooses the format: .obj, .ply, .stl or .glb "
-                  "(default: the -o network's path with .obj)");
+                  "where E exports the surface; the extension chooses the format: .obj, .ply, .stl or .glb (in mm, "
+                  ".glb in m), or .step, .stp, .igs or .iges for B-spline patches in mm, written in the background once the "
+                  "surface has settled (default: the -o network's path with .obj)");
   cmd->add_option("--record", o.record_path, "write the session's input log here on exit (not with a .fnet input, nor with a session folder, whose "
                   "input.log is the record)");
   cmd->add_option("--size", o.size, "window size WIDTHxHEIGHT in pixels")->capture_default_str();

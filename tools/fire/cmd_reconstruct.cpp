@@ -4,10 +4,12 @@
 #include <nlohmann/json.hpp>
 
 #include "platform/clock.hpp"
+#include "platform/cad/cad_export.hpp"
 #include "platform/cage_io.hpp"
 #include "platform/network_file.hpp"
 #include "platform/surface_io.hpp"
 #include "systems/reconstruct/reconstruct.hpp"
+#include "systems/subdivide/bspline_patches.hpp"
 #include "tools/fire/commands.hpp"
 #include "tools/fire/surface_args.hpp"
 
@@ -36,8 +38,13 @@ int run_reconstruct(const ReconstructArgs& a, const CLI::App& cmd) {
     return 2;
   }
   // The outputs' formats are checked first, so a wrong extension costs no reconstruction.
-  if (!a.out_path.empty())
-    if (auto format = surface_format_of(a.out_path); !format) return fail(format.error());
+  const bool to_cad = !a.out_path.empty() && cad::cad_format_of(a.out_path).ok();
+  if (to_cad && !cad::cad_available())
+    return fail(a.out_path + ": this fire was built without OpenCASCADE, so it writes no STEP or IGES (install "
+                "libocct-data-exchange-dev and build again, or write a mesh: .obj, .ply, .stl, .glb)");
+  if (!a.out_path.empty() && !to_cad)
+    if (auto format = surface_format_of(a.out_path); !format)
+      return fail(format.error() + "; or .step, .stp, .igs, .iges for CAD");
   for (const std::string& path : a.cage_paths)
     if (Status s = check_cage_path(path); !s) return fail(s.error);
   auto unit = export_unit(a.units, cmd, {a.out_path});
@@ -51,8 +58,23 @@ int run_reconstruct(const ReconstructArgs& a, const CLI::App& cmd) {
   const Status built = reconstruct::reconstruct_update(*net, options, state, surface);
   const double seconds = double(monotonic_ns() - start) * 1e-9;
   if (!built) return fail(a.network_path + ": " + built.error);
-  if (!a.out_path.empty())
+  nlohmann::ordered_json cad_out;
+  if (to_cad) {
+    auto converted = subdivide::bspline_patches(reconstruct::cage_of(state, options, surface));
+    if (!converted) return fail(a.network_path + ": " + converted.error());
+    auto written = cad::write_cad(converted->patches, a.out_path, *unit);
+    if (!written) return fail(written.error());
+    cad_out["patches"] = converted->patches.patch_count();
+    cad_out["exact"] = converted->exact;
+    cad_out["fitted"] = converted->fitted;
+    cad_out["max_fit_error"] = converted->max_fit_error;
+    cad_out["solids"] = written->solids;
+    cad_out["shells"] = written->shells;
+    cad_out["free_edges"] = written->free_edges;
+    cad_out["units"] = unit_name(*unit);
+  } else if (!a.out_path.empty()) {
     if (auto written = write_surface(surface, a.out_path, *unit); !written) return fail(written.error);
+  }
   if (!a.cage_paths.empty()) {
     const Cage cage = reconstruct::cage_of(state, options, surface);
     for (const std::string& path : a.cage_paths)
@@ -74,6 +96,7 @@ int run_reconstruct(const ReconstructArgs& a, const CLI::App& cmd) {
   out["fairness"] = reconstruct::fit_fairness(options, reconstruct::fit_noise(noise, spread));
   out["short_curves"] = state.short_curves();
   out["joined_vertices"] = state.joined_vertices();
+  if (to_cad) out["cad"] = cad_out;
   std::cout << out.dump() << "\n";
   return 0;
 }
@@ -100,7 +123,11 @@ void add_reconstruct_commands(CLI::App& app, Registry& registry) {
       "vertices where just two curves meet, which the surface runs through as through any curve sample "
       "instead of making them vertices of its base mesh).");
   cmd->add_option("NET", a->network_path, "curve network file (format: engine/NETWORK_FORMAT.md)")->required();
-  cmd->add_option("-o,--output", a->out_path, "surface file to write: .obj, .ply, .stl or .glb");
+  cmd->add_option("-o,--output", a->out_path,
+                  "surface file to write: a mesh (.obj, .ply, .stl or .glb), or CAD (.step or .stp: STEP AP214; .igs or "
+                  ".iges: IGES): one bicubic B-spline patch per face of the limit surface, exact where the face is "
+                  "regular, fitted within 1e-4 of the diagonal around extraordinary vertices, sewn into one shell (a "
+                  "closed object a solid), in --units");
   cmd->add_option("--cage", a->cage_paths,
                   "also (or instead) write the subdivision cage whose Catmull-Clark limit the surface is: the base mesh "
                   "at its fitted points, for subdivision modellers; .obj with OpenSubdiv's tags (t interpolateboundary, "

@@ -576,6 +576,27 @@ TEST_CASE("fire app: an export that cannot be written says why and loses nothing
   fs::remove_all(dir);
 }
 
+TEST_CASE("fire app: E to a STEP file converts and writes it in the background, and exit waits for it",
+          "[app][window][export][cad]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("export_step");
+  const std::string script = (dir / "export.script").string(), exported = (dir / "surface.step").string();
+  REQUIRE(fire::write_file_atomic(script, "20 key e\n60 close\n"));
+  const Run app = run_app(310, quote(FIRE_DEMO_LOG) + " --size 320x200 --script " + quote(script) + " --export " + quote(exported), dir);
+  INFO("stdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  CHECK(app.err.find("exporting the surface to " + exported + " in the background") != std::string::npos);
+  // Finished during the session or waited for at its end, it is reported either way.
+  CHECK(app.err.find("B-spline patches (") != std::string::npos);
+  CHECK(app.err.find("fitted) to " + exported) != std::string::npos);
+  const auto step = fire::read_text_file(exported);
+  REQUIRE(step);
+  CHECK(step->starts_with("ISO-10303-21;"));
+  CHECK(step->find("SI_UNIT(.MILLI.,.METRE.)") != std::string::npos);
+  CHECK(step->find("B_SPLINE_SURFACE") != std::string::npos);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("fire app without a display: a clear message, exit 1, no crash", "[app][window]") {
   const fs::path dir = scratch("no_display");
   const Run app = run("env -u DISPLAY -u WAYLAND_DISPLAY " + quote(FIRE_BINARY) + " app " + quote(FIRE_DEMO_LOG), dir);
