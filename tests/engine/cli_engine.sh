@@ -48,6 +48,7 @@ usage_exit() { "$@" >/dev/null 2>"$tmp/err"; [ $? -eq 2 ]; }
 check "an unknown command exits 2, named" "usage_exit '$fire' frobnicate && grep -q \"fire: 'frobnicate' is not a command\" '$tmp/err'"
 check "an unknown option exits 2, naming the command" "usage_exit '$fire' replay --bogus && grep -q '^fire replay: .*--bogus' '$tmp/err'"
 check "a malformed value exits 2, naming the subcommand" "usage_exit '$fire' simulate drawing --seed x && grep -q '^fire simulate drawing: ' '$tmp/err'"
+check "an unknown option of reconstruct exits 2, naming it" "usage_exit '$fire' reconstruct x.fnet -o x.obj --frobnicate && grep -q '^fire reconstruct: .*--frobnicate' '$tmp/err'"
 check "no command exits 2" "usage_exit '$fire'"
 check "--version names the version and the commit" "'$fire' --version | grep -q '^fire [0-9][0-9.]* (commit [0-9a-f]'"
 head -c 300 "$tmp/demo.fnet" >"$tmp/trunc.fnet"
