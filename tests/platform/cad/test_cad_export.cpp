@@ -13,6 +13,7 @@
 #include "../../temp_dir.hpp"
 #include "platform/cad/cad_export.hpp"
 #include "platform/obj.hpp"
+#include "systems/evaluate/evaluate.hpp"
 #include "systems/reconstruct/reconstruct.hpp"
 #include "systems/subdivide/bspline_patches.hpp"
 #include "systems/synth/network_from_mesh.hpp"
@@ -176,6 +177,37 @@ TEST_CASE("the pawn as STEP and IGES: one valid shell of a face per patch, open 
       farthest = std::max(farthest, distance_to_segments(middle / 1000.0, border) / diagonal);
     CHECK(farthest < 1e-9);
   }
+}
+
+TEST_CASE("the pawn read back from STEP lies on FIRE's limit surface within the tolerance at 10^5 points", "[cad]") {
+  fire::test::TempDir dir;
+  const fire::Cage cage = cage_of("pawn");
+  const sd::BsplineConversion c = patches_of(cage);
+  const std::string path = (dir.path / "pawn.step").string();
+  REQUIRE(cad::write_cad(c.patches, path).ok());
+  // 12 x 12 points of each face's surface as OpenCASCADE reads it: 720 faces, 103,680 points.
+  auto info = cad::read_cad(path, 12);
+  INFO(info.error());
+  REQUIRE(info.ok());
+  REQUIRE(info->samples.size() >= 100'000);
+  std::vector<Vec3> samples(info->samples.size());
+  std::transform(info->samples.begin(), info->samples.end(), samples.begin(), [](const Vec3& mm) { return mm / 1000.0; });
+  // FIRE's limit surface, four levels down from the cage (a chord there is far under the tolerance).
+  const sd::BaseTopology topology{uint32_t(cage.mesh.positions.size()), cage.mesh.face_offsets, cage.mesh.face_vertices,
+                                  cage.sharp_edges, cage.border_corners};
+  auto refinement = sd::build_refinement(topology, {.levels = 4});
+  REQUIRE(refinement.ok());
+  auto limit = sd::build_limit_stencils(*refinement);
+  REQUIRE(limit.ok());
+  std::vector<Vec3> last, scratch, positions, normals;
+  sd::evaluate(*refinement, cage.mesh.positions, last, scratch);
+  sd::evaluate_limit(*limit, last, positions, normals);
+  auto surface = fire::evaluate::triangulate(positions, refinement->last().face_offsets, refinement->last().face_vertices);
+  REQUIRE(surface.ok());
+  const fire::evaluate::TriangleBvh bvh(*surface);
+  const fire::evaluate::OneSided d = fire::evaluate::distances_to(samples, bvh);
+  CHECK(d.max <= 1e-4 * c.diagonal);
+  CHECK(d.max > 0);  // the fitted patches around the pole are not the limit itself
 }
 
 TEST_CASE("the egg, a closed object, is one solid in both formats, in mm or cm", "[cad]") {
