@@ -1,6 +1,9 @@
 #include "platform/obj.hpp"
 
+#include <algorithm>
 #include <charconv>
+#include <cmath>
+#include <map>
 
 #include "engine/text.hpp"
 #include "platform/files.hpp"
@@ -73,6 +76,81 @@ Result<PolygonMesh> read_obj(const std::string& path) {
   auto text = read_text_file(path);
   if (!text) return Result<PolygonMesh>::failure(text.error());
   return parse_obj(*text, path);
+}
+
+Result<SubdivisionTags> parse_obj_tags(std::string_view text, const std::string& source, const PolygonMesh& mesh) {
+  using R = Result<SubdivisionTags>;
+  auto fail = [&](size_t line, const std::string& why) { return R::failure(source + ":" + std::to_string(line) + ": " + why); };
+  const size_t n = mesh.positions.size();
+  std::vector<uint32_t> creases;
+  std::vector<std::pair<size_t, uint32_t>> corners;  // (line, vertex)
+  int boundary = 1;
+  size_t pos = 0, line_no = 0;
+  while (pos < text.size()) {
+    size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    const std::vector<std::string_view> f = split_fields(text.substr(pos, end - pos));
+    pos = end + 1;
+    ++line_no;
+    if (f.empty() || f[0] != "t") continue;
+    auto number = [&](size_t k, double& value) {
+      const auto [ptr, ec] = std::from_chars(f[k].data(), f[k].data() + f[k].size(), value);
+      return ec == std::errc() && ptr == f[k].data() + f[k].size() && std::isfinite(value);
+    };
+    auto vertex = [&](size_t k, uint32_t& v) {
+      double x = 0;
+      if (!number(k, x) || x < 0 || x >= double(n) || x != std::floor(x)) return false;
+      v = uint32_t(x);
+      return true;
+    };
+    const std::string name = f.size() > 1 ? std::string(f[1]) : "";
+    if (name == "crease" && f.size() == 6 && f[2] == "2/1/0") {
+      uint32_t a = 0, b = 0;
+      double sharpness = 0;
+      if (!vertex(3, a) || !vertex(4, b)) return fail(line_no, "crease: vertex indices (from 0) of " + std::to_string(n) + " vertices expected");
+      if (!number(5, sharpness) || sharpness < 10)
+        return fail(line_no, "crease sharpness " + std::string(f[5]) + ": FIRE's subdivision takes only infinitely sharp creases (10 or more)");
+      creases.insert(creases.end(), {a, b});
+    } else if (name == "corner" && f.size() == 5 && f[2] == "1/1/0") {
+      uint32_t v = 0;
+      double sharpness = 0;
+      if (!vertex(3, v)) return fail(line_no, "corner: a vertex index (from 0) of " + std::to_string(n) + " vertices expected");
+      if (!number(4, sharpness) || sharpness < 10)
+        return fail(line_no, "corner sharpness " + std::string(f[4]) + ": FIRE's subdivision takes only infinitely sharp corners (10 or more)");
+      corners.push_back({line_no, v});
+    } else if (name == "interpolateboundary" && f.size() == 4 && f[2] == "1/0/0" && (f[3] == "1" || f[3] == "2")) {
+      boundary = f[3] == "1" ? 1 : 2;
+    } else {
+      return fail(line_no, "tag '" + name +
+                               "' is not one FIRE's subdivision honours (t crease 2/1/0 A B S, t corner 1/1/0 V S, "
+                               "t interpolateboundary 1/0/0 1 or 2)");
+    }
+  }
+  SubdivisionTags tags;
+  tags.sharp_edges = std::move(creases);
+  if (boundary == 1 && corners.empty()) return tags;
+  // Faces per vertex and per edge: border vertices, and those of one face (EdgeAndCorner's corners).
+  std::vector<uint32_t> faces_at(n, 0);
+  std::map<std::pair<uint32_t, uint32_t>, uint32_t> uses;
+  for (size_t face = 0; face < mesh.face_count(); ++face) {
+    const auto fv = mesh.face(face);
+    for (size_t k = 0; k < fv.size(); ++k) {
+      ++faces_at[fv[k]];
+      const uint32_t a = fv[k], b = fv[(k + 1) % fv.size()];
+      ++uses[{std::min(a, b), std::max(a, b)}];
+    }
+  }
+  std::vector<uint8_t> border(n, 0);
+  for (const auto& [edge, count] : uses)
+    if (count == 1) border[edge.first] = border[edge.second] = 1;
+  tags.border_corners.assign(n, 0);
+  if (boundary == 1)
+    for (uint32_t v = 0; v < n; ++v) tags.border_corners[v] = border[v] && faces_at[v] == 1;
+  for (const auto& [line, v] : corners) {
+    if (!border[v]) return fail(line, "corner at vertex " + std::to_string(v) + ", which is not on the border: FIRE's subdivision makes corners of border vertices only");
+    tags.border_corners[v] = 1;
+  }
+  return tags;
 }
 
 }  // namespace fire

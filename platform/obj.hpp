@@ -15,4 +15,15 @@ namespace fire {
 Result<PolygonMesh> parse_obj(std::string_view text, const std::string& source);
 Result<PolygonMesh> read_obj(const std::string& path);
 
+// OpenSubdiv's subdivision tags in an OBJ (its regression shapes', and `fire reconstruct --cage`'s), as FIRE's
+// Catmull-Clark takes them: `t crease 2/1/0 A B S` and `t corner 1/1/0 V S` with vertex indices from 0 and S
+// at least 10 (infinitely sharp), `t interpolateboundary 1/0/0 K` with K 1 (EdgeAndCorner, the default) or 2
+// (EdgeOnly). Anything FIRE's subdivision cannot honour (a finite sharpness, a corner off the border, another
+// boundary rule, another tag) is an error naming the line, never ignored.
+struct SubdivisionTags {
+  std::vector<uint32_t> sharp_edges;    // vertex pairs
+  std::vector<uint8_t> border_corners;  // per vertex; empty for EdgeAndCorner without `t corner`
+};
+Result<SubdivisionTags> parse_obj_tags(std::string_view text, const std::string& source, const PolygonMesh& mesh);
+
 }  // namespace fire

@@ -48,7 +48,8 @@ SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleBvh& a_bvh
 }
 
 Result<TriangleMesh> reference_limit_surface(std::span<const Vec3> positions, std::span<const uint32_t> face_offsets,
-                                             std::span<const uint32_t> face_vertices, int levels) {
+                                             std::span<const uint32_t> face_vertices, int levels,
+                                             std::span<const uint32_t> sharp_edges, std::span<const uint8_t> border_corners) {
   using R = Result<TriangleMesh>;
   // Measuring against the reference costs about half a kilobyte per quad (limit points, triangles, BVH,
   // samples): a dense surface given as the control mesh would exhaust memory, so it is refused up front.
@@ -58,7 +59,7 @@ Result<TriangleMesh> reference_limit_surface(std::span<const Vec3> positions, st
                       " quads at " + std::to_string(levels) + " Catmull-Clark levels, more than the " +
                       std::to_string(kMaxReferenceQuads) +
                       " a reference may have; give the coarse control mesh, not a dense surface");
-  auto sub = subdivide::subdivide({positions, face_offsets, face_vertices, {}}, levels);
+  auto sub = subdivide::subdivide({positions, face_offsets, face_vertices, sharp_edges, border_corners}, levels);
   if (!sub) return R::failure(sub.error());
   TriangleMesh mesh;
   mesh.positions = std::move(sub->limit_positions);

@@ -102,12 +102,15 @@ struct SurfaceDistance {
 SurfaceDistance surface_distance(const TriangleMesh& a, const TriangleBvh& a_bvh, const TriangleMesh& b,
                                  const TriangleBvh& b_bvh, double spacing, double scale);
 
-// The ground truth of a control mesh: Catmull-Clark (fire_subdivide, EdgeAndCorner) to `levels` and the
-// last level's vertices projected to their limit positions, each quad split along its shorter diagonal.
+// The ground truth of a control mesh: Catmull-Clark (fire_subdivide: EdgeAndCorner, or with `border_corners`
+// the border's corners given; `sharp_edges` infinitely sharp) to `levels` and the last level's vertices
+// projected to their limit positions, each quad split along its shorter diagonal.
 // Errors are fire_subdivide's (non-manifold edge or vertex, bad faces, non-finite positions, size), and
 // more than kMaxReferenceQuads quads at `levels`.
 inline constexpr uint64_t kMaxReferenceQuads = uint64_t{1} << 24;
 Result<TriangleMesh> reference_limit_surface(std::span<const Vec3> positions, std::span<const uint32_t> face_offsets,
-                                             std::span<const uint32_t> face_vertices, int levels);
+                                             std::span<const uint32_t> face_vertices, int levels,
+                                             std::span<const uint32_t> sharp_edges = {},
+                                             std::span<const uint8_t> border_corners = {});
 
 }  // namespace fire::evaluate

@@ -380,7 +380,7 @@ Result<SubdividedMesh> subdivide(const SubdivisionInput& input, int levels) {
     if (!is_finite(input.positions[v]))
       return Result<SubdividedMesh>::failure("vertex " + std::to_string(v) + " has a non-finite coordinate");
   const BaseTopology base{static_cast<uint32_t>(input.positions.size()), input.face_offsets, input.face_vertices,
-                          input.sharp_edges};
+                          input.sharp_edges, input.border_corners};
   Result<Refinement> refinement = build_refinement(base, {levels, true});
   if (!refinement) return Result<SubdividedMesh>::failure(refinement.error());
   Result<LimitStencils> limit = build_limit_stencils(*refinement);

@@ -219,6 +219,7 @@ struct SubdivisionInput {
   std::span<const uint32_t> face_offsets;
   std::span<const uint32_t> face_vertices;
   std::span<const uint32_t> sharp_edges;
+  std::span<const uint8_t> border_corners = {};  // as BaseTopology's
 };
 struct SubdividedMesh {
   std::vector<Vec3> positions;         // last level points

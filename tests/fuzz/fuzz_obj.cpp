@@ -1,6 +1,6 @@
 // OBJ reader (parse_obj): a failed parse names the input, the line and the problem; a parsed mesh has
 // finite positions and faces of 3 or more distinct vertices in range, and written back as an OBJ surface
-// it reads back to the same positions and faces.
+// it reads back to the same positions and faces; its OpenSubdiv tags are read or refused in words.
 #include <cstdint>
 #include <string_view>
 
@@ -29,6 +29,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       for (uint32_t d = mesh->face_offsets[f]; d < c; ++d)
         FUZZ_CHECK(mesh->face_vertices[d] != mesh->face_vertices[c], "a face uses each vertex once");
     }
+  }
+  // OpenSubdiv's tags: refused in words, or creases between vertices that exist and corners one flag per vertex.
+  const Result<SubdivisionTags> tags = parse_obj_tags(text, fuzz::kSource, *mesh);
+  if (!tags) {
+    FUZZ_CHECK(fuzz::names_input_and_problem(tags.error()), "a refused tag names the input and the problem");
+  } else {
+    FUZZ_CHECK(tags->sharp_edges.size() % 2 == 0, "creases are vertex pairs");
+    for (uint32_t v : tags->sharp_edges) FUZZ_CHECK(v < mesh->positions.size(), "crease vertices are in range");
+    FUZZ_CHECK(tags->border_corners.empty() || tags->border_corners.size() == mesh->positions.size(),
+               "border corners are one flag per vertex");
   }
   SurfaceMesh surface;
   surface.positions = mesh->positions;

@@ -91,5 +91,22 @@ check "STEP: patches, sewn into one shell with its border free, in mm" "grep -q 
 check "IGES in metres" "[ -s '$tmp/u.IGES' ] && grep -q '\"units\":\"m\"' <<<\"\$('$fire' reconstruct '$tmp/square.fnet' -o '$tmp/u.IGES' --units m)\""
 expect_error "STEP into a folder that is not there" "fire reconstruct: .*no/such/dir/x.step" "$tmp/no/such/dir/x.step" \
   "$fire" reconstruct "$tmp/square.fnet" -o "$tmp/no/such/dir/x.step"
-check "nothing else was left in the folder" "[ -z \"\$(ls '$tmp' | grep -v -e '\\.fnet\$' -e '^square\\.' -e '^s\\.' -e '^digon\\.obj\$' -e '^u\\.stl\$' -e '^u_m\\.obj\$' -e '^u_mm\\.obj\$' -e '^u_cage\\.obj\$' -e '^u_cage\\.usda\$' -e '^u\\.step\$' -e '^u\\.IGES\$' -e '^stdout\$' -e '^err\$')\" ]"
+# A cage with a sharp curve as fire eval's reference: its tags are honoured (the crease measured as a crease), and
+# a tag FIRE's subdivision cannot honour is refused by its line.
+network ridge "$(v 0,0,0),$(v 1,0,0),$(v 2,0,0),$(v 2,1,0),$(v 1,1,0),$(v 0,1,0)" \
+  "$(e 0,1 '[0,0,0],[0.5,0,0.1],[1,0,0]'),$(e 1,4 '[1,0,0],[1,0.5,0.3],[1,1,0]'),$(e 4,5 '[1,1,0],[0.5,1,0.1],[0,1,0]'),$(e 5,0 '[0,1,0],[0,0.5,0.1],[0,0,0]'),$(e 1,2 '[1,0,0],[1.5,0,0.1],[2,0,0]'),$(e 2,3 '[2,0,0],[2,0.5,0.1],[2,1,0]'),$(e 3,4 '[2,1,0],[1.5,1,0.1],[1,1,0]')" \
+  '{"edges":[0,1,2,3],"reversed":[false,false,false,false]},{"edges":[4,5,6,1],"reversed":[false,false,false,true]}'
+sed -i 's/"v":\[1,4\],"sharp":false/"v":[1,4],"sharp":true/' "$tmp/ridge.fnet"
+"$fire" reconstruct "$tmp/ridge.fnet" -o "$tmp/u_ridge.obj" --cage "$tmp/u_ridge_cage.obj" --levels 4 >/dev/null
+sed '/^t /d' "$tmp/u_ridge_cage.obj" >"$tmp/u_ridge_untagged.obj"
+eval_rms() { "$fire" eval "$tmp/u_ridge.obj" --reference "$1" | sed 's/.*"rms":\([0-9.e+-]*\).*/\1/'; }
+check "fire eval honours the cage's crease: the surface measured against its own cage, not a rounded one" \
+  "grep -q '^t crease 2/1/0 ' '$tmp/u_ridge_cage.obj' && awk -v a=\$(eval_rms '$tmp/u_ridge_cage.obj') -v b=\$(eval_rms '$tmp/u_ridge_untagged.obj') 'BEGIN { exit !(a < 2e-4 && b > 10 * a) }'"
+sed 's/^\(t crease 2\/1\/0 [0-9]* [0-9]*\) 10$/\1 2.5/' "$tmp/u_ridge_cage.obj" >"$tmp/u_ridge_soft.obj"
+expect_error "a finite crease in a reference" "u_ridge_soft.obj:[0-9]*: crease sharpness 2.5: FIRE's subdivision takes only infinitely sharp creases" \
+  "$tmp/none" "$fire" eval "$tmp/u_ridge.obj" --reference "$tmp/u_ridge_soft.obj"
+{ cat "$tmp/u_ridge_cage.obj"; echo 't hole 1/0/0 0'; } >"$tmp/u_ridge_hole.obj"
+expect_error "a tag FIRE cannot honour" "u_ridge_hole.obj:[0-9]*: tag 'hole' is not one FIRE's subdivision honours" \
+  "$tmp/none" "$fire" eval "$tmp/u_ridge.obj" --reference "$tmp/u_ridge_hole.obj"
+check "nothing else was left in the folder" "[ -z \"\$(ls '$tmp' | grep -v -e '\\.fnet\$' -e '^square\\.' -e '^s\\.' -e '^digon\\.obj\$' -e '^u\\.stl\$' -e '^u_m\\.obj\$' -e '^u_mm\\.obj\$' -e '^u_cage\\.obj\$' -e '^u_cage\\.usda\$' -e '^u\\.step\$' -e '^u_ridge' -e '^u\\.IGES\$' -e '^stdout\$' -e '^err\$')\" ]"
 exit $fail

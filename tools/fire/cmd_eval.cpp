@@ -8,6 +8,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "platform/files.hpp"
 #include "platform/network_file.hpp"
 #include "platform/obj.hpp"
 #include "platform/surface_io.hpp"
@@ -52,10 +53,15 @@ int run_eval(const EvalArgs& a) {
   auto out_mesh = evaluate::triangulate(surface->positions, surface->face_offsets, surface->face_vertices);
   if (!out_mesh) return fail(a.surface_path + ": " + out_mesh.error());
 
-  auto control = read_obj(a.reference_path);
+  auto control_text = read_text_file(a.reference_path);
+  if (!control_text) return fail(control_text.error());
+  auto control = parse_obj(*control_text, a.reference_path);
   if (!control) return fail(control.error());
+  // A cage from fire reconstruct --cage, or one of OpenSubdiv's shapes, says which edges are creases.
+  auto tags = parse_obj_tags(*control_text, a.reference_path, *control);
+  if (!tags) return fail(tags.error());
   auto reference = evaluate::reference_limit_surface(control->positions, control->face_offsets, control->face_vertices,
-                                                     a.reference_levels);
+                                                     a.reference_levels, tags->sharp_edges, tags->border_corners);
   if (!reference) return fail(a.reference_path + ": reference mesh cannot be subdivided: " + reference.error());
   const double diagonal = bounding_box_diagonal(reference->positions);
   if (!(diagonal > 0) || !std::isfinite(diagonal))
@@ -140,7 +146,9 @@ void add_eval_commands(CLI::App& app, Registry& registry) {
   cmd->add_option("SURFACE", a->surface_path, "surface to measure: .obj, .ply, .stl or .glb as `fire reconstruct` writes")
       ->required();
   cmd->add_option("--reference", a->reference_path,
-                  "control mesh (OBJ) whose limit surface is the ground truth; must be manifold")
+                  "control mesh (OBJ) whose limit surface is the ground truth; must be manifold. OpenSubdiv's tags in it "
+                  "are honoured (t crease and t corner, infinitely sharp; t interpolateboundary 1 or 2), as `fire "
+                  "reconstruct --cage` writes them")
       ->required();
   cmd->add_option("--network", a->network_path, "curve network whose polyline points are measured to SURFACE");
   cmd->add_option("--reference-levels", a->reference_levels,
