@@ -4,11 +4,11 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
-#include <map>
 #include <utility>
 #include <vector>
 
 #include "platform/files.hpp"
+#include "platform/obj.hpp"
 
 namespace fire {
 
@@ -18,22 +18,6 @@ void append_number(std::string& out, double value) {
   char buf[32];
   const auto r = std::to_chars(buf, buf + sizeof buf, value);
   out.append(buf, r.ptr);
-}
-
-// Vertices on the border: ends of an edge that one face alone uses.
-std::vector<uint8_t> border_vertices(const PolygonMesh& mesh) {
-  std::map<std::pair<uint32_t, uint32_t>, uint32_t> uses;
-  for (size_t f = 0; f < mesh.face_count(); ++f) {
-    const auto face = mesh.face(f);
-    for (size_t k = 0; k < face.size(); ++k) {
-      const uint32_t a = face[k], b = face[(k + 1) % face.size()];
-      ++uses[{std::min(a, b), std::max(a, b)}];
-    }
-  }
-  std::vector<uint8_t> border(mesh.positions.size(), 0);
-  for (const auto& [edge, count] : uses)
-    if (count == 1) border[edge.first] = border[edge.second] = 1;
-  return border;
 }
 
 // The border vertices FIRE's rule makes corners (flags of inner vertices mean nothing to it).
@@ -64,9 +48,7 @@ Status check_cage(const Cage& cage) {
 }  // namespace
 
 Status check_cage_path(const std::string& path) {
-  const size_t dot = path.find_last_of('.'), slash = path.find_last_of('/');
-  std::string ext = dot == std::string::npos || (slash != std::string::npos && dot < slash) ? "" : path.substr(dot + 1);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const std::string ext = file_extension(path);
   if (ext == "obj" || ext == "usda") return Status::success();
   return Status::failure(path + ": unknown cage format '" + ext + "' (the extension must be .obj or .usda)");
 }
@@ -152,10 +134,7 @@ Result<std::string> encode_cage_usda(const Cage& cage, LengthUnit unit) {
 
 Status write_cage(const Cage& cage, const std::string& path, LengthUnit unit) {
   if (Status s = check_cage_path(path); !s) return s;
-  const bool usda = path.size() >= 5 && std::equal(path.end() - 5, path.end(), ".usda", [](char a, char b) {
-                      return std::tolower(static_cast<unsigned char>(a)) == b;
-                    });
-  Result<std::string> text = usda ? encode_cage_usda(cage, unit) : encode_cage_obj(cage, unit);
+  Result<std::string> text = file_extension(path) == "usda" ? encode_cage_usda(cage, unit) : encode_cage_obj(cage, unit);
   if (!text) return Status::failure(path + ": cannot export the cage: " + text.error());
   return write_file_atomic(path, *text);
 }

@@ -1,6 +1,7 @@
 #include "platform/files.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -135,6 +136,13 @@ Status AppendFile::append(std::string_view data) {
 Status AppendFile::sync() {
   if (::fdatasync(fd_) != 0) return Status::failure(path_ + ": fsync failed (" + std::strerror(errno) + ")");
   return Status::success();
+}
+
+std::string file_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  if (!ext.empty()) ext.erase(0, 1);
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
 }
 
 Result<std::string> bundled_data_file(const std::string& relative) {

@@ -26,6 +26,10 @@ Result<std::vector<std::string>> list_directory(const std::string& path);
 Status sync_directory(const std::string& path);
 Status remove_file(const std::string& path);
 
+// The extension of a file name, lower case and without the dot ("" when it has none): what the exporters and
+// readers choose a format by.
+std::string file_extension(const std::string& path);
+
 // A file of the data FIRE bundles (the meshes, under tests/data/ in the repository and share/fire/ once
 // installed), found from the running executable, so no path is compiled in: in its folder or up to three
 // above it, `share/fire/RELATIVE` (an install: bin/fire) or `tests/data/RELATIVE` (a checkout: build/fire,

@@ -78,6 +78,21 @@ Result<PolygonMesh> read_obj(const std::string& path) {
   return parse_obj(*text, path);
 }
 
+std::vector<uint8_t> border_vertices(const PolygonMesh& mesh) {
+  std::map<std::pair<uint32_t, uint32_t>, uint32_t> uses;
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    const auto face = mesh.face(f);
+    for (size_t k = 0; k < face.size(); ++k) {
+      const uint32_t a = face[k], b = face[(k + 1) % face.size()];
+      ++uses[{std::min(a, b), std::max(a, b)}];
+    }
+  }
+  std::vector<uint8_t> border(mesh.positions.size(), 0);
+  for (const auto& [edge, count] : uses)
+    if (count == 1) border[edge.first] = border[edge.second] = 1;
+  return border;
+}
+
 Result<SubdivisionTags> parse_obj_tags(std::string_view text, const std::string& source, const PolygonMesh& mesh) {
   using R = Result<SubdivisionTags>;
   auto fail = [&](size_t line, const std::string& why) { return R::failure(source + ":" + std::to_string(line) + ": " + why); };
@@ -129,20 +144,10 @@ Result<SubdivisionTags> parse_obj_tags(std::string_view text, const std::string&
   SubdivisionTags tags;
   tags.sharp_edges = std::move(creases);
   if (boundary == 1 && corners.empty()) return tags;
-  // Faces per vertex and per edge: border vertices, and those of one face (EdgeAndCorner's corners).
+  // Border vertices, and those of one face (EdgeAndCorner's corners).
   std::vector<uint32_t> faces_at(n, 0);
-  std::map<std::pair<uint32_t, uint32_t>, uint32_t> uses;
-  for (size_t face = 0; face < mesh.face_count(); ++face) {
-    const auto fv = mesh.face(face);
-    for (size_t k = 0; k < fv.size(); ++k) {
-      ++faces_at[fv[k]];
-      const uint32_t a = fv[k], b = fv[(k + 1) % fv.size()];
-      ++uses[{std::min(a, b), std::max(a, b)}];
-    }
-  }
-  std::vector<uint8_t> border(n, 0);
-  for (const auto& [edge, count] : uses)
-    if (count == 1) border[edge.first] = border[edge.second] = 1;
+  for (uint32_t v : mesh.face_vertices) ++faces_at[v];
+  const std::vector<uint8_t> border = border_vertices(mesh);
   tags.border_corners.assign(n, 0);
   if (boundary == 1)
     for (uint32_t v = 0; v < n; ++v) tags.border_corners[v] = border[v] && faces_at[v] == 1;

@@ -15,6 +15,9 @@ namespace fire {
 Result<PolygonMesh> parse_obj(std::string_view text, const std::string& source);
 Result<PolygonMesh> read_obj(const std::string& path);
 
+// Per vertex, 1 where it lies on the mesh's border (an end of an edge one face alone uses).
+std::vector<uint8_t> border_vertices(const PolygonMesh& mesh);
+
 // OpenSubdiv's subdivision tags in an OBJ (its regression shapes', and `fire reconstruct --cage`'s), as FIRE's
 // Catmull-Clark takes them: `t crease 2/1/0 A B S` and `t corner 1/1/0 V S` with vertex indices from 0 and S
 // at least 10 (infinitely sharp), `t interpolateboundary 1/0/0 K` with K 1 (EdgeAndCorner, the default) or 2

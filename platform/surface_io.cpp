@@ -740,10 +740,7 @@ Result<LengthUnit> length_unit_of(std::string_view name) {
 }
 
 Result<SurfaceFormat> surface_format_of(const std::string& path) {
-  const size_t dot = path.find_last_of('.');
-  const size_t slash = path.find_last_of('/');
-  std::string ext = dot == std::string::npos || (slash != std::string::npos && dot < slash) ? "" : path.substr(dot + 1);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const std::string ext = file_extension(path);
   if (ext == "obj") return SurfaceFormat::obj;
   if (ext == "ply") return SurfaceFormat::ply;
   if (ext == "stl") return SurfaceFormat::stl;

@@ -1,6 +1,7 @@
 // fire reconstruct: a curve network to a smooth surface file (thesis chapter 6, or the FIRE pipeline).
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "platform/clock.hpp"
@@ -58,9 +59,12 @@ int run_reconstruct(const ReconstructArgs& a, const CLI::App& cmd) {
   const Status built = reconstruct::reconstruct_update(*net, options, state, surface);
   const double seconds = double(monotonic_ns() - start) * 1e-9;
   if (!built) return fail(a.network_path + ": " + built.error);
+  // The cage, once, for the CAD export and the cage files.
+  std::optional<Cage> cage;
+  if (to_cad || !a.cage_paths.empty()) cage = reconstruct::cage_of(state, options, surface);
   nlohmann::ordered_json cad_out;
   if (to_cad) {
-    auto converted = subdivide::bspline_patches(reconstruct::cage_of(state, options, surface));
+    auto converted = subdivide::bspline_patches(*cage);
     if (!converted) return fail(a.network_path + ": " + converted.error());
     auto written = cad::write_cad(converted->patches, a.out_path, *unit);
     if (!written) return fail(written.error());
@@ -75,11 +79,8 @@ int run_reconstruct(const ReconstructArgs& a, const CLI::App& cmd) {
   } else if (!a.out_path.empty()) {
     if (auto written = write_surface(surface, a.out_path, *unit); !written) return fail(written.error);
   }
-  if (!a.cage_paths.empty()) {
-    const Cage cage = reconstruct::cage_of(state, options, surface);
-    for (const std::string& path : a.cage_paths)
-      if (Status written = write_cage(cage, path, *unit); !written) return fail(written.error);
-  }
+  for (const std::string& path : a.cage_paths)
+    if (Status written = write_cage(*cage, path, *unit); !written) return fail(written.error);
 
   nlohmann::ordered_json out;
   out["method"] = a.surface.method;
