@@ -1,9 +1,13 @@
 #include "systems/sketch/sketch.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>  // cross products
 #include <algorithm>
+#include <cmath>
 #include <iterator>
 #include <limits>
+#include <numbers>
+#include <numeric>
 #include <optional>
 
 #include "engine/text.hpp"
@@ -113,6 +117,114 @@ HoleSnap snap_to_hole(const Mesh& m, const SnapIndex& index, const Vec3& start, 
   out.start = {a.edge, a.point};
   out.end = {b.edge, b.point};
   return out;
+}
+
+// Which side of its boundary a face lies on at a stroke's end, seen from the camera (`viewpoint`, a point the
+// pen's side of the surface faces: the cameras saw the pen draw there).
+constexpr double kSideReach = 0.005;  // metres: directions from points this far along, past the pen's jitter
+
+// The direction from `from` to the first point of `line` at least kSideReach away (or its last point).
+Vec3 direction_along(std::span<const Vec3> line, const Vec3& from) {
+  for (const Vec3& p : line)
+    if ((p - from).norm() >= kSideReach) return (p - from).normalized();
+  return (line.back() - from).normalized();
+}
+
+// The curves at a vertex in counter-clockwise order about the surface's normal there, turned toward the camera.
+struct Fan {
+  Vec3 at, normal, first;  // `first`: where angles start, in the plane
+  std::vector<std::pair<double, uint32_t>> edges;  // angle about `normal`, edge
+  double angle(const Vec3& d) const {
+    const Vec3 w = normal.cross(first);
+    const double a = std::atan2(d.dot(w), d.dot(first));
+    return a < 0 ? a + 2 * std::numbers::pi : a;
+  }
+};
+
+// At vertex v with three or more curves: the normal is the one their directions (and the stroke's, `d`) leave
+// least of, turned toward the camera. nullopt with fewer curves.
+std::optional<Fan> fan_at(const Mesh& m, uint32_t v, const Vec3& d, const Vec3& viewpoint) {
+  Fan fan;
+  fan.at = m.vertices.position[v];
+  std::vector<std::pair<uint32_t, Vec3>> directions;
+  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+    if (!m.edge_alive(e) || m.is_loose_edge(e)) continue;
+    const std::span<const Vec3> line = m.polyline(e);
+    for (int side = 0; side < 2; ++side)
+      if (m.edges.vertex[e][side] == v) {
+        const std::vector<Vec3> from_v = side == 0 ? std::vector<Vec3>(line.begin(), line.end()) : std::vector<Vec3>(line.rbegin(), line.rend());
+        directions.emplace_back(e, direction_along(from_v, fan.at));
+      }
+  }
+  if (directions.size() < 3) return std::nullopt;
+  Eigen::Matrix3d moments = d * d.transpose();
+  for (const auto& [e, u] : directions) moments += u * u.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(moments);
+  fan.normal = solver.eigenvectors().col(0);
+  if (fan.normal.dot(viewpoint - fan.at) < 0) fan.normal = -fan.normal;
+  fan.first = (directions.front().second - directions.front().second.dot(fan.normal) * fan.normal).normalized();
+  for (const auto& [e, u] : directions) fan.edges.emplace_back(fan.angle(u), e);
+  std::sort(fan.edges.begin(), fan.edges.end());
+  return fan;
+}
+
+// +1 where the faces at a fan walk counter-clockwise about its normal (each face's curve out of the vertex is
+// followed, counter-clockwise, by its curve in), -1 where clockwise; 0 where they do not say.
+int fan_turn(const Mesh& m, const Fan& fan, uint32_t v) {
+  const size_t n = fan.edges.size();
+  auto rank = [&](uint32_t e) {
+    return size_t(std::find_if(fan.edges.begin(), fan.edges.end(), [&](const auto& x) { return x.second == e; }) - fan.edges.begin());
+  };
+  int votes = 0;
+  for (uint32_t f = 0; f < m.face_slots(); ++f) {
+    if (!m.face_alive(f)) continue;
+    const std::span<const uint32_t> loop = m.face_loop(f);
+    for (size_t i = 0; i < loop.size(); ++i) {
+      const uint32_t in = loop[i], out = loop[(i + 1) % loop.size()];
+      if (m.head(in) != v || edge_of(in) == edge_of(out)) continue;
+      const size_t r_in = rank(edge_of(in)), r_out = rank(edge_of(out));
+      if (r_in == n || r_out == n) continue;
+      if (r_in == (r_out + 1) % n) ++votes;
+      else if (r_out == (r_in + 1) % n) --votes;
+    }
+  }
+  return votes > 0 ? 1 : votes < 0 ? -1 : 0;
+}
+
+// Whether a stroke leaving the boundary point `end` of face f along `path` (from that end on) goes into f. At a
+// vertex, f's sector lies counter-clockwise from its curve out to its curve in about the fan's normal when the
+// faces turn that way there (`turn`); elsewhere, f lies to the left of its walk about the normal. `normal`: the
+// surface's normal there, toward the camera.
+bool goes_into(const Mesh& m, uint32_t f, const CurveEnd& end, std::span<const Vec3> path, const Vec3& normal, int turn) {
+  const Vec3 q = m.polyline(end.edge)[end.point];
+  const std::vector<Vec3> loop = m.face_boundary(f);
+  const size_t n = loop.size(), at = size_t(std::find(loop.begin(), loop.end(), q) - loop.begin());
+  if (at == n) return true;
+  std::vector<Vec3> ahead, behind;
+  for (size_t k = 1; k < n; ++k) ahead.push_back(loop[(at + k) % n]), behind.push_back(loop[(at + n - k) % n]);
+  const Vec3 up = double(turn) * normal;
+  auto flat = [&](const Vec3& x) { return Vec3(x - x.dot(up) * up); };
+  const Vec3 u = flat(direction_along(ahead, q)).normalized(), w = up.cross(u);
+  auto angle = [&](const Vec3& x) {
+    const double a = std::atan2(flat(x).dot(w), flat(x).dot(u));
+    return a < 0 ? a + 2 * std::numbers::pi : a;
+  };
+  const double beta = angle(direction_along(path, q));
+  return beta > 0 && beta < angle(direction_along(behind, q));
+}
+
+// A label per vertex slot, equal for the vertices of one part (joined by live edges).
+std::vector<uint32_t> part_labels(const Mesh& m) {
+  std::vector<uint32_t> up(m.vertex_slots());
+  std::iota(up.begin(), up.end(), 0u);
+  auto find = [&](uint32_t v) {
+    while (up[v] != v) v = up[v] = up[up[v]];
+    return v;
+  };
+  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e)) up[find(m.edges.vertex[e][0])] = find(m.edges.vertex[e][1]);
+  for (uint32_t v = 0; v < up.size(); ++v) up[v] = find(v);
+  return up;
 }
 
 // The nearest point to p within `radius` of a curve of the network, not of a pending chain.
@@ -337,7 +449,8 @@ std::optional<EditCommand> plan_crossing(const Mesh& m, const SnapIndex& index, 
 
 }  // namespace
 
-Snap snap_to_face(const Mesh& m, const SnapIndex& index, const Vec3& start, const Vec3& end, double limit) {
+Snap snap_to_face(const Mesh& m, const SnapIndex& index, const Vec3& start, const Vec3& end, double limit,
+                  const std::function<bool(const Snap&)>& accept) {
   // Only faces with a boundary point within `limit` of both ends can be chosen: those of the edges near both.
   std::vector<SnapHit> near_start, near_end;
   index.nearest_per_edge(start, limit, near_start);
@@ -362,10 +475,11 @@ Snap snap_to_face(const Mesh& m, const SnapIndex& index, const Vec3& start, cons
     const SnapHit a = index.nearest_on_face(m, f, start, limit), b = index.nearest_on_face(m, f, end, limit);
     if (!a.found() || !b.found()) continue;
     const double cost = a.distance + b.distance;
-    if (cost < best_cost) {
-      best_cost = cost;
-      best = {f, {a.edge, a.point}, {b.edge, b.point}, a.distance, b.distance};
-    }
+    if (cost >= best_cost) continue;
+    const Snap snap{f, {a.edge, a.point}, {b.edge, b.point}, a.distance, b.distance};
+    if (accept && !accept(snap)) continue;
+    best_cost = cost;
+    best = snap;
   }
   return best;
 }
@@ -444,8 +558,8 @@ void publish_feedback(const Mesh& mesh, const SnapIndex& snap, const SketchState
 }  // namespace
 
 void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh, const SnapIndex& snap,
-                   const SketchSettings& settings, SketchState& state, std::vector<EditRequest>& requests,
-                   std::vector<Rejection>& rejections, PenFeedback& feedback) {
+                   const SketchSettings& settings, const std::optional<Vec3>& viewpoint, SketchState& state,
+                   std::vector<EditRequest>& requests, std::vector<Rejection>& rejections, PenFeedback& feedback) {
   requests.clear();
   // At most one request per frame, so every request is placed on the mesh as the previous one left it;
   // events after it wait in `pending` for the next frame.
@@ -557,9 +671,85 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           // A face holding both ends takes the stroke, as the thesis's sketch model has it. Else the stroke may run
           // over several faces, cross a border loop's hole (the far side of the surface), or, far from every
           // curve, start a new part.
-          const Snap s = snap_to_face(mesh, snap, r.command.points.front(), r.command.points.back(), both_snap);
+          Snap s = snap_to_face(mesh, snap, r.command.points.front(), r.command.points.back(), both_snap);
+          // Seen from the cameras, a stroke goes into the face it splits. Where several faces, or a face and a
+          // border loop's hole (the far side, drawn with the object turned over), hold both ends, that tells them
+          // apart: of the faces, the nearest one it goes into; into none, the hole. Which way the faces turn about
+          // the outside is read where an end lands on a vertex of three or more curves. Only the ends drawn in this
+          // pose are judged: a chain's start was drawn from where the camera was then.
+          bool far_side = false;
+          if (s.face != kNone && settings.topology_strokes && viewpoint) {
+            const std::vector<Vec3>& ahead = r.command.points;
+            const std::vector<Vec3> back(ahead.rbegin(), ahead.rend());
+            const bool start_judged = chain_last == kNone;
+            auto vertex_of = [&](const CurveEnd& e) {
+              return e.point == 0 ? mesh.edges.vertex[e.edge][0]
+                     : e.point + 1 == mesh.edges.point_count[e.edge] ? mesh.edges.vertex[e.edge][1] : kNone;
+            };
+            // Each judged end of the stroke as it lands on face c's boundary, with the path from it.
+            auto judged_ends = [&](const Snap& c) {
+              const std::span<const uint32_t> loop = mesh.face_loop(c.face);
+              std::vector<std::pair<CurveEnd, std::span<const Vec3>>> out;
+              if (start_judged) out.emplace_back(at_vertex(mesh, loop, c.start, ahead.front(), vertex_radius(state.start_snap)), ahead);
+              out.emplace_back(at_vertex(mesh, loop, c.end, ahead.back(), vertex_radius(state.end_snap)), back);
+              return out;
+            };
+            auto fan_of = [&](const CurveEnd& e, std::span<const Vec3> path) -> std::optional<Fan> {
+              const uint32_t v = vertex_of(e);
+              if (v == kNone) return std::nullopt;
+              return fan_at(mesh, v, direction_along(path, mesh.vertices.position[v]), *viewpoint);
+            };
+            auto normal_at = [&](const CurveEnd& e, std::span<const Vec3> path) {
+              const std::optional<Fan> fan = fan_of(e, path);
+              return fan ? fan->normal : Vec3((*viewpoint - mesh.polyline(e.edge)[e.point]).normalized());
+            };
+            // How many judged ends go into face c, of how many, with the faces turning `turn` about the outside.
+            auto ends_into = [&](const Snap& c, int turn) {
+              const auto ends = judged_ends(c);
+              size_t in = 0;
+              for (const auto& [e, path] : ends) in += goes_into(mesh, c.face, e, path, normal_at(e, path), turn);
+              return std::pair{in, ends.size()};
+            };
+            // The way the faces turn: as the part's first split found it; else as the fans at the judged ends say.
+            const std::vector<uint32_t> part = part_labels(mesh);
+            auto part_of = [&](uint32_t f) { return part[mesh.tail(mesh.face_loop(f)[0])]; };
+            auto faces_in = [&](uint32_t p) {
+              size_t n = 0;
+              for (uint32_t f = 0; f < mesh.face_slots(); ++f) n += mesh.face_alive(f) && part_of(f) == p;
+              return n;
+            };
+            // A part drawn back to its border by undo is split first again, maybe from its other side.
+            std::erase_if(state.outside, [&](const OutsideTurn& o) { return !mesh.valid(o.at) || faces_in(part[o.at.index]) < 2; });
+            int turn = 0;
+            const uint32_t here = part_of(s.face);
+            if (const auto known = std::find_if(state.outside.begin(), state.outside.end(), [&](const OutsideTurn& o) { return part[o.at.index] == here; });
+                known != state.outside.end()) {
+              turn = known->turn;
+            } else if (faces_in(here) == 1) {
+              const auto [in, judged] = ends_into(s, 1);
+              if (in == judged || in == 0) state.outside.push_back({mesh.vertex_id(mesh.tail(mesh.face_loop(s.face)[0])), int8_t(in == 0 ? -1 : 1)});
+            } else {
+              for (const auto& [e, path] : judged_ends(s))
+                if (const std::optional<Fan> fan = fan_of(e, path))
+                  if (const int t = fan_turn(mesh, *fan, vertex_of(e)); t != 0) turn = turn == 0 || turn == t ? t : 2;
+            }
+            if (turn == 1 || turn == -1) {
+              if (const auto [in, judged] = ends_into(s, turn); in < judged) {
+                const Snap inside = snap_to_face(mesh, snap, ahead.front(), ahead.back(), both_snap, [&](const Snap& c) {
+                  const auto [c_in, c_judged] = ends_into(c, turn);
+                  return c_in == c_judged;
+                });
+                if (inside.face != kNone) {
+                  s = inside;
+                } else if (in == 0 && !snap_to_hole(mesh, snap, ahead.front(), ahead.back(), both_snap).rim.empty()) {
+                  far_side = true;
+                  s = Snap{};
+                }
+              }
+            }
+          }
           // A stroke over several faces is cut where it crosses curves.
-          if (s.face == kNone && settings.topology_strokes) {
+          if (s.face == kNone && settings.topology_strokes && !far_side) {
             std::string refusal;
             std::optional<EditCommand> crossing =
                 plan_crossing(mesh, snap, r.command.points, radius(state.start_snap), end_snap, vertex_radius(state.start_snap),

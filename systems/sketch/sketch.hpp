@@ -5,6 +5,8 @@
 // gives the answers of an exhaustive search (thesis 5.5.1); strokes that cannot be placed are rejected
 // with a reason, and nothing already drawn changes.
 #include <cstdint>
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,8 +43,16 @@ struct SketchSettings {
 inline constexpr double kTrackedVertexSnap = 0.003;
 inline constexpr double kTrackedBlendReach = 1.0 / 3;
 
+// Which way the faces of one part of the mesh turn about the object's outside, seen from the cameras: +1
+// counter-clockwise, -1 clockwise. Set by the part's first split, whose stroke goes into the part's one face.
+struct OutsideTurn {
+  VertexId at;  // a vertex of the part
+  int8_t turn = 0;
+};
+
 struct SketchState {
   bool pen_down = false;
+  std::vector<OutsideTurn> outside;  // one per part whose first split was drawn through the rig
   std::vector<Vec3> stroke;
   double start_snap = 0, end_snap = 0;  // the snap radii logged with the stroke's first and last samples (0: none)
   std::vector<InputEvent> pending;  // events after this frame's request, handled next frame
@@ -57,7 +67,9 @@ struct Snap {
 
 // The face whose boundary passes closest to both points (sum of distances), each within `limit`; on equal
 // sums the lowest face slot, and on each boundary the point first in loop order. `index` is in step with `mesh`.
-Snap snap_to_face(const Mesh& mesh, const SnapIndex& index, const Vec3& start, const Vec3& end, double limit);
+// With `accept`, only the faces whose snap it accepts are chosen.
+Snap snap_to_face(const Mesh& mesh, const SnapIndex& index, const Vec3& start, const Vec3& end, double limit,
+                  const std::function<bool(const Snap&)>& accept = {});
 // The live edge with a polyline point nearest to p within `limit` (the lowest slot on ties), or kNone.
 uint32_t pick_edge(const SnapIndex& index, const Vec3& p, double limit);
 
@@ -68,8 +80,11 @@ uint32_t face_under(const Mesh& mesh, const Vec3& p);
 
 // Emits at most one request per frame (see `pending`). `snap` is in step with `mesh`. Publishes `feedback`
 // (engine/pen_feedback.hpp) for the mesh as this frame found it, from the last pen sample handled.
+// `viewpoint`: where camera 0 is in the object's frame, once the rig is registered. With it, a stroke whose ends
+// one face's border curves hold, but which leaves that face at both ends as the camera sees it, crosses the
+// border loop's hole (the far side, drawn with the object turned over) instead of splitting the face.
 void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh, const SnapIndex& snap,
-                   const SketchSettings& settings, SketchState& state, std::vector<EditRequest>& requests,
-                   std::vector<Rejection>& rejections, PenFeedback& feedback);
+                   const SketchSettings& settings, const std::optional<Vec3>& viewpoint, SketchState& state,
+                   std::vector<EditRequest>& requests, std::vector<Rejection>& rejections, PenFeedback& feedback);
 
 }  // namespace fire

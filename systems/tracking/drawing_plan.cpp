@@ -38,9 +38,9 @@ constexpr size_t kMaxPieces = 4;
 // ends (metres: the sketch's 3 mm at each end, and 2 mm to draw).
 constexpr double kShortestStroke = 0.005;
 constexpr size_t kPieceMargin = 2;  // points
-// How far a piece's free end stays from every curve drawn (metres): twice the sketch's snap distance, so the
-// tracked end is not taken for one on the network.
-constexpr double kPieceClearance = 0.02;
+// How far a piece's free end stays from every curve drawn (metres): the sketch's snap distance and a few times
+// the tracked pen's error, so the tracked end is not taken for one on the network.
+constexpr double kPieceClearance = 0.014;
 
 // Points first..last of a chain, drawn in one pose.
 struct Piece {
@@ -453,6 +453,11 @@ struct Drawing {
       f.erase(std::unique(f.begin(), f.end()), f.end());
     }
   }
+  bool inner_curve() const {
+    for (uint32_t k = 0; k < g.net.curves.size(); ++k)
+      if (curve[k] && surface_beside(k) == 2) return true;
+    return false;
+  }
   size_t faces_holding(uint32_t a, uint32_t b) const {
     std::vector<uint32_t> both;
     std::set_intersection(faces_at[a].begin(), faces_at[a].end(), faces_at[b].begin(), faces_at[b].end(), std::back_inserter(both));
@@ -561,32 +566,40 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
   size_t next_part = 0;
   if (Status s = draw_border((*parts)[0], 0); !s) return R::failure(s.error);
   ++next_part;
-  // Whether a and b lie on one edge of the sketch's mesh (a chain of drawn curves between stroke ends): the
-  // faces on both sides of it would hold both ends of a stroke between them, and the sketch picks the wrong one
-  // as often as the right one.
-  auto same_edge = [&](uint32_t a, uint32_t b) {
-    std::vector<uint32_t> stack{a};
-    std::vector<char> seen(net.vertices.size(), 0);
-    seen[a] = 1;
-    while (!stack.empty()) {
-      const uint32_t v = stack.back();
-      stack.pop_back();
-      if (v == b) return true;
-      if (v != a && drawing.end_vertex[v]) continue;
-      for (uint32_t k : g.at[v]) {
-        if (!drawing.curve[k]) continue;
-        const uint32_t w = g.other(k, v);
-        if (!seen[w]) seen[w] = 1, stack.push_back(w);
+  // Whether a and b lie on one edge of the sketch's mesh (a chain of drawn curves between stroke ends) that
+  // the split would start and end on: a point inside it, or its two ends where it bounds `face` (a face of two
+  // sides). Else the faces on its two sides hold both ends too, which the sketch tells apart once it can.
+  auto same_edge = [&](uint32_t a, uint32_t b, uint32_t face) {
+    for (uint32_t first : g.at[a]) {
+      if (!drawing.curve[first]) continue;
+      uint32_t v = a, k = first;
+      bool bounds = false;
+      for (;;) {
+        for (uint32_t c : g.beside[k]) bounds = bounds || (drawing.surface[c] && drawing.face[c] == face);
+        v = g.other(k, v);
+        if (v == b) {
+          if (!drawing.end_vertex[a] || !drawing.end_vertex[b] || bounds) return true;
+          break;
+        }
+        if (v == a || drawing.end_vertex[v]) break;
+        const auto next = std::find_if(g.at[v].begin(), g.at[v].end(), [&](uint32_t x) { return x != k && drawing.curve[x]; });
+        if (next == g.at[v].end()) break;
+        k = *next;
       }
     }
     return false;
   };
   // What a stroke along chain c does to the far side: nullopt where the sketch would not take it as planned;
   // else the cells that get surface (none for a bridge that waits).
+  // Whether the sketch tells apart the faces (and the hole) that hold both ends of a stroke: once the part's
+  // first split has shown it which way its faces turn about the outside, it sees from the cameras which one the
+  // stroke goes into.
+  auto told_apart = [&] { return drawing.inner_curve(); };
   auto across = [&](const Chain& c) -> std::optional<std::vector<uint32_t>> {
     const uint32_t a = chain_start(net, c), b = chain_end(net, c);
-    // No face may hold both ends: the sketch would take the stroke for that face's split.
-    if (drawing.loop[a] == kNoLoop || drawing.loop[b] == kNoLoop || drawing.faces_holding(a, b) != 0) return std::nullopt;
+    // A face that holds both ends must not take the stroke.
+    if (drawing.loop[a] == kNoLoop || drawing.loop[b] == kNoLoop) return std::nullopt;
+    if (drawing.faces_holding(a, b) != 0 && !told_apart()) return std::nullopt;
     const std::vector<char> none(net.curves.size(), 0);
     std::vector<char> cut(net.curves.size(), 0);
     for (const Leg& l : c) cut[l.curve] = 1;
@@ -649,9 +662,24 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
         pieces.push_back({best_pose, from, reach});
         return pieces;
       }
-      // A few points short of the last one seen, where the pen rests lit and both cameras still see it.
-      size_t cut = reach > from + kPieceMargin ? reach - kPieceMargin : from;
-      while (cut > from && !off_network(points[cut])) --cut;
+      // A few points short of the last one seen, where the pen rests lit and both cameras still see it; closer
+      // to it where only that lets another pose go on from the free end.
+      auto cut_at = [&](size_t margin) {
+        size_t cut = reach > from + margin ? reach - margin : from;
+        while (cut > from && !off_network(points[cut])) --cut;
+        return cut;
+      };
+      auto goes_on = [&](size_t cut) {  // some pose sees on from the free end, past the last point this one sees
+        for (int j : poses.order(best_pose)) {
+          bool all = true;
+          for (size_t i = cut; i <= reach + 1 && all; ++i) all = poses.sees(j, owner[i].first, owner[i].second);
+          if (all) return true;
+        }
+        return false;
+      };
+      size_t cut = cut_at(kPieceMargin);
+      for (size_t margin = kPieceMargin; margin-- > 0 && !goes_on(cut);)
+        if (goes_on(cut_at(margin))) cut = cut_at(margin);
       if (cut <= from + 2) return std::nullopt;
       pieces.push_back({best_pose, from, cut});
       from = cut;
@@ -723,7 +751,11 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
     auto takes = [&](const Chain& c) -> std::optional<std::pair<std::vector<uint32_t>, bool>> {
       const uint32_t a = chain_start(net, c), b = chain_end(net, c);
       if (drawing.surface[g.beside[c[0].curve][0]]) {
-        if (same_edge(a, b) || drawing.faces_holding(a, b) != 1) return std::nullopt;
+        // Of several faces that hold both ends, the sketch takes the one the stroke goes into where it tells
+        // them apart; else the nearest, which may be the wrong one.
+        if (drawing.faces_holding(a, b) == 0 || same_edge(a, b, drawing.face[g.beside[c[0].curve][0]]) ||
+            (drawing.faces_holding(a, b) > 1 && !told_apart()))
+          return std::nullopt;
         return std::pair{std::vector<uint32_t>{}, false};
       }
       std::optional<std::vector<uint32_t>> surfaced = across(c);

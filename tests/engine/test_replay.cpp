@@ -340,7 +340,7 @@ TEST_CASE("the session's frame order is accepted and the surface follows the net
   w->log = std::move(*log);
   auto s = Scheduler::build(session_systems(*w), fake_clock);
   REQUIRE(s.ok());
-  CHECK_THAT(s->describe(), Catch::Contains("sketch: reads object_events, sketch_settings, log; reads last frame's mesh, snap; "
+  CHECK_THAT(s->describe(), Catch::Contains("sketch: reads object_events, sketch_settings, log, registration; reads last frame's mesh, snap; "
                                             "writes sketch, requests, rejections, pen_feedback"));
   CHECK_THAT(s->describe(), Catch::Contains("triangulate: reads frame, rig, frame_events; writes triangulate, pen_events"));
   replay_headless(*w, *s);

@@ -33,16 +33,19 @@ std::vector<SystemSpec> session_systems(World& w) {
         register_system(events, pen_events, rig.has_value(), state, object_events, rejections);
       }));
   systems.push_back(declare_system<Read<&W::object_events>, ReadPrevious<&W::mesh>, ReadPrevious<&W::snap>,
-                                   Read<&W::sketch_settings>, Read<&W::log>, Write<&W::sketch>, Write<&W::requests>,
-                                   Write<&W::rejections>, Write<&W::pen_feedback>>(
+                                   Read<&W::sketch_settings>, Read<&W::log>, Read<&W::registration>, Write<&W::sketch>,
+                                   Write<&W::requests>, Write<&W::rejections>, Write<&W::pen_feedback>>(
       w, "sketch",
       [](const std::vector<InputEvent>& events, const Mesh& mesh, const SnapIndex& snap, const SketchSettings& settings,
-         const InputLog& log, SketchState& state, std::vector<EditRequest>& requests, std::vector<Rejection>& rejections,
-         PenFeedback& feedback) {
+         const InputLog& log, const RegistrationState& registration, SketchState& state, std::vector<EditRequest>& requests,
+         std::vector<Rejection>& rejections, PenFeedback& feedback) {
         // A version-1 log replays by the rules it was drawn with.
         SketchSettings rules = settings;
         rules.topology_strokes = settings.topology_strokes && log.version >= 2;
-        sketch_system(events, mesh, snap, rules, state, requests, rejections, feedback);
+        // Camera 0 sits at the rig's origin.
+        const std::optional<Vec3> viewpoint =
+            registration.transform ? std::optional<Vec3>(registration.transform->t) : std::nullopt;
+        sketch_system(events, mesh, snap, rules, viewpoint, state, requests, rejections, feedback);
       }));
   systems.push_back(declare_system<Read<&W::requests>, Write<&W::mesh>, Write<&W::history>, Write<&W::rejections>>(
       w, "split", [](const std::vector<EditRequest>& requests, Mesh& mesh, EditHistory& history,

@@ -128,6 +128,12 @@ std::string snapshot_world(const World& w, uint64_t log_bytes, uint64_t log_hash
   out.put(w.sketch.stroke);
   out.put(w.sketch.start_snap);
   out.put(w.sketch.end_snap);
+  out.put(uint64_t(w.sketch.outside.size()));
+  for (const OutsideTurn& o : w.sketch.outside) {
+    out.put(o.at.index);
+    out.put(o.at.generation);
+    out.put(o.turn);
+  }
   out.put(uint64_t(w.sketch.pending.size()));
   for (const InputEvent& e : w.sketch.pending) save_event(out, e);
   save_surface(out, w.surface);
@@ -173,6 +179,14 @@ Status load_world_snapshot(SnapshotReader& in, const SessionContents& session, W
   in.get(w.sketch.start_snap);
   in.get(w.sketch.end_snap);
   w.sketch.pen_down = pen_down != 0;
+  in.get(count);
+  for (uint64_t k = 0; k < count && in.ok(); ++k) {
+    OutsideTurn& o = w.sketch.outside.emplace_back();
+    in.get(o.at.index);
+    in.get(o.at.generation);
+    in.get(o.turn);
+    if (in.ok() && ((o.turn != 1 && o.turn != -1) || !w.mesh.valid(o.at))) return Status::failure("the sketch's outside turns do not load");
+  }
   in.get(count);
   for (uint64_t k = 0; k < count && in.ok(); ++k) load_event(in, w.sketch.pending.emplace_back());
   if (!load_surface(in, w.surface)) return Status::failure("the surface does not load");

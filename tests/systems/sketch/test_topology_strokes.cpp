@@ -171,3 +171,83 @@ TEST_CASE("strokes between two parts' border loops: the first waits with no surf
   CHECK(t.border_loops == 2);
   CHECK(t.euler_characteristic == 0);
 }
+
+namespace {
+
+// Replays `log` with camera 0 at `above` (object frame) until event `turned`, then at `below`: as a tracked drawing
+// whose object is turned over there and registered again.
+std::unique_ptr<World> replay_seen_from(const Log& log, const Vec3& above, size_t turned, const Vec3& below) {
+  auto parsed = parse_input_log(log.text, "seen.log");
+  REQUIRE(parsed);
+  auto w = std::make_unique<World>();
+  w->log = std::move(*parsed);
+  Scheduler scheduler = make_scheduler(*w, fire::test::step_clock);
+  ReplayHooks hooks;
+  hooks.before_frame = [&](World& world) {
+    world.registration.transform.emplace();
+    world.registration.transform->t = world.cursor.next < turned ? above : below;
+  };
+  replay_headless(*w, scheduler, hooks);
+  return w;
+}
+
+constexpr size_t kEventsPerArc = 13;  // down, 11 samples, up
+
+}  // namespace
+
+TEST_CASE("seen from the cameras, a stroke whose ends one face holds, drawn under it, crosses the hole", "[sketch][topology]") {
+  // The square, its top split by an arch drawn from above; then, from below, a curve under the left half between
+  // two points of its border curves. Those points are on the left face's boundary too.
+  Log log;
+  square(log);
+  arc(log, {0.05, 0, 0}, {0.05, 0.1, 0}, 0.03);
+  arc(log, {0.02, 0, 0}, {0.02, 0.1, 0}, -0.03);
+  const Vec3 above(0.05, 0.05, 0.5), below(0.05, 0.05, -0.5);
+  const auto seen = replay_seen_from(log, above, 5 * kEventsPerArc, below);
+  INFO(rejections(*seen));
+  CHECK(seen->rejections.empty());
+  REQUIRE(seen->sketch.outside.size() == 1);  // the first split said which way the faces turn
+  CHECK(seen->mesh.face_count() == 4);
+  CHECK(seen->mesh.border_loop_count() == 0);
+  // Without the cameras (a mouse), the face that holds both ends takes it, as the thesis's sketch model has it.
+  const auto unseen = replay(log);
+  CHECK(unseen->rejections.empty());
+  CHECK(unseen->mesh.face_count() == 3);
+  CHECK(unseen->mesh.border_loop_count() == 1);
+  // Drawn from above, the same curve lies over the left face: it splits it.
+  const auto over = replay_seen_from(log, above, 6 * kEventsPerArc, below);
+  CHECK(over->mesh.face_count() == 3);
+}
+
+TEST_CASE("seen from the cameras, of two faces that hold both ends of a stroke, it splits the one it goes into", "[sketch][topology]") {
+  // The square split by an arch between (5, 0) and (5, 10) cm; then a second curve between the same two vertices,
+  // bowed toward +x or -x: both halves hold its ends, at the same distance.
+  for (const double side : {1.0, -1.0}) {
+    Log log;
+    square(log);
+    arc(log, {0.05, 0, 0}, {0.05, 0.1, 0}, 0.03);
+    log.event("down");
+    for (int k = 0; k <= 10; ++k) {
+      const double t = k / 10.0, lift = std::sin(std::numbers::pi * t);
+      log.pen(0.05 + side * 0.03 * lift, 0.1 * t, 0.01 * lift);
+    }
+    log.event("up");
+    const Vec3 camera(0.05, 0.05, 0.5);
+    const auto w = replay_seen_from(log, camera, 7 * kEventsPerArc, camera);
+    INFO("bowed toward " << side << " x\n" << rejections(*w));
+    CHECK(w->rejections.empty());
+    REQUIRE(w->mesh.face_count() == 3);
+    // Every face beside the new curve lies on the side it was bowed toward.
+    uint32_t bowed = kNone;
+    for (uint32_t e = 0; e < w->mesh.edge_slots(); ++e)
+      if (w->mesh.edge_alive(e) && side * (w->mesh.polyline(e)[w->mesh.edges.point_count[e] / 2].x() - 0.05) > 0.02) bowed = e;
+    REQUIRE(bowed != kNone);
+    for (uint32_t f : w->mesh.edges.face[bowed]) {
+      REQUIRE(f != kNone);
+      Vec3 centre = Vec3::Zero();
+      const std::vector<Vec3> boundary = w->mesh.face_boundary(f);
+      for (const Vec3& p : boundary) centre += p;
+      CHECK(side * (centre.x() / double(boundary.size()) - 0.05) > 0);
+    }
+  }
+}
