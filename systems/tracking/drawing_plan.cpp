@@ -750,10 +750,14 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
     // Whether the sketch would take chain c as planned, and what it does to the far side.
     auto takes = [&](const Chain& c) -> std::optional<std::pair<std::vector<uint32_t>, bool>> {
       const uint32_t a = chain_start(net, c), b = chain_end(net, c);
-      if (drawing.surface[g.beside[c[0].curve][0]]) {
+      // The cell the chain starts in: one with surface where it has any (a capped rim's curve lies between the
+      // cap, a face of the disc, and the far side).
+      const std::vector<uint32_t>& beside = g.beside[c[0].curve];
+      const auto in_face = std::find_if(beside.begin(), beside.end(), [&](uint32_t cell) { return drawing.surface[cell] != 0; });
+      if (in_face != beside.end()) {
         // Of several faces that hold both ends, the sketch takes the one the stroke goes into where it tells
         // them apart; else the nearest, which may be the wrong one.
-        if (drawing.faces_holding(a, b) == 0 || same_edge(a, b, drawing.face[g.beside[c[0].curve][0]]) ||
+        if (drawing.faces_holding(a, b) == 0 || same_edge(a, b, drawing.face[*in_face]) ||
             (drawing.faces_holding(a, b) > 1 && !told_apart()))
           return std::nullopt;
         return std::pair{std::vector<uint32_t>{}, false};
