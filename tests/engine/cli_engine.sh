@@ -26,6 +26,15 @@ check "replay --progress says how far it is on stderr, every 10 %, sums up, and 
 golden=$(cat "$src/tests/engine/demo.hash")
 check "replay hash matches the recorded one ($golden)" "[ '$h1' = '$golden' ]"
 check "replay writes the network" "'$fire' replay '$src/tools/demo/sketch.log' -o '$tmp/demo.fnet' 2>/dev/null && [ -s '$tmp/demo.fnet' ]"
+# --until-stroke N: the drawing as it was after its N-th committed pen stroke. The demo's 18 strokes end the log, so
+# the 18th gives the whole replay's hash; after 4 it is the closed border alone (one face), after 5 its first split.
+check "replay --until-stroke 18 of the demo's 18 strokes prints the whole replay's hash" \
+  "[ \"\$('$fire' replay '$src/tools/demo/sketch.log' --until-stroke 18 --hash 2>/dev/null)\" = '$h1' ]"
+check "replay --until-stroke 4 and 5: the border alone, then its first split" \
+  "'$fire' replay '$src/tools/demo/sketch.log' --until-stroke 4 -o '$tmp/u4.fnet' 2>/dev/null && grep -o '\"reversed\"' '$tmp/u4.fnet' | wc -l | grep -qx 1 && '$fire' replay '$src/tools/demo/sketch.log' --until-stroke 5 -o '$tmp/u5.fnet' 2>/dev/null && grep -o '\"reversed\"' '$tmp/u5.fnet' | wc -l | grep -qx 2"
+expect_error "replay --until-stroke past the log's strokes says how many it has" "commits 18 pen stroke(s), not 19" \
+  "$fire" replay "$src/tools/demo/sketch.log" --until-stroke 19
+expect_error "replay --until-stroke 0 is refused" "until-stroke" "$fire" replay "$src/tools/demo/sketch.log" --until-stroke 0
 # The surface the frame's refine and subdivide systems left equals a reconstruction from scratch of the
 # same network, byte for byte.
 check "replay writes the surface, to each --surface" "'$fire' replay '$src/tools/demo/sketch.log' -o '$tmp/s.fnet' --surface '$tmp/live.obj' --surface '$tmp/live.glb' 2>/dev/null && [ -s '$tmp/live.obj' ]"

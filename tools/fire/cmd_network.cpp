@@ -1,8 +1,10 @@
 // fire replay, fire open, fire export-network: the engine foundation's commands.
+#include <algorithm>
 #include <cinttypes>
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include <unistd.h>
 
@@ -59,6 +61,7 @@ struct ReplayOptions {
   std::string log_path, out_path, obj_path, session_dir, rig_path;
   std::vector<std::string> surface_paths;
   uint64_t snapshot_every = 0;
+  uint64_t until_stroke = 0;  // 0: the whole log
   bool hash = false, timings = false, no_surface = false, schedule = false, progress = false;
   bool settings_given = false;  // --snap, a surface option or --no-surface on the command line
   double snap = SketchSettings{}.snap_distance;
@@ -84,6 +87,39 @@ Result<ReopenedSession> reopen(const std::string& command, const std::string& di
   return r;
 }
 
+// How many events of `log` the frame that commits its n-th pen stroke has read (a stroke the split system
+// applied: part of a border, a split, a stroke across curves or a hole, a piece of a chain; not a command), from
+// a replay without the surface, which no commit depends on. nullopt, with how many it commits, when fewer.
+std::optional<size_t> events_until_stroke(const InputLog& log, const std::optional<TrackingRig>& rig, double snap,
+                                          uint64_t n, uint64_t& committed) {
+  auto w = std::make_unique<World>();
+  w->log = log;
+  if (rig) set_rig(*w, *rig);
+  w->sketch_settings.snap_distance = snap;
+  w->build_surface = false;
+  std::vector<char> command_line;
+  for (const InputEvent& e : log.events) {
+    if (e.line >= command_line.size()) command_line.resize(e.line + 1, 0);
+    command_line[e.line] = e.kind == EventKind::Command;
+  }
+  std::optional<size_t> until;
+  committed = 0;
+  size_t rejections_seen = 0;
+  ReplayHooks hooks;
+  hooks.after_frame = [&](const World& world) {
+    for (const EditRequest& r : world.requests) {
+      if (r.kind != RequestKind::Edit || (r.line < command_line.size() && command_line[r.line])) continue;
+      const bool refused = std::any_of(world.rejections.begin() + std::ptrdiff_t(rejections_seen), world.rejections.end(),
+                                       [&](const Rejection& x) { return x.line == r.line; });
+      if (!refused && ++committed == n) until = world.cursor.next;
+    }
+    rejections_seen = world.rejections.size();
+  };
+  Scheduler scheduler = make_scheduler(*w, monotonic_ns);
+  replay_headless(*w, scheduler, hooks);
+  return until;
+}
+
 int run_replay(const ReplayOptions& o) {
   const int64_t started_ns = monotonic_ns();
   const bool session_in = is_directory(o.log_path);
@@ -98,6 +134,10 @@ int run_replay(const ReplayOptions& o) {
   }
   if (!o.rig_path.empty() && session_in) {
     std::cerr << "fire replay: " << o.log_path << " is a session folder: it replays with the rig.json it holds, not --rig\n";
+    return 1;
+  }
+  if (o.until_stroke > 0 && (session_in || !o.session_dir.empty())) {
+    std::cerr << "fire replay: --until-stroke replays part of a log; it takes no session folder, in or out\n";
     return 1;
   }
   if (o.snapshot_every > 0 && o.session_dir.empty()) {
@@ -152,6 +192,16 @@ int run_replay(const ReplayOptions& o) {
       std::cerr << "fire replay: " << o.log_path << " holds Wii Remote reports; give the rig they were drawn with: "
                 << "--rig RIG.json (from fire calibrate)\n";
       return 1;
+    }
+    if (o.until_stroke > 0) {
+      uint64_t committed = 0;
+      const std::optional<size_t> until = events_until_stroke(*log, world->rig, o.snap, o.until_stroke, committed);
+      if (!until) {
+        std::cerr << "fire replay: " << o.log_path << " commits " << committed << " pen stroke(s), not " << o.until_stroke
+                  << " (--until-stroke)\n";
+        return 1;
+      }
+      log->events.resize(*until);
     }
     world->log = std::move(*log);
     world->sketch_settings.snap_distance = o.snap;
@@ -282,6 +332,11 @@ void add_network_commands(CLI::App& app, Registry& registry) {
       ->allow_extra_args(false);
   add_units_option(*replay, o->units);
   replay->add_flag("--no-surface", o->no_surface, "run only input, sketch and split (no refine and subdivide)");
+  replay->add_option("--until-stroke", o->until_stroke,
+                     "N: replay the log up to the frame that commits its N-th pen stroke (one the network took: part of "
+                     "a border, a split, a stroke across curves or a hole, a piece of a chain; commands do not count), "
+                     "then let the surface settle: -o, --surface and --hash give the drawing as it was then")
+      ->check(CLI::PositiveNumber);
   replay->add_flag("--progress", o->progress,
                    "say how far through the log it is, every 10 %, and end with a summary line (on a terminal it always does, after "
                    "a second, and sums up a replay that took over two seconds)");
