@@ -132,7 +132,7 @@ Vec3 direction_along(std::span<const Vec3> line, const Vec3& from) {
 
 // The curves at a vertex in counter-clockwise order about the surface's normal there, turned toward the camera.
 struct Fan {
-  Vec3 at, normal, first;  // `first`: where angles start, in the plane
+  Vec3 normal, first;  // `first`: where angles start, in the plane
   std::vector<std::pair<double, uint32_t>> edges;  // angle about `normal`, edge
   double angle(const Vec3& d) const {
     const Vec3 w = normal.cross(first);
@@ -145,15 +145,18 @@ struct Fan {
 // least of, turned toward the camera. nullopt with fewer curves.
 std::optional<Fan> fan_at(const Mesh& m, uint32_t v, const Vec3& d, const Vec3& viewpoint) {
   Fan fan;
-  fan.at = m.vertices.position[v];
+  const Vec3& at = m.vertices.position[v];
+  std::vector<uint32_t> incident = m.vertex_edges(v);
+  std::sort(incident.begin(), incident.end());
+  incident.erase(std::unique(incident.begin(), incident.end()), incident.end());
   std::vector<std::pair<uint32_t, Vec3>> directions;
-  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
-    if (!m.edge_alive(e) || m.is_loose_edge(e)) continue;
+  for (uint32_t e : incident) {
+    if (m.is_loose_edge(e)) continue;
     const std::span<const Vec3> line = m.polyline(e);
     for (int side = 0; side < 2; ++side)
       if (m.edges.vertex[e][side] == v) {
         const std::vector<Vec3> from_v = side == 0 ? std::vector<Vec3>(line.begin(), line.end()) : std::vector<Vec3>(line.rbegin(), line.rend());
-        directions.emplace_back(e, direction_along(from_v, fan.at));
+        directions.emplace_back(e, direction_along(from_v, at));
       }
   }
   if (directions.size() < 3) return std::nullopt;
@@ -161,7 +164,7 @@ std::optional<Fan> fan_at(const Mesh& m, uint32_t v, const Vec3& d, const Vec3& 
   for (const auto& [e, u] : directions) moments += u * u.transpose();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(moments);
   fan.normal = solver.eigenvectors().col(0);
-  if (fan.normal.dot(viewpoint - fan.at) < 0) fan.normal = -fan.normal;
+  if (fan.normal.dot(viewpoint - at) < 0) fan.normal = -fan.normal;
   fan.first = (directions.front().second - directions.front().second.dot(fan.normal) * fan.normal).normalized();
   for (const auto& [e, u] : directions) fan.edges.emplace_back(fan.angle(u), e);
   std::sort(fan.edges.begin(), fan.edges.end());
@@ -175,9 +178,15 @@ int fan_turn(const Mesh& m, const Fan& fan, uint32_t v) {
   auto rank = [&](uint32_t e) {
     return size_t(std::find_if(fan.edges.begin(), fan.edges.end(), [&](const auto& x) { return x.second == e; }) - fan.edges.begin());
   };
+  // The faces at v: those beside its curves, each once.
+  std::vector<uint32_t> faces;
+  for (const auto& [angle, e] : fan.edges)
+    for (uint32_t f : m.edges.face[e])
+      if (f != kNone) faces.push_back(f);
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
   int votes = 0;
-  for (uint32_t f = 0; f < m.face_slots(); ++f) {
-    if (!m.face_alive(f)) continue;
+  for (uint32_t f : faces) {
     const std::span<const uint32_t> loop = m.face_loop(f);
     for (size_t i = 0; i < loop.size(); ++i) {
       const uint32_t in = loop[i], out = loop[(i + 1) % loop.size()];
