@@ -1,6 +1,6 @@
 #pragma once
 // Bicubic B-spline patches as plain data: the limit surface in the form CAD systems take
-// (systems/subdivide/bspline_patches.hpp makes them from a cage, platform/cad writes them as STEP or IGES).
+// (systems/catmull_clark/bspline_patches.hpp makes them from a cage, platform/cad writes them as STEP or IGES).
 #include <cstddef>
 #include <cstdint>
 #include <vector>

@@ -1,5 +1,5 @@
 #pragma once
-// A Catmull-Clark subdivision cage as FIRE builds its surfaces on one (systems/subdivide/subdivide.hpp's rules):
+// A Catmull-Clark subdivision cage as FIRE builds its surfaces on one (systems/catmull_clark/catmull_clark.hpp's rules):
 // what `fire reconstruct --cage` exports for subdivision modellers and what the CAD export converts.
 #include <cstdint>
 #include <vector>

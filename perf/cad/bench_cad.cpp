@@ -1,5 +1,5 @@
 // The CAD export measured: networks reconstructed to a cage (reconstruct_cage), the cage's limit surface as
-// B-spline patches (systems/subdivide/bspline_patches.hpp), written as STEP and IGES (platform/cad) and read
+// B-spline patches (systems/catmull_clark/bspline_patches.hpp), written as STEP and IGES (platform/cad) and read
 // back with OpenCASCADE. Per network: its size, the cage's, the patches (exact, fitted, fit level, largest fit
 // error), the time of each step, each file's size and what OpenCASCADE reads from it.
 //
@@ -21,7 +21,7 @@
 #include "platform/network_file.hpp"
 #include "platform/obj.hpp"
 #include "systems/reconstruct/reconstruct.hpp"
-#include "systems/subdivide/bspline_patches.hpp"
+#include "systems/catmull_clark/bspline_patches.hpp"
 #include "systems/synth/network_from_mesh.hpp"
 
 using namespace fire;
@@ -52,7 +52,7 @@ int measure(const std::string& name, const Mesh& net, const std::string& out) {
   }
   const double reconstruct_ms = ms_since(start);
   start = Clock::now();
-  Result<subdivide::BsplineConversion> c = subdivide::bspline_patches(*cage);
+  Result<catmull_clark::BsplineConversion> c = catmull_clark::bspline_patches(*cage);
   if (!c) {
     std::fprintf(stderr, "bench_cad: %s: %s\n", name.c_str(), c.error().c_str());
     return 1;

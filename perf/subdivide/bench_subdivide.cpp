@@ -24,15 +24,15 @@
 #include "engine/surface.hpp"
 #include "platform/obj.hpp"
 #include "systems/reconstruct/reconstruct.hpp"
-#include "systems/subdivide/subdivide.hpp"
+#include "systems/catmull_clark/catmull_clark.hpp"
 #include "systems/synth/network_from_mesh.hpp"
-#include "tests/subdivide/osd_reference.hpp"
+#include "tests/systems/catmull_clark/osd_reference.hpp"
 
 namespace {
 
 namespace Far = OpenSubdiv::Far;
 namespace Sdc = OpenSubdiv::Sdc;
-namespace sd = fire::subdivide;
+namespace sd = fire::catmull_clark;
 // The oracle test's OpenSubdiv setup: the same vertex type and the options we claim to match.
 using fire::osd_reference::in_osd_numbering;
 using fire::osd_reference::Point;

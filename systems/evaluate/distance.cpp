@@ -4,7 +4,7 @@
 #include <string>
 
 #include "systems/evaluate/evaluate.hpp"
-#include "systems/subdivide/subdivide.hpp"
+#include "systems/catmull_clark/catmull_clark.hpp"
 
 namespace fire::evaluate {
 
@@ -53,13 +53,13 @@ Result<TriangleMesh> reference_limit_surface(std::span<const Vec3> positions, st
   using R = Result<TriangleMesh>;
   // Measuring against the reference costs about half a kilobyte per quad (limit points, triangles, BVH,
   // samples): a dense surface given as the control mesh would exhaust memory, so it is refused up front.
-  const uint64_t quads = levels > 0 ? subdivide::faces_at_level(face_vertices.size(), levels) : 0;
+  const uint64_t quads = levels > 0 ? catmull_clark::faces_at_level(face_vertices.size(), levels) : 0;
   if (quads > kMaxReferenceQuads)
     return R::failure(std::to_string(face_offsets.size() - 1) + " faces make " + std::to_string(quads) +
                       " quads at " + std::to_string(levels) + " Catmull-Clark levels, more than the " +
                       std::to_string(kMaxReferenceQuads) +
                       " a reference may have; give the coarse control mesh, not a dense surface");
-  auto sub = subdivide::subdivide({positions, face_offsets, face_vertices, sharp_edges, border_corners}, levels);
+  auto sub = catmull_clark::subdivide({positions, face_offsets, face_vertices, sharp_edges, border_corners}, levels);
   if (!sub) return R::failure(sub.error());
   TriangleMesh mesh;
   mesh.positions = std::move(sub->limit_positions);

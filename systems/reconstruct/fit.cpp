@@ -219,10 +219,10 @@ LimitFit::~LimitFit() = default;
 LimitFit::LimitFit(LimitFit&&) noexcept = default;
 LimitFit& LimitFit::operator=(LimitFit&&) noexcept = default;
 
-Result<LimitFit> LimitFit::build(const subdivide::Refinement& refinement, const subdivide::LimitStencils& limit,
+Result<LimitFit> LimitFit::build(const catmull_clark::Refinement& refinement, const catmull_clark::LimitStencils& limit,
                                  const BaseMesh& base, const FitWeights& settings) {
   const uint32_t last = static_cast<uint32_t>(refinement.levels.size() - 1);
-  const subdivide::Level& level0 = refinement.levels[0];
+  const catmull_clark::Level& level0 = refinement.levels[0];
   const uint32_t nb = base.vertex_count();
   auto impl = std::make_unique<Impl>();
   impl->settings = settings;
@@ -239,7 +239,7 @@ Result<LimitFit> LimitFit::build(const subdivide::Refinement& refinement, const 
   for (uint32_t v = 0; v < nb; ++v)
     if (base.vertex_drawn[v]) {
       impl->vertex_row[v] = Eigen::Index(selected.size());
-      selected.push_back(subdivide::last_level_vertex(refinement, v));
+      selected.push_back(catmull_clark::last_level_vertex(refinement, v));
     }
   std::vector<uint32_t> chain;
   for (uint32_t s = 0; s < base.side_count(); ++s) {
@@ -253,7 +253,7 @@ Result<LimitFit> LimitFit::build(const subdivide::Refinement& refinement, const 
       if (it == edge_of_pair.end())
         return Result<LimitFit>::failure("internal error: curve " + std::to_string(c) + " is not a base edge");
       chain.clear();
-      subdivide::vertices_along_edge(refinement, 0, it->second, a, chain);
+      catmull_clark::vertices_along_edge(refinement, 0, it->second, a, chain);
       for (size_t k = 1; k < chain.size(); ++k) {
         impl->paths.back().push_back(Eigen::Index(selected.size()));
         selected.push_back(chain[k]);
@@ -262,7 +262,7 @@ Result<LimitFit> LimitFit::build(const subdivide::Refinement& refinement, const 
     }
   }
 
-  subdivide::StencilTable table;
+  catmull_clark::StencilTable table;
   for (uint32_t v : selected) {
     for (uint32_t k = limit.offsets[v]; k < limit.offsets[v + 1]; ++k) {
       table.sources.push_back(limit.sources[k]);
@@ -274,7 +274,7 @@ Result<LimitFit> LimitFit::build(const subdivide::Refinement& refinement, const 
   for (uint32_t l = last; l-- > 0;) {
     read.assign(refinement.levels[l + 1].vertex_count, 0);
     for (uint32_t s : table.sources) read[s] = 1;
-    table = subdivide::compose(table, subdivide::stencil_table(refinement, l, read));
+    table = catmull_clark::compose(table, catmull_clark::stencil_table(refinement, l, read));
   }
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(table.sources.size());

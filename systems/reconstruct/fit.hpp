@@ -45,7 +45,7 @@
 
 #include "systems/reconstruct/reconstruct.hpp"
 #include "systems/reconstruct/steps.hpp"
-#include "systems/subdivide/subdivide.hpp"
+#include "systems/catmull_clark/catmull_clark.hpp"
 
 namespace fire::reconstruct {
 
@@ -102,7 +102,7 @@ class LimitFit {
   LimitFit& operator=(LimitFit&&) noexcept;
 
   // Rows and factorization for this topology (`refinement` of `base`, with last-level adjacency).
-  static Result<LimitFit> build(const subdivide::Refinement& refinement, const subdivide::LimitStencils& limit,
+  static Result<LimitFit> build(const catmull_clark::Refinement& refinement, const catmull_clark::LimitStencils& limit,
                                 const BaseMesh& base, const FitWeights& weights);
   struct Report {
     uint32_t iterations = 0;  // solves (back-substitutions)

@@ -11,7 +11,7 @@
 
 #include "engine/assert.hpp"
 #include "systems/reconstruct/fit.hpp"
-#include "systems/subdivide/subdivide.hpp"
+#include "systems/catmull_clark/catmull_clark.hpp"
 
 namespace fire::reconstruct {
 
@@ -58,8 +58,8 @@ struct ReconstructionCache {
   std::vector<uint32_t> key_face_offsets, key_face_vertices, key_sharp, key_curve_ends;
   std::vector<uint8_t> key_curve_drawn, key_vertex_drawn, key_border_corners;
   uint32_t key_vertex_count = 0;
-  subdivide::Refinement refinement;
-  subdivide::LimitStencils limit;
+  catmull_clark::Refinement refinement;
+  catmull_clark::LimitStencils limit;
   // fit is the factorization of the current topology only when fit_built; fit_waiting: a new base mesh
   // has been shown and its fit has not started yet. fit_shape: the shape weights it was built with,
   // which depend on the base points (a change of them needs a new factorization too).
@@ -701,11 +701,11 @@ Status rebuild_topology(const Options& options, ReconstructionCache& c) {
   const BaseMesh& b = c.base;
   c.have_topology = false;
   c.fit_built = false;
-  subdivide::BaseTopology topology{b.vertex_count(), b.face_offsets, b.face_vertices, b.sharp_edges, b.border_corners};
-  auto refinement = subdivide::build_refinement(topology, {static_cast<int>(options.levels), true});
+  catmull_clark::BaseTopology topology{b.vertex_count(), b.face_offsets, b.face_vertices, b.sharp_edges, b.border_corners};
+  auto refinement = catmull_clark::build_refinement(topology, {static_cast<int>(options.levels), true});
   if (!refinement) return Status::failure("the base mesh cannot be subdivided: " + refinement.error());
   c.refinement = std::move(*refinement);
-  if (auto s = subdivide::build_limit_stencils(c.refinement, c.limit); !s)
+  if (auto s = catmull_clark::build_limit_stencils(c.refinement, c.limit); !s)
     return Status::failure("internal error: " + s.error);
   c.key_vertex_count = b.vertex_count();
   c.key_face_offsets = b.face_offsets;
@@ -800,9 +800,9 @@ Result<bool> run_refine(const Mesh& net, const Options& options, ReconstructionC
 
 void evaluate_surface(ReconstructionCache& c, std::span<const Vec3> base_points, SurfaceMesh& surface) {
   std::vector<Vec3> last_level;
-  subdivide::evaluate(c.refinement, base_points, last_level, c.scratch);
+  catmull_clark::evaluate(c.refinement, base_points, last_level, c.scratch);
   SurfaceMesh out;
-  subdivide::evaluate_limit(c.limit, last_level, out.positions, out.normals);
+  catmull_clark::evaluate_limit(c.limit, last_level, out.positions, out.normals);
   out.face_offsets = c.refinement.last().face_offsets;
   out.face_vertices = c.refinement.last().face_vertices;
   surface = std::move(out);

@@ -89,7 +89,7 @@ struct BaseMesh : PolygonMesh {
   // consecutive (the subdivide system groups the surface's quads into patches by it).
   std::vector<uint32_t> face_source;
   std::vector<uint32_t> sharp_edges;  // vertex pairs along network edges marked sharp
-  // fire: per vertex, 1 where the border is a corner of the surface (subdivide::BaseTopology::
+  // fire: per vertex, 1 where the border is a corner of the surface (catmull_clark::BaseTopology::
   // border_corners); empty for thesis, whose border keeps Catmull-Clark's EdgeAndCorner rule.
   std::vector<uint8_t> border_corners;
   // One curve per base edge, from curve_ends[2c] to curve_ends[2c+1]: a piece of a network polyline

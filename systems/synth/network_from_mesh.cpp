@@ -11,7 +11,7 @@
 #include <string>
 #include <unordered_map>
 
-#include "systems/subdivide/subdivide.hpp"
+#include "systems/catmull_clark/catmull_clark.hpp"
 
 namespace fire {
 
@@ -577,23 +577,23 @@ Result<LimitCurves> LimitCurves::build(const PolygonMeshView& control, uint32_t 
   int levels = 0;
   while ((1u << levels) < samples_per_edge) ++levels;
   levels = std::max(levels, 1);
-  const subdivide::BaseTopology base{uint32_t(control.positions.size()), control.face_offsets, control.face_vertices, {}};
-  auto refinement = subdivide::build_refinement(base, {levels, true});
+  const catmull_clark::BaseTopology base{uint32_t(control.positions.size()), control.face_offsets, control.face_vertices, {}};
+  auto refinement = catmull_clark::build_refinement(base, {levels, true});
   if (!refinement) return Result<LimitCurves>::failure(std::string(control.source) + ": " + refinement.error());
-  auto stencils = subdivide::build_limit_stencils(*refinement);
+  auto stencils = catmull_clark::build_limit_stencils(*refinement);
   if (!stencils) return Result<LimitCurves>::failure(std::string(control.source) + ": " + stencils.error());
   std::vector<Vec3> last, scratch, normals;
-  subdivide::evaluate(*refinement, control.positions, last, scratch);
+  catmull_clark::evaluate(*refinement, control.positions, last, scratch);
   LimitCurves curves;
-  subdivide::evaluate_limit(*stencils, last, curves.limit_, normals);
+  catmull_clark::evaluate_limit(*stencils, last, curves.limit_, normals);
 
-  const subdivide::Level& L0 = refinement->levels[0];
+  const catmull_clark::Level& L0 = refinement->levels[0];
   curves.base_edge_vertices_ = L0.edge_vertices;
-  for (uint32_t v = 0; v < L0.vertex_count; ++v) curves.last_of_base_.push_back(subdivide::last_level_vertex(*refinement, v));
+  for (uint32_t v = 0; v < L0.vertex_count; ++v) curves.last_of_base_.push_back(catmull_clark::last_level_vertex(*refinement, v));
   curves.along_.resize(L0.edge_count());
   for (uint32_t e = 0; e < L0.edge_count(); ++e) {
     const uint32_t a = L0.edge_vertices[2 * e], b = L0.edge_vertices[2 * e + 1];
-    subdivide::vertices_along_edge(*refinement, 0, e, a, curves.along_[e]);
+    catmull_clark::vertices_along_edge(*refinement, 0, e, a, curves.along_[e]);
     curves.edge_by_ends_.emplace_back(uint64_t(std::min(a, b)) << 32 | std::max(a, b), e);
   }
   std::sort(curves.edge_by_ends_.begin(), curves.edge_by_ends_.end());
@@ -624,8 +624,8 @@ bool LimitCurves::sample_chain(std::span<const uint32_t> chain, std::vector<Vec3
 namespace fire {
 
 Result<PolygonMesh> limit_mesh(const PolygonMeshView& control, int levels) {
-  Result<subdivide::SubdividedMesh> sub =
-      subdivide::subdivide({control.positions, control.face_offsets, control.face_vertices, {}}, levels);
+  Result<catmull_clark::SubdividedMesh> sub =
+      catmull_clark::subdivide({control.positions, control.face_offsets, control.face_vertices, {}}, levels);
   if (!sub) return Result<PolygonMesh>::failure(std::string(control.source) + ": " + sub.error());
   PolygonMesh out;
   out.positions = std::move(sub->limit_positions);

@@ -26,11 +26,11 @@ TEST_CASE("a fit advanced 1, 7 or all back-substitutions at a time ends on solve
   SurfaceMesh surface;
   REQUIRE(reconstruct_update(grid_network(4, 3, 17, height), options, state, surface).ok());
   const BaseMesh& base = state.base();
-  const subdivide::BaseTopology topology{base.vertex_count(), base.face_offsets, base.face_vertices, base.sharp_edges,
+  const catmull_clark::BaseTopology topology{base.vertex_count(), base.face_offsets, base.face_vertices, base.sharp_edges,
                                          base.border_corners};
-  auto refinement = subdivide::build_refinement(topology, {int(options.levels), true});
+  auto refinement = catmull_clark::build_refinement(topology, {int(options.levels), true});
   REQUIRE(refinement.ok());
-  auto limit = subdivide::build_limit_stencils(*refinement);
+  auto limit = catmull_clark::build_limit_stencils(*refinement);
   REQUIRE(limit.ok());
   auto fit = LimitFit::build(*refinement, *limit, base, FitWeights{});
   REQUIRE(fit.ok());

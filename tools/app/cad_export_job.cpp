@@ -4,14 +4,14 @@
 #include <utility>
 
 #include "platform/cad/cad_export.hpp"
-#include "systems/subdivide/bspline_patches.hpp"
+#include "systems/catmull_clark/bspline_patches.hpp"
 
 namespace fire {
 
 namespace {
 
 std::string write_cad_file(const Cage& cage, const std::string& path, LengthUnit unit) {
-  auto converted = subdivide::bspline_patches(cage);
+  auto converted = catmull_clark::bspline_patches(cage);
   if (!converted) return "export failed: " + path + ": " + converted.error();
   auto written = cad::write_cad(converted->patches, path, unit);
   if (!written) return "export failed: " + written.error();

@@ -10,7 +10,7 @@
 #include "platform/network_file.hpp"
 #include "platform/surface_io.hpp"
 #include "systems/reconstruct/reconstruct.hpp"
-#include "systems/subdivide/bspline_patches.hpp"
+#include "systems/catmull_clark/bspline_patches.hpp"
 #include "tools/fire/commands.hpp"
 #include "tools/fire/surface_args.hpp"
 
@@ -64,7 +64,7 @@ int run_reconstruct(const ReconstructArgs& a, const CLI::App& cmd) {
   if (to_cad || !a.cage_paths.empty()) cage = reconstruct::cage_of(state, options, surface);
   nlohmann::ordered_json cad_out;
   if (to_cad) {
-    auto converted = subdivide::bspline_patches(*cage);
+    auto converted = catmull_clark::bspline_patches(*cage);
     if (!converted) return fail(a.network_path + ": " + converted.error());
     auto written = cad::write_cad(converted->patches, a.out_path, *unit);
     if (!written) return fail(written.error());

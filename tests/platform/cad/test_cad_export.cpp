@@ -15,7 +15,7 @@
 #include "platform/obj.hpp"
 #include "systems/evaluate/evaluate.hpp"
 #include "systems/reconstruct/reconstruct.hpp"
-#include "systems/subdivide/bspline_patches.hpp"
+#include "systems/catmull_clark/bspline_patches.hpp"
 #include "systems/synth/network_from_mesh.hpp"
 
 // The sanitizer build's LeakSanitizer reads OpenCASCADE's suppressions (its process-lifetime allocations).
@@ -25,7 +25,7 @@ namespace {
 
 using fire::Vec3;
 namespace cad = fire::cad;
-namespace sd = fire::subdivide;
+namespace sd = fire::catmull_clark;
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 

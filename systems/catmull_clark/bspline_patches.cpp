@@ -1,6 +1,6 @@
 // The limit surface as bicubic patches (see bspline_patches.hpp): regular quads exactly, the rest
 // subdivided locally, level by level, with the faces each depends on, and fitted at the end.
-#include "systems/subdivide/bspline_patches.hpp"
+#include "systems/catmull_clark/bspline_patches.hpp"
 
 #include <Eigen/Cholesky>
 #include <algorithm>
@@ -8,7 +8,7 @@
 #include <cmath>
 #include <string>
 
-namespace fire::subdivide {
+namespace fire::catmull_clark {
 namespace {
 
 using Grid = std::array<Vec3, 16>;  // control point (i, j) at 4 j + i, i along u
@@ -612,4 +612,4 @@ Result<BsplineConversion> bspline_patches(const BaseTopology& topology, std::spa
   return out;
 }
 
-}  // namespace fire::subdivide
+}  // namespace fire::catmull_clark

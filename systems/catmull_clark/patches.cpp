@@ -4,9 +4,9 @@
 #include <algorithm>
 #include <array>
 
-#include "systems/subdivide/patches.hpp"
+#include "systems/catmull_clark/patches.hpp"
 
-namespace fire::subdivide::detail {
+namespace fire::catmull_clark::detail {
 namespace {
 
 struct Cell {
@@ -371,4 +371,4 @@ void plan_regular_patches(const BaseTopology& topology, Refinement& refinement) 
   refinement.last_from_osd = std::move(rank);
 }
 
-}  // namespace fire::subdivide::detail
+}  // namespace fire::catmull_clark::detail

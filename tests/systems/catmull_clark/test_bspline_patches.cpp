@@ -1,4 +1,4 @@
-// The limit surface as bicubic patches (systems/subdivide/bspline_patches.hpp) against the limit itself, from
+// The limit surface as bicubic patches (systems/catmull_clark/bspline_patches.hpp) against the limit itself, from
 // limit stencils of a uniform refinement: exact patches equal it at the same (u, v), fitted ones lie within the
 // tolerance at points finer than those they were fitted to; regular and irregular counts where they are known.
 #include <catch2/catch.hpp>
@@ -9,11 +9,11 @@
 #include <string>
 
 #include "platform/obj.hpp"
-#include "systems/subdivide/bspline_patches.hpp"
+#include "systems/catmull_clark/bspline_patches.hpp"
 
 namespace {
 
-namespace sd = fire::subdivide;
+namespace sd = fire::catmull_clark;
 using fire::Vec3;
 using fire::kNone;
 

@@ -24,9 +24,9 @@
 #include "engine/bspline.hpp"
 #include "engine/cage.hpp"
 #include "engine/common.hpp"
-#include "systems/subdivide/subdivide.hpp"
+#include "systems/catmull_clark/catmull_clark.hpp"
 
-namespace fire::subdivide {
+namespace fire::catmull_clark {
 
 struct BsplineOptions {
   double tolerance = 1e-4;     // largest distance of a fitted patch to the limit, a fraction of the diagonal
@@ -68,4 +68,4 @@ Vec3 evaluate_patch(const BsplinePatches& patches, size_t p, double u, double v)
 // upper bound of the true distance; equal to it when (u, v) starts in the right basin).
 double distance_to_patch(const BsplinePatches& patches, size_t p, const Vec3& x, double u, double v);
 
-}  // namespace fire::subdivide
+}  // namespace fire::catmull_clark

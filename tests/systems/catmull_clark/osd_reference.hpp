@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "engine/common.hpp"
-#include "systems/subdivide/subdivide.hpp"
+#include "systems/catmull_clark/catmull_clark.hpp"
 
 namespace fire::osd_reference {
 
@@ -106,7 +106,7 @@ inline Limit limit(const Far::TopologyRefiner& refiner, const std::vector<Point>
 }
 
 // Per-vertex values of our last level (points, limit positions, normals) in OpenSubdiv's numbering.
-inline std::vector<Vec3> in_osd_numbering(const subdivide::Refinement& refinement, const std::vector<Vec3>& values) {
+inline std::vector<Vec3> in_osd_numbering(const catmull_clark::Refinement& refinement, const std::vector<Vec3>& values) {
   if (refinement.last_from_osd.empty()) return values;
   std::vector<Vec3> out(values.size());
   for (size_t v = 0; v < values.size(); ++v) out[v] = values[refinement.last_from_osd[v]];
@@ -114,8 +114,8 @@ inline std::vector<Vec3> in_osd_numbering(const subdivide::Refinement& refinemen
 }
 
 // Our last level with OpenSubdiv's vertex numbering (faces and edges keep theirs).
-inline subdivide::Level last_level_in_osd_numbering(const subdivide::Refinement& refinement) {
-  subdivide::Level level = refinement.last();
+inline catmull_clark::Level last_level_in_osd_numbering(const catmull_clark::Refinement& refinement) {
+  catmull_clark::Level level = refinement.last();
   const std::vector<uint32_t>& ours = refinement.last_from_osd;
   if (ours.empty()) return level;
   std::vector<uint32_t> theirs(ours.size());
@@ -123,7 +123,7 @@ inline subdivide::Level last_level_in_osd_numbering(const subdivide::Refinement&
   for (uint32_t& v : level.face_vertices) v = theirs[v];
   for (uint32_t& v : level.edge_vertices) v = theirs[v];
   if (!level.has_adjacency()) return level;
-  const subdivide::Level& last = refinement.last();
+  const catmull_clark::Level& last = refinement.last();
   level.ring_offsets.assign(1, 0);
   level.ring_edges.clear();
   level.ring_neighbors.clear();

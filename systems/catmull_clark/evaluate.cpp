@@ -7,9 +7,9 @@
 #include <cstring>
 #include <string>
 
-#include "systems/subdivide/subdivide.hpp"
+#include "systems/catmull_clark/catmull_clark.hpp"
 
-namespace fire::subdivide {
+namespace fire::catmull_clark {
 namespace {
 
 // A point as an x,y pair and z: two arithmetic instructions per operation instead of three (the GCC
@@ -394,4 +394,4 @@ Result<SubdividedMesh> subdivide(const SubdivisionInput& input, int levels) {
   return mesh;
 }
 
-}  // namespace fire::subdivide
+}  // namespace fire::catmull_clark

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <string>
 
-#include "systems/subdivide/patches.hpp"
+#include "systems/catmull_clark/patches.hpp"
 
-namespace fire::subdivide {
+namespace fire::catmull_clark {
 namespace {
 
 // Upper bound on the faces of the last level: beyond it the arrays would not fit a shared machine.
@@ -466,4 +466,4 @@ void vertices_along_edge(const Refinement& r, size_t level, uint32_t edge, uint3
     along_edge(r, level, edge, from, out);
 }
 
-}  // namespace fire::subdivide
+}  // namespace fire::catmull_clark

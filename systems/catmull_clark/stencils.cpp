@@ -2,9 +2,9 @@
 // composition.
 #include <algorithm>
 
-#include "systems/subdivide/subdivide.hpp"
+#include "systems/catmull_clark/catmull_clark.hpp"
 
-namespace fire::subdivide {
+namespace fire::catmull_clark {
 namespace {
 
 class RowWriter {
@@ -207,4 +207,4 @@ StencilTable factorize(const Refinement& refinement) {
   return table;
 }
 
-}  // namespace fire::subdivide
+}  // namespace fire::catmull_clark

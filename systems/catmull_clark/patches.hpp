@@ -1,8 +1,8 @@
 #pragma once
 // Internal to fire_subdivide: the two halves of build_refinement.
-#include "systems/subdivide/subdivide.hpp"
+#include "systems/catmull_clark/catmull_clark.hpp"
 
-namespace fire::subdivide::detail {
+namespace fire::catmull_clark::detail {
 
 // The levels alone (Refinement::patches left empty).
 Result<Refinement> build_levels(const BaseTopology& base, const RefinementOptions& options);
@@ -12,4 +12,4 @@ Result<Refinement> build_levels(const BaseTopology& base, const RefinementOption
 // base quad, or a vertex in no face).
 void plan_regular_patches(const BaseTopology& base, Refinement& refinement);
 
-}  // namespace fire::subdivide::detail
+}  // namespace fire::catmull_clark::detail

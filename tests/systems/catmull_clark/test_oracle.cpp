@@ -8,11 +8,11 @@
 
 #include "osd_reference.hpp"
 #include "platform/obj.hpp"
-#include "systems/subdivide/subdivide.hpp"
+#include "systems/catmull_clark/catmull_clark.hpp"
 
 namespace {
 
-namespace sd = fire::subdivide;
+namespace sd = fire::catmull_clark;
 namespace osd = fire::osd_reference;
 using fire::Vec3;
 

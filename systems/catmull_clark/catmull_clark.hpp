@@ -30,7 +30,7 @@
 
 #include "engine/common.hpp"
 
-namespace fire::subdivide {
+namespace fire::catmull_clark {
 
 // The rule that moves a vertex, from its count of infinitely sharp incident edges (boundary edges
 // included): 0 smooth, 1 dart (moves like smooth), 2 crease, more than 2 corner. A boundary vertex with
@@ -230,4 +230,4 @@ struct SubdividedMesh {
 // levels >= 1. Rejects non-finite positions besides what build_refinement rejects.
 Result<SubdividedMesh> subdivide(const SubdivisionInput& input, int levels);
 
-}  // namespace fire::subdivide
+}  // namespace fire::catmull_clark

@@ -6,9 +6,9 @@
 #include <numbers>
 #include <string>
 
-#include "systems/subdivide/subdivide.hpp"
+#include "systems/catmull_clark/catmull_clark.hpp"
 
-namespace fire::subdivide {
+namespace fire::catmull_clark {
 namespace {
 
 // Row layout for a vertex with n ring edges and m ring faces: [vertex, edge neighbours 0..n-1, the
@@ -192,4 +192,4 @@ void evaluate_limit(const LimitStencils& limit, std::span<const Vec3> last_level
   }
 }
 
-}  // namespace fire::subdivide
+}  // namespace fire::catmull_clark

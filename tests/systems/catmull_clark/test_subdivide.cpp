@@ -6,11 +6,11 @@
 #include <string>
 
 #include "platform/obj.hpp"
-#include "systems/subdivide/subdivide.hpp"
+#include "systems/catmull_clark/catmull_clark.hpp"
 
 namespace {
 
-namespace sd = fire::subdivide;
+namespace sd = fire::catmull_clark;
 using fire::Vec3;
 
 // Axis-aligned cube [-1, 1]^3, faces counter-clockwise seen from outside.
