@@ -22,7 +22,7 @@
 #include "systems/refine/refine_system.hpp"
 #include "systems/split/edit.hpp"
 #include "systems/subdivide/subdivide_system.hpp"
-#include "tests/reconstruct/networks.hpp"
+#include "tests/systems/reconstruct/networks.hpp"
 
 using namespace fire;
 using soak::peak_mib;

@@ -12,7 +12,7 @@
 #include "systems/tracking/calibration.hpp"
 #include "systems/tracking/registration.hpp"
 #include "systems/tracking/triangulation.hpp"
-#include "tests/tracking_geometry/synthetic.hpp"
+#include "tests/systems/tracking/synthetic.hpp"
 
 using namespace fire;
 using namespace fire::tracking;

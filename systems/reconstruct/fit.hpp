@@ -26,7 +26,7 @@
 //      Alternating with the solve creeps along the curves, so the last steps are Anderson-mixed. Each
 //      foot keeps `min_target_spacing` of the equal step from its neighbours: where a curve bends faster
 //      than the surface can follow, the feet would otherwise gather at the bend, and the surface, pinched
-//      across the curve there, folds (the rook's K = 2 foot ring: tests/reconstruct/cli_folds.sh).
+//      across the curve there, folds (the rook's K = 2 foot ring: tests/systems/reconstruct/cli_folds.sh).
 //      Where it leaves some edges followed closely, phase 2 runs again with less fairness around them,
 //      on a second factorization (FitWeights::followed_distance);
 //   3. the split points settle on the polyline samples nearest to where phase 2 put them, and each

@@ -6,7 +6,7 @@
 #include <catch2/catch.hpp>
 
 #include "engine/network_io.hpp"
-#include "../reconstruct/networks.hpp"
+#include "tests/systems/reconstruct/networks.hpp"
 #include "test_helpers.hpp"
 
 using namespace fire;

@@ -22,7 +22,7 @@
 #include <unistd.h>
 
 #include "platform/obj.hpp"
-#include "systems/tracking/simulate.hpp"
+#include "tools/simulation/simulate.hpp"
 #include "tests/temp_dir.hpp"
 #include "tools/app/session_rig.hpp"
 #include "tools/app/session_store.hpp"
@@ -517,16 +517,16 @@ TEST_CASE("a tracked drawing's snapshots hold the triangulation system's state",
   // its filter, reopens to what a clean `fire replay --rig` gives.
   auto pawn = read_obj(FIRE_DATA_DIR "/meshes/pawn.obj");
   REQUIRE(pawn.ok());
-  tracking::RigOptions rig_options;
+  simulation::RigOptions rig_options;
   rig_options.occlusion_per_s = 0.5;
-  tracking::SketchOptions sketch;
+  simulation::SketchOptions sketch;
   sketch.duration_s = 14;
   sketch.strokes = 4;
   sketch.hold_s = 0.5;
-  auto simulated = tracking::simulate_sketch(rig_options, sketch,
+  auto simulated = simulation::simulate_sketch(rig_options, sketch,
                                              {pawn->positions, pawn->face_offsets, pawn->face_vertices});
   REQUIRE(simulated.ok());
-  auto true_rig = tracking::true_rig_json(rig_options);
+  auto true_rig = simulation::true_rig_json(rig_options);
   REQUIRE(true_rig.ok());
   const std::string rig_json = *true_rig;
   auto log = parse_input_log(format_input_log(simulated->events), "sketch.log");

@@ -15,7 +15,7 @@
 #include "platform/wiimote/driver.hpp"
 #include "platform/wiimote/fake_remote.hpp"
 #include "systems/synth/network_from_mesh.hpp"
-#include "systems/tracking/simulate.hpp"
+#include "tools/simulation/simulate.hpp"
 #include "tests/platform/wiimote/helpers.hpp"
 #include "tests/temp_dir.hpp"
 #include "tools/app/fake_rig.hpp"
@@ -55,8 +55,8 @@ struct Scenario {
   std::vector<InputEvent> commands;  // stamped from the simulation's start
 };
 
-std::string rig_json_of(const tracking::RigOptions& rig_options) {
-  auto rig = tracking::true_rig_json(rig_options);
+std::string rig_json_of(const simulation::RigOptions& rig_options) {
+  auto rig = simulation::true_rig_json(rig_options);
   REQUIRE(rig.ok());
   return *rig;
 }
@@ -66,13 +66,13 @@ const Scenario& sketch() {
   static const Scenario s = [] {
     auto pawn = read_obj(FIRE_DATA_DIR "/meshes/pawn.obj");
     REQUIRE(pawn.ok());
-    tracking::RigOptions rig_options;
-    tracking::SketchOptions options;
+    simulation::RigOptions rig_options;
+    simulation::SketchOptions options;
     options.duration_s = 7;
     options.strokes = 5;
     options.hold_s = 0.3;
     auto simulated =
-        tracking::simulate_sketch(rig_options, options, {pawn->positions, pawn->face_offsets, pawn->face_vertices});
+        simulation::simulate_sketch(rig_options, options, {pawn->positions, pawn->face_offsets, pawn->face_vertices});
     REQUIRE(simulated.ok());
     return Scenario{simulated_blobs_of(simulated->events), simulated->stats.duration_s, rig_json_of(rig_options), {}};
   }();
@@ -84,16 +84,16 @@ const Scenario& drawing() {
   static const Scenario s = [] {
     auto pawn = read_obj(FIRE_DATA_DIR "/meshes/pawn.obj");
     REQUIRE(pawn.ok());
-    tracking::DrawingOptions options;
+    simulation::DrawingOptions options;
     options.max_strokes = 2;
-    auto placed = tracking::object_frame(pawn->positions, options.height_m);
+    auto placed = simulation::object_frame(pawn->positions, options.height_m);
     REQUIRE(placed.ok());
     auto network = network_from_mesh({*placed, pawn->face_offsets, pawn->face_vertices, "pawn.obj"},
                                      UnrefineOptions{.unrefine = 2, .limit = true});
     REQUIRE(network.ok());
-    tracking::RigOptions rig_options;
-    auto simulated = tracking::simulate_drawing(rig_options, options, {*placed, pawn->face_offsets, pawn->face_vertices},
-                                                tracking::drawing_network(*network));
+    simulation::RigOptions rig_options;
+    auto simulated = simulation::simulate_drawing(rig_options, options, {*placed, pawn->face_offsets, pawn->face_vertices},
+                                                simulation::drawing_network(*network));
     REQUIRE(simulated.ok());
     constexpr double kSeconds = 12;  // the first registration (at 5.6 s) and the border's first strokes
     Scenario out{simulated_blobs_of(simulated->session.events), kSeconds, rig_json_of(rig_options), {}};

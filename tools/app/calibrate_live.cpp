@@ -16,7 +16,7 @@
 #include "platform/wiimote/hidapi_backend.hpp"
 #include "systems/tracking/camera.hpp"
 #include "engine/ir_report.hpp"
-#include "systems/tracking/simulate.hpp"
+#include "tools/simulation/simulate.hpp"
 #include "tools/app/fake_rig.hpp"
 #include "tools/app/live_session.hpp"
 
@@ -71,13 +71,13 @@ class WandCoverage {
 };
 
 Result<SimulatedBlobs> simulated_wand(uint64_t seed, const LiveWandOptions& o) {
-  tracking::RigOptions rig;
+  simulation::RigOptions rig;
   rig.seed = seed;
   rig.rig_seed = seed;
-  tracking::WandOptions wand;
+  simulation::WandOptions wand;
   wand.duration_s = o.max_seconds;
   wand.length_m = o.wand_length_m;
-  auto session = tracking::simulate_wand(rig, wand);
+  auto session = simulation::simulate_wand(rig, wand);
   if (!session) return Result<SimulatedBlobs>::failure("--fake-rig: " + session.error());
   return simulated_blobs_of(session->events);
 }

@@ -9,7 +9,7 @@
 #include "platform/obj.hpp"
 #include "systems/synth/network_from_mesh.hpp"
 #include "engine/ir_report.hpp"
-#include "systems/tracking/simulate.hpp"
+#include "tools/simulation/simulate.hpp"
 #include "tools/app/pad.hpp"
 #include "tools/app/session_rig.hpp"
 
@@ -99,20 +99,20 @@ Result<std::unique_ptr<FakeDrawingRig>> FakeDrawingRig::create(uint64_t seed, in
   if (!pawn_path) return R::failure("--fake-rig: " + pawn_path.error());
   auto pawn = read_obj(*pawn_path);
   if (!pawn) return R::failure("--fake-rig: " + pawn.error());
-  tracking::DrawingOptions options;
+  simulation::DrawingOptions options;
   options.max_strokes = max_strokes;
-  auto placed = tracking::object_frame(pawn->positions, options.height_m);
+  auto placed = simulation::object_frame(pawn->positions, options.height_m);
   if (!placed) return R::failure("--fake-rig: " + placed.error());
   auto network = network_from_mesh({*placed, pawn->face_offsets, pawn->face_vertices, *pawn_path},
                                    UnrefineOptions{.unrefine = 2, .limit = true});
   if (!network) return R::failure("--fake-rig: " + network.error());
-  tracking::RigOptions rig;
+  simulation::RigOptions rig;
   rig.seed = rig.rig_seed = seed;
-  auto surface = limit_mesh({*placed, pawn->face_offsets, pawn->face_vertices, *pawn_path}, tracking::kOccluderLevels);
+  auto surface = limit_mesh({*placed, pawn->face_offsets, pawn->face_vertices, *pawn_path}, simulation::kOccluderLevels);
   if (!surface) return R::failure("--fake-rig: " + surface.error());
-  auto drawing = tracking::simulate_drawing(rig, options, surface->view(), tracking::drawing_network(*network));
+  auto drawing = simulation::simulate_drawing(rig, options, surface->view(), simulation::drawing_network(*network));
   if (!drawing) return R::failure("--fake-rig: " + drawing.error());
-  auto rig_json = tracking::true_rig_json(rig);
+  auto rig_json = simulation::true_rig_json(rig);
   if (!rig_json) return R::failure("--fake-rig: " + rig_json.error());
 
   std::unique_ptr<FakeDrawingRig> out(new FakeDrawingRig());

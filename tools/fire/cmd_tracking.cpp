@@ -16,7 +16,7 @@
 #include "systems/synth/network_from_mesh.hpp"
 #include "systems/tracking/calibration.hpp"
 #include "systems/tracking/rig_io.hpp"
-#include "systems/tracking/simulate.hpp"
+#include "tools/simulation/simulate.hpp"
 #include "systems/tracking/track.hpp"
 #include "systems/triangulate/triangulate.hpp"
 #include "tools/app/calibrate_live.hpp"
@@ -29,6 +29,7 @@ namespace {
 
 using nlohmann::ordered_json;
 using namespace fire::tracking;
+using namespace fire::simulation;
 
 int fail(const std::string& command, const std::string& message) {
   std::cerr << "fire " << command << ": " << message << "\n";

@@ -11,7 +11,7 @@
 #include "platform/obj.hpp"
 #include "platform/wiimote/driver.hpp"
 #include "platform/wiimote/fake_remote.hpp"
-#include "systems/tracking/simulate.hpp"
+#include "tools/simulation/simulate.hpp"
 #include "systems/tracking/track.hpp"
 #include "tests/platform/wiimote/helpers.hpp"
 #include "tools/app/fake_rig.hpp"
@@ -331,11 +331,11 @@ namespace {
 SimulatedBlobs simulated_blobs() {
   Result<PolygonMesh> mesh = read_obj(std::string(FIRE_DATA_DIR) + "/meshes/pawn.obj");
   REQUIRE(mesh.ok());
-  tracking::SketchOptions sketch;
+  simulation::SketchOptions sketch;
   sketch.strokes = 2;
   sketch.hold_s = 0.2;
   sketch.duration_s = 3;
-  Result<tracking::SimulatedSession> sim = tracking::simulate_sketch(tracking::RigOptions{}, sketch, mesh->view());
+  Result<simulation::SimulatedSession> sim = simulation::simulate_sketch(simulation::RigOptions{}, sketch, mesh->view());
   REQUIRE(sim.ok());
   return simulated_blobs_of(sim->events);
 }

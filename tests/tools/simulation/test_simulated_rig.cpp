@@ -7,12 +7,13 @@
 
 #include "engine/input_log.hpp"
 #include "platform/obj.hpp"
-#include "systems/tracking/simulate.hpp"
+#include "tools/simulation/simulate.hpp"
 #include "systems/tracking/track.hpp"
 #include "systems/triangulate/triangulate.hpp"
 
 using namespace fire;
 using namespace fire::tracking;
+using namespace fire::simulation;
 
 namespace {
 

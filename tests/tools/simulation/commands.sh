@@ -3,7 +3,7 @@
 #   commands.sh FIRE_BINARY WORK_DIR
 # Checks that each prints one JSON line whose accuracy fields are finite numbers, that a damaged
 # log still tracks with its bad reports counted, and that bad input fails with a message.
-source "$(dirname "${BASH_SOURCE[0]}")/../work_dir.sh"
+source "$(dirname "${BASH_SOURCE[0]}")/../../work_dir.sh"
 # A finite JSON number for "key" (JSON has no NaN or infinity: those would be null or absent).
 has_number() { # json key
   grep -Eq "\"$2\":-?[0-9]+(\.[0-9]+)?([eE][-+]?[0-9]+)?[,}]" <<<"$1" || fail "no finite \"$2\" in: $1"

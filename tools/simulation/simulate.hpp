@@ -33,7 +33,7 @@
 #include "systems/tracking/camera.hpp"
 #include "systems/tracking/track.hpp"
 
-namespace fire::tracking {
+namespace fire::simulation {
 
 struct RigOptions {
   uint64_t seed = 1;               // noise, timing, motion, dropouts, stray, occlusions
@@ -162,8 +162,8 @@ DrawingNetwork drawing_network(const Mesh& network);
 
 // The accuracy rig: the true cameras and the intrinsics calibration is told to start from.
 struct SimulatedRig {
-  std::array<Camera, 2> cameras;
-  std::array<Intrinsics, 2> nominal;
+  std::array<tracking::Camera, 2> cameras;
+  std::array<tracking::Intrinsics, 2> nominal;
 };
 Result<SimulatedRig> make_simulated_rig(const RigOptions& rig);
 // The rig file (rig_io.hpp) of the true cameras and clock offset: what a perfect calibration would give,
@@ -185,9 +185,9 @@ struct PenTruth {
 };
 struct SessionTruth {
   bool has_cameras = false;
-  std::array<Camera, 2> cameras;
+  std::array<tracking::Camera, 2> cameras;
   std::array<bool, 2> has_nominal{};
-  std::array<Intrinsics, 2> nominal{};
+  std::array<tracking::Intrinsics, 2> nominal{};
   bool has_wand_length = false;
   double wand_length_m = 0;
   bool has_clocks = false;
@@ -224,7 +224,7 @@ struct PenAccuracy {
 // is moved into camera 0's frame with camera 0's true pose (X_cam0 = R0 X + t0): the calibrated
 // rig has camera 0 at its origin, so no registration stands between the two. Fails when the
 // log has no camera truth.
-Result<PenAccuracy> evaluate_pen_accuracy(const PenTrack& track, const SessionTruth& truth,
+Result<PenAccuracy> evaluate_pen_accuracy(const tracking::PenTrack& track, const SessionTruth& truth,
                                           double settle_s);
 
 // How far a calibrated rig is from the simulator's cameras (camera 1 relative to camera 0).
@@ -236,6 +236,6 @@ struct RigErrors {
   std::array<double, 2> principal_point_error_px{};
   std::array<double, 2> k1_error{};
 };
-Result<RigErrors> compare_rig(const CalibrationResult& rig, const SessionTruth& truth);
+Result<RigErrors> compare_rig(const tracking::CalibrationResult& rig, const SessionTruth& truth);
 
-}  // namespace fire::tracking
+}  // namespace fire::simulation

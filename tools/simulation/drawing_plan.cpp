@@ -1,4 +1,4 @@
-#include "systems/tracking/drawing_plan.hpp"
+#include "tools/simulation/drawing_plan.hpp"
 
 #include <algorithm>
 #include <numeric>
@@ -9,7 +9,8 @@
 
 #include "engine/input_log.hpp"
 
-namespace fire::tracking {
+namespace fire::simulation {
+using namespace tracking;  // the cameras, calibration and tracking this simulation feeds and checks
 
 std::vector<Vec3> chain_points(const DrawingNetwork& net, const Chain& chain) {
   std::vector<Vec3> out;
@@ -869,4 +870,4 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
   return plan;
 }
 
-}  // namespace fire::tracking
+}  // namespace fire::simulation

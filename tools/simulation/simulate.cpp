@@ -1,4 +1,4 @@
-#include "systems/tracking/simulate.hpp"
+#include "tools/simulation/simulate.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -13,11 +13,12 @@
 #include <random>
 
 #include "engine/ir_report.hpp"
-#include "systems/tracking/drawing_plan.hpp"
+#include "tools/simulation/drawing_plan.hpp"
 #include "systems/tracking/registration.hpp"
 #include "systems/tracking/rig_io.hpp"
 
-namespace fire::tracking {
+namespace fire::simulation {
+using namespace tracking;  // the cameras, calibration and tracking this simulation feeds and checks
 namespace {
 
 // Random numbers from raw 64-bit draws: the standard distributions differ between standard
@@ -1313,4 +1314,4 @@ DrawingNetwork drawing_network(const Mesh& m) {
   return net;
 }
 
-}  // namespace fire::tracking
+}  // namespace fire::simulation

@@ -5,7 +5,7 @@
 # box through it when the pawn is upside down): the pawn is drawn whole, then the box, a second part, would
 # start with a border loop of its own that no camera sees, so `fire simulate drawing` exits 1 naming what it
 # could not draw, why, and how many curves it drew; --max-strokes still stops a drawing early with exit 0.
-source "$(dirname "${BASH_SOURCE[0]}")/../work_dir.sh"
+source "$(dirname "${BASH_SOURCE[0]}")/../../work_dir.sh"
 meshes="$3"
 awk '
   /^v / { print "v", $2, $3, $4; n++ }

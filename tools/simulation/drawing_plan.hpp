@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "engine/common.hpp"
-#include "systems/tracking/simulate.hpp"
+#include "tools/simulation/simulate.hpp"
 
-namespace fire::tracking {
+namespace fire::simulation {
 
 std::vector<Vec3> chain_points(const DrawingNetwork& net, const Chain& chain);
 
@@ -51,4 +51,4 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
 // Whether a network has no border loop: its underside is drawn with the object upside down.
 bool network_closed(const DrawingNetwork& net);
 
-}  // namespace fire::tracking
+}  // namespace fire::simulation

@@ -2,7 +2,7 @@
 # Bad live input through the simulated rig and the whole frame (fire replay --rig): each kind of damage
 # is counted, said in words on stderr naming the log, and leaves the drawing intact; none crashes.
 #   bad_live_input.sh FIRE_BINARY WORK_DIR
-source "$(dirname "${BASH_SOURCE[0]}")/../work_dir.sh"
+source "$(dirname "${BASH_SOURCE[0]}")/../../work_dir.sh"
 
 "$fire" simulate wand --duration-s 10 -o w.log >/dev/null
 "$fire" calibrate w.log -o rig.json >/dev/null

@@ -6,7 +6,7 @@
 #include <numbers>
 
 #include "systems/tracking/track.hpp"
-#include "tests/triangulate/exact_pen.hpp"
+#include "tests/systems/triangulate/exact_pen.hpp"
 
 using namespace fire;
 using namespace fire::tracking;

@@ -4,7 +4,7 @@
 # measured 2026-11-24 with the whole-log frame clock and time offset): fire track now runs the
 # triangulation system frame by frame, and must stay within 5 % of those figures.
 #   live_accuracy.sh FIRE_BINARY WORK_DIR
-source "$(dirname "${BASH_SOURCE[0]}")/../work_dir.sh"
+source "$(dirname "${BASH_SOURCE[0]}")/../../work_dir.sh"
 field() { sed -n "s/.*\"$1\":\([-+0-9.eE]*\)[,}].*/\1/p" <<<"$2"; }
 
 "$fire" simulate wand --seed 1 --rig-seed 1 -o w.log >/dev/null

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "systems/triangulate/triangulate.hpp"
-#include "tests/triangulate/exact_pen.hpp"
+#include "tests/systems/triangulate/exact_pen.hpp"
 
 using namespace fire;
 using namespace fire::tracking;

@@ -5,7 +5,7 @@
 # surface has the object's Euler characteristic and border loops, and fire eval's rms is within 2e-3 of the
 # diagonal. The summary's counts are checked where the options ask for them: `--turns 3` on the lampshade
 # draws curves in pieces, continued after the object is turned and registered again.
-source "$(dirname "${BASH_SOURCE[0]}")/../work_dir.sh"
+source "$(dirname "${BASH_SOURCE[0]}")/../../work_dir.sh"
 meshes="$3" object="$4" euler="$5" loops="$6"
 shift 6
 field() { sed -n "s/.*\"$1\": *\([-+0-9.eE]*\).*/\1/p" "$2" | head -1; }
