@@ -217,24 +217,24 @@ Status Presenter::record_capture(VkCommandBuffer cmd, VkImage image) {
   return Status::success();
 }
 
-Result<bool> Presenter::frame(Renderer& renderer, const Camera& camera, const DrawOptions& options,
+Result<Presented> Presenter::frame(Renderer& renderer, const Camera& camera, const DrawOptions& options,
                               const Overlay& overlay, Image* capture) {
   VkDevice device = context_.device();
-  if (!swapchain_ || extent_.width == 0 || extent_.height == 0) return false;
-  if (capture && !can_capture_) return Result<bool>::failure("the window's images cannot be read back for a screenshot");
+  if (!swapchain_ || extent_.width == 0 || extent_.height == 0) return Presented::swapchain_stale;
+  if (capture && !can_capture_) return Result<Presented>::failure("the window's images cannot be read back for a screenshot");
   if (renderer.color_format() != format_.format)
-    return Result<bool>::failure("the renderer draws in another format than the window's images (RenderSettings::color_format)");
-  if (Status s = wait(); !s) return Result<bool>::failure(s.error);
+    return Result<Presented>::failure("the renderer draws in another format than the window's images (RenderSettings::color_format)");
+  if (Status s = wait(); !s) return Result<Presented>::failure(s.error);
   if (renderer.width() != extent_.width || renderer.height() != extent_.height)
-    if (Status s = renderer.resize(extent_.width, extent_.height); !s) return Result<bool>::failure(s.error);
+    if (Status s = renderer.resize(extent_.width, extent_.height); !s) return Result<Presented>::failure(s.error);
 
   uint32_t index = 0;
   const VkResult acquired = vkAcquireNextImageKHR(device, swapchain_, kWaitNs, acquired_, VK_NULL_HANDLE, &index);
-  if (acquired == VK_ERROR_OUT_OF_DATE_KHR) return false;
+  if (acquired == VK_ERROR_OUT_OF_DATE_KHR) return Presented::swapchain_stale;
   if (acquired != VK_SUCCESS && acquired != VK_SUBOPTIMAL_KHR)
-    return Result<bool>::failure(vk_failure("vkAcquireNextImageKHR", acquired));
+    return Result<Presented>::failure(vk_failure("vkAcquireNextImageKHR", acquired));
 
-  auto fail = [](const char* call, VkResult r) { return Result<bool>::failure(vk_failure(call, r)); };
+  auto fail = [](const char* call, VkResult r) { return Result<Presented>::failure(vk_failure(call, r)); };
   if (VkResult r = vkResetFences(device, 1, &fence_); r != VK_SUCCESS) return fail("vkResetFences", r);
   VkCommandBuffer cmd = commands_;
   if (VkResult r = vkResetCommandBuffer(cmd, 0); r != VK_SUCCESS) return fail("vkResetCommandBuffer", r);
@@ -255,7 +255,7 @@ Result<bool> Presenter::frame(Renderer& renderer, const Camera& camera, const Dr
   overlay(cmd);
   vkCmdEndRenderPass(cmd);
   if (capture)
-    if (Status s = record_capture(cmd, image); !s) return Result<bool>::failure(s.error);
+    if (Status s = record_capture(cmd, image); !s) return Result<Presented>::failure(s.error);
   if (VkResult r = vkEndCommandBuffer(cmd); r != VK_SUCCESS) return fail("vkEndCommandBuffer", r);
 
   VkSemaphoreSubmitInfo wait_acquire{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
@@ -286,7 +286,7 @@ Result<bool> Presenter::frame(Renderer& renderer, const Camera& camera, const Dr
     return fail("vkQueuePresentKHR", presented);
 
   if (capture) {
-    if (Status s = wait(); !s) return Result<bool>::failure(s.error);
+    if (Status s = wait(); !s) return Result<Presented>::failure(s.error);
     capture->width = extent_.width;
     capture->height = extent_.height;
     const auto* bytes = static_cast<const uint8_t*>(capture_mapped_);
@@ -296,7 +296,7 @@ Result<bool> Presenter::frame(Renderer& renderer, const Camera& camera, const Dr
     for (size_t i = 3; i < capture->rgba.size(); i += 4) capture->rgba[i] = 255;  // what the window shows is opaque
   }
   // Shown, but the swapchain no longer matches the window: the caller resizes before the next frame.
-  return acquired == VK_SUCCESS && presented == VK_SUCCESS;
+  return acquired == VK_SUCCESS && presented == VK_SUCCESS ? Presented::shown : Presented::swapchain_stale;
 }
 
 }  // namespace fire::render

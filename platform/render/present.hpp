@@ -16,6 +16,9 @@
 
 namespace fire::render {
 
+// What Presenter::frame did with a frame it drew.
+enum class Presented { shown, swapchain_stale };
+
 class Presenter {
  public:
   // Takes ownership of `surface`, made from context.instance(); width and height are the window's in pixels.
@@ -30,10 +33,10 @@ class Presenter {
   // Draws over the scene, inside overlay_pass().
   using Overlay = std::function<void(VkCommandBuffer)>;
   // Acquires an image, records the renderer's frame (resized to the swapchain first if needed) and the
-  // overlay, submits and presents. False: the swapchain no longer fits the window (out of date, suboptimal or
-  // minimised; the frame may or may not have been shown), call resize(). With `capture`, a frame that was
-  // presented is read back into it (RGBA, top row first), waiting for the frame.
-  Result<bool> frame(Renderer& renderer, const Camera& camera, const DrawOptions& options, const Overlay& overlay,
+  // overlay, submits and presents. swapchain_stale: the swapchain no longer fits the window (out of date,
+  // suboptimal or minimised; the frame may or may not have been shown), call resize(). With `capture`, a frame
+  // that was presented is read back into it (RGBA, top row first), waiting for the frame.
+  Result<Presented> frame(Renderer& renderer, const Camera& camera, const DrawOptions& options, const Overlay& overlay,
                      Image* capture = nullptr);
   // Recreates the swapchain for a window of this size; at a zero size (minimised) frame() shows nothing
   // until a later call.

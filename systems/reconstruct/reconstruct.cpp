@@ -759,17 +759,17 @@ Status build_fit(const Options& options, ReconstructionCache& c) {
   return Status::success();
 }
 
-// Per-element stage and base mesh. Returns whether the base mesh may differ from the last update's.
-Result<bool> run_refine(const Mesh& net, const Options& options, ReconstructionCache& c) {
+// Per-element stage and base mesh. `assembled`: the base mesh may differ from the last update's.
+Result<Refined> run_refine(const Mesh& net, const Options& options, ReconstructionCache& c) {
   // Cached results name slots; after a compaction they would name the wrong ones.
   const bool everything =
       !c.built || !(c.options == options) || net.last_compaction().count != c.compactions_seen;
   // An unchanged network passed the check when it was last built (a failed one empties the cache).
   if (!everything && !c.pending_subdivide && !net.written_after(c.seen)) {
     c.stats = {};
-    return false;
+    return Refined::unchanged;
   }
-  if (auto s = check_reconstruction_input(net, options); !s) return Result<bool>::failure(s.error);
+  if (auto s = check_reconstruction_input(net, options); !s) return Result<Refined>::failure(s.error);
   c.built = false;
   c.options = options;
   c.run = {};  // a fit of the previous base mesh is abandoned; subdivide starts one from the new
@@ -795,7 +795,7 @@ Result<bool> run_refine(const Mesh& net, const Options& options, ReconstructionC
   c.seen = net.frame();
   c.compactions_seen = net.last_compaction().count;
   c.built = true;
-  return true;
+  return Refined::assembled;
 }
 
 void evaluate_surface(ReconstructionCache& c, std::span<const Vec3> base_points, SurfaceMesh& surface) {
@@ -858,8 +858,8 @@ Result<SurfaceWrite> run_subdivide(const Options& options, ReconstructionCache& 
 
 }  // namespace
 
-Result<bool> refine_update(const Mesh& net, const Options& options, ReconstructionState& state) {
-  Result<bool> r = run_refine(net, options, state.cache());
+Result<Refined> refine_update(const Mesh& net, const Options& options, ReconstructionState& state) {
+  Result<Refined> r = run_refine(net, options, state.cache());
   if (!r) state.cache() = ReconstructionCache{};
   return r;
 }

@@ -242,6 +242,12 @@ Status check_reconstruction_input(const Mesh& net, const Options& options);
 // `surface` is left as it was and `state` is emptied, so the next call rebuilds everything.
 Status reconstruct_update(const Mesh& net, const Options& options, ReconstructionState& state, SurfaceMesh& surface);
 
+// What a refine_update call did with the base mesh.
+enum class Refined : uint8_t {
+  unchanged,  // nothing changed since the last call: nothing was done
+  assembled,  // the base mesh was assembled anew and may differ from the last one
+};
+
 // What a subdivide_update call wrote into its `surface`.
 enum class SurfaceWrite : uint8_t {
   none,         // nothing new: `surface` is left as it was
@@ -250,14 +256,14 @@ enum class SurfaceWrite : uint8_t {
 };
 
 // reconstruct_update in the two halves the frame runs as systems. refine_update recomputes the changed
-// edges and faces and assembles the base mesh; it returns false, doing nothing, when nothing changed since
-// its last call (a new base mesh abandons a fit still running). subdivide_update then, for a new base
+// edges and faces and assembles the base mesh; it returns Refined::unchanged, doing nothing, when nothing
+// changed since its last call (a new base mesh abandons a fit still running). subdivide_update then, for a new base
 // mesh, rebuilds topology and limit stencils where needed and evaluates into `surface` the new base
 // mesh's provisional surface (fire, unless the whole fit runs in the same call: kWholeFit). The next call
 // (fire) factorizes the fit if the topology changed, and then, or at once with the old factorization,
 // the calls run at most Options::fit_solves_per_frame of the fit's back-substitutions each and write the
 // settled surface when the fit ends. On failure the state is emptied as above.
-Result<bool> refine_update(const Mesh& net, const Options& options, ReconstructionState& state);
+Result<Refined> refine_update(const Mesh& net, const Options& options, ReconstructionState& state);
 Result<SurfaceWrite> subdivide_update(const Options& options, ReconstructionState& state, SurfaceMesh& surface);
 
 // One reconstruction from scratch.

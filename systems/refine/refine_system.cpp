@@ -10,12 +10,12 @@ void refine_system(const Mesh& mesh, const reconstruct::Options& options, recons
     build.problem.clear();
     return;
   }
-  Result<bool> changed = reconstruct::refine_update(mesh, options, build.state);
+  Result<reconstruct::Refined> changed = reconstruct::refine_update(mesh, options, build.state);
   if (!changed) {
     build.problem = changed.error();
     return;
   }
-  if (*changed) {
+  if (*changed == reconstruct::Refined::assembled) {
     build.problem.clear();
     ++build.updates;
   }
