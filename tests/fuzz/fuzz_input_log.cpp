@@ -1,7 +1,7 @@
 // Input log reader: a failed parse names the input and the problem; a parsed log has non-decreasing
 // timestamps and reads back to the same events after format_input_log (garbled hid lines aside: their
 // hex is not kept, so they cannot be written back). Non-finite pen samples are read as written: the
-// sketch system rejects their stroke (tests/engine/test_replay.cpp), so they must survive the round trip.
+// sketch system rejects their stroke (tests/tools/test_replay.cpp), so they must survive the round trip.
 #include <cmath>
 #include <cstdint>
 #include <string_view>

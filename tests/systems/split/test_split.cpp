@@ -4,7 +4,7 @@
 
 #include <catch2/catch.hpp>
 
-#include "test_helpers.hpp"
+#include "tests/engine/test_helpers.hpp"
 
 using namespace fire;
 using namespace fire::test;

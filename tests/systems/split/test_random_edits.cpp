@@ -7,7 +7,7 @@
 
 #include "engine/network_io.hpp"
 #include "tests/systems/reconstruct/networks.hpp"
-#include "test_helpers.hpp"
+#include "tests/engine/test_helpers.hpp"
 
 using namespace fire;
 using namespace fire::test;
