@@ -58,7 +58,7 @@ int measure(const std::string& name, const Mesh& net, const std::string& out) {
     return 1;
   }
   const double convert_ms = ms_since(start);
-  std::printf("%s: network %zu faces, cage %zu faces; reconstruct %.0f ms; patches %zu (%u exact, %u fitted, "
+  std::printf("%s: network %zu faces, cage %u faces; reconstruct %.0f ms; patches %zu (%u exact, %u fitted, "
               "deepest level %u), largest fit error %.2e of the diagonal; convert %.0f ms\n",
               name.c_str(), net.face_count(), cage->mesh.face_count(), reconstruct_ms, c->patches.patch_count(),
               c->exact, c->fitted, c->fit_level, c->max_fit_error, convert_ms);

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "engine/common.hpp"
+#include "engine/polygon_mesh.hpp"
 
 namespace fire::catmull_clark {
 
@@ -54,10 +55,8 @@ struct BaseTopology {
 // One level's topology. A "corner" is one entry of face_vertices; corner c of face f lies in
 // [face_offsets[f], face_offsets[f+1]). Only face_offsets and face_vertices are filled in a last level
 // built without adjacency (RefinementOptions::last_level_adjacency = false).
-struct Level {
+struct Level : PolygonFaces<uint32_t> {
   uint32_t vertex_count = 0;
-  std::vector<uint32_t> face_offsets{0};  // face count + 1
-  std::vector<uint32_t> face_vertices;    // per corner
   std::vector<uint32_t> face_edges;       // per corner: the edge from this corner to the next one
   std::vector<uint32_t> corner_faces;     // per corner: its face; level 0 only (later levels: corner / 4)
 
@@ -77,7 +76,6 @@ struct Level {
   std::vector<uint32_t> ring_corners;
   std::vector<VertexRule> vertex_rules;
 
-  uint32_t face_count() const { return static_cast<uint32_t>(face_offsets.size() - 1); }
   uint32_t corner_count() const { return static_cast<uint32_t>(face_vertices.size()); }
   uint32_t edge_count() const { return static_cast<uint32_t>(edge_vertices.size() / 2); }
   bool has_adjacency() const { return !ring_offsets.empty(); }
@@ -215,9 +213,7 @@ void vertices_along_edge(const Refinement& refinement, size_t level, uint32_t ed
 
 // One call from a polygon mesh to its subdivided quads and limit surface samples.
 struct SubdivisionInput {
-  std::span<const Vec3> positions;
-  std::span<const uint32_t> face_offsets;
-  std::span<const uint32_t> face_vertices;
+  PolygonMeshView mesh;
   std::span<const uint32_t> sharp_edges;
   std::span<const uint8_t> border_corners = {};  // as BaseTopology's
 };

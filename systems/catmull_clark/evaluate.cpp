@@ -376,11 +376,11 @@ void evaluate_all_levels(const Refinement& refinement, std::span<const Vec3> bas
 Result<SubdividedMesh> subdivide(const SubdivisionInput& input, int levels) {
   if (levels < 1)
     return Result<SubdividedMesh>::failure("subdivide needs at least 1 level, got " + std::to_string(levels));
-  for (size_t v = 0; v < input.positions.size(); ++v)
-    if (!is_finite(input.positions[v]))
+  for (size_t v = 0; v < input.mesh.positions.size(); ++v)
+    if (!is_finite(input.mesh.positions[v]))
       return Result<SubdividedMesh>::failure("vertex " + std::to_string(v) + " has a non-finite coordinate");
-  const BaseTopology base{static_cast<uint32_t>(input.positions.size()), input.face_offsets, input.face_vertices,
-                          input.sharp_edges, input.border_corners};
+  const BaseTopology base{static_cast<uint32_t>(input.mesh.positions.size()), input.mesh.face_offsets,
+                          input.mesh.face_vertices, input.sharp_edges, input.border_corners};
   Result<Refinement> refinement = build_refinement(base, {levels, true});
   if (!refinement) return Result<SubdividedMesh>::failure(refinement.error());
   Result<LimitStencils> limit = build_limit_stencils(*refinement);
@@ -388,7 +388,7 @@ Result<SubdividedMesh> subdivide(const SubdivisionInput& input, int levels) {
 
   SubdividedMesh mesh;
   std::vector<Vec3> scratch;
-  evaluate(*refinement, input.positions, mesh.positions, scratch);
+  evaluate(*refinement, input.mesh.positions, mesh.positions, scratch);
   mesh.quads = refinement->last().face_vertices;
   evaluate_limit(*limit, mesh.positions, mesh.limit_positions, mesh.limit_normals);
   return mesh;

@@ -59,7 +59,7 @@ Result<TriangleMesh> reference_limit_surface(std::span<const Vec3> positions, st
                       " quads at " + std::to_string(levels) + " Catmull-Clark levels, more than the " +
                       std::to_string(kMaxReferenceQuads) +
                       " a reference may have; give the coarse control mesh, not a dense surface");
-  auto sub = catmull_clark::subdivide({positions, face_offsets, face_vertices, sharp_edges, border_corners}, levels);
+  auto sub = catmull_clark::subdivide({{positions, face_offsets, face_vertices}, sharp_edges, border_corners}, levels);
   if (!sub) return R::failure(sub.error());
   TriangleMesh mesh;
   mesh.positions = std::move(sub->limit_positions);

@@ -359,10 +359,10 @@ FacePatch build_face_patch(std::span<const FaceSide> sides, const FaceSettings& 
   patch.interior = mesh.interior;
   for (const auto& f : faces) {
     for (uint32_t oe : f) {
-      patch.corners.push_back(mesh.tail(oe));
-      mesh.append_finer_points(oe, patch.corners);
+      patch.face_vertices.push_back(mesh.tail(oe));
+      mesh.append_finer_points(oe, patch.face_vertices);
     }
-    patch.face_offsets.push_back(static_cast<uint32_t>(patch.corners.size()));
+    patch.face_offsets.push_back(static_cast<uint32_t>(patch.face_vertices.size()));
   }
   for (const LocalEdge& e : mesh.edges) {
     if (e.splits || e.first_child >= 0) continue;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "engine/mesh.hpp"
+#include "engine/polygon_mesh.hpp"
 #include "systems/reconstruct/geometry.hpp"
 
 namespace fire::reconstruct {
@@ -48,19 +49,16 @@ struct FaceSettings {
   Planarity planarity = Planarity::least_squares;
 };
 
-// What one network face contributes to the base mesh.
-struct FacePatch {
+// What one network face contributes to the base mesh. Its faces (PolygonFaces) are the base faces, corners in
+// the face's winding: quads, or polygons where a side is split more finely than the face's Coons steps (its
+// edge's EdgeSplits::depth), whose finer split points lie between them.
+struct FacePatch : PolygonFaces<VertexRef> {
   std::vector<Vec3> interior;       // positions of the vertices made inside the face
-  // The base faces, corners in the face's winding: quads, or polygons where a side is split more finely
-  // than the face's Coons steps (its edge's EdgeSplits::depth), whose finer split points lie between them.
-  std::vector<VertexRef> corners;
-  std::vector<uint32_t> face_offsets{0};
   // Base edges inside the face (triquadrification cuts, spokes) with the polylines they carry: straight
   // (thesis) or sampled from the transfinite patch (FIRE). 2 ends per curve.
   std::vector<VertexRef> curve_ends;
   std::vector<uint32_t> curve_offsets{0};
   std::vector<Vec3> curve_points;
-  uint32_t face_count() const { return static_cast<uint32_t>(face_offsets.size() - 1); }
   uint32_t curve_count() const { return static_cast<uint32_t>(curve_offsets.size() - 1); }
   std::span<const Vec3> curve(uint32_t c) const {
     return std::span<const Vec3>(curve_points).subspan(curve_offsets[c], curve_offsets[c + 1] - curve_offsets[c]);

@@ -647,7 +647,7 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
     if (!net.face_alive(f)) continue;
     const FacePatch& p = c.faces[f];
     for (uint32_t k = 0; k < p.face_count(); ++k) {
-      for (uint32_t i = p.face_offsets[k]; i < p.face_offsets[k + 1]; ++i) base.face_vertices.push_back(id(p.corners[i], f));
+      for (uint32_t i = p.face_offsets[k]; i < p.face_offsets[k + 1]; ++i) base.face_vertices.push_back(id(p.face_vertices[i], f));
       base.face_offsets.push_back(static_cast<uint32_t>(base.face_vertices.size()));
       base.face_source.push_back(f);
     }

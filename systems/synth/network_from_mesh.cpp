@@ -624,8 +624,7 @@ bool LimitCurves::sample_chain(std::span<const uint32_t> chain, std::vector<Vec3
 namespace fire {
 
 Result<PolygonMesh> limit_mesh(const PolygonMeshView& control, int levels) {
-  Result<catmull_clark::SubdividedMesh> sub =
-      catmull_clark::subdivide({control.positions, control.face_offsets, control.face_vertices, {}}, levels);
+  Result<catmull_clark::SubdividedMesh> sub = catmull_clark::subdivide({control, {}}, levels);
   if (!sub) return Result<PolygonMesh>::failure(std::string(control.source) + ": " + sub.error());
   PolygonMesh out;
   out.positions = std::move(sub->limit_positions);

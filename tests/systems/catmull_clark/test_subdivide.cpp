@@ -75,7 +75,7 @@ TEST_CASE("boundary edges are creases and single-face boundary vertices are corn
   // One quad: every vertex is a corner, every edge point the edge midpoint.
   const std::vector<Vec3> quad = {{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {0, 2, 0}};
   const std::vector<uint32_t> offsets = {0, 4}, faces = {0, 1, 2, 3};
-  auto result = sd::subdivide({quad, offsets, faces, {}}, 2);
+  auto result = sd::subdivide({{quad, offsets, faces}, {}}, 2);
   REQUIRE(result.ok());
   for (int v = 0; v < 4; ++v) {
     CHECK((result->positions[size_t(v)] - quad[size_t(v)]).norm() == 0.0);
@@ -307,9 +307,9 @@ TEST_CASE("bad topology is rejected with a message naming the problem", "[subdiv
 
 TEST_CASE("subdivide rejects non-finite points and too few levels", "[subdivide]") {
   std::vector<Vec3> points = kCubePoints;
-  CHECK(contains(sd::subdivide({points, kCubeOffsets, kCubeFaces, {}}, 0).error(), "at least 1 level"));
+  CHECK(contains(sd::subdivide({{points, kCubeOffsets, kCubeFaces}, {}}, 0).error(), "at least 1 level"));
   points[3].y() = std::numeric_limits<double>::quiet_NaN();
-  auto result = sd::subdivide({points, kCubeOffsets, kCubeFaces, {}}, 1);
+  auto result = sd::subdivide({{points, kCubeOffsets, kCubeFaces}, {}}, 1);
   REQUIRE_FALSE(result.ok());
   CHECK(contains(result.error(), "vertex 3 has a non-finite coordinate"));
 }
@@ -326,7 +326,7 @@ TEST_CASE("limit masks need quads in the last level", "[subdivide]") {
 TEST_CASE("a vertex without faces stays where it is", "[subdivide]") {
   std::vector<Vec3> points = kCubePoints;
   points.emplace_back(5, 5, 5);
-  auto result = sd::subdivide({points, kCubeOffsets, kCubeFaces, {}}, 2);
+  auto result = sd::subdivide({{points, kCubeOffsets, kCubeFaces}, {}}, 2);
   REQUIRE(result.ok());
   CHECK(result->positions[8] == Vec3(5, 5, 5));
   CHECK(result->limit_positions[8] == Vec3(5, 5, 5));

@@ -115,7 +115,7 @@ Mesh limit_grid_network(uint32_t m, uint32_t levels, const Height& height) {
       offsets.push_back(static_cast<uint32_t>(quads.size()));
     }
   auto limit_of = [&](const std::vector<Vec3>& points) {
-    auto s = catmull_clark::subdivide({points, offsets, quads, {}}, static_cast<int>(levels));
+    auto s = catmull_clark::subdivide({{points, offsets, quads}, {}}, static_cast<int>(levels));
     REQUIRE(s.ok());
     return s->limit_positions;
   };

@@ -434,7 +434,7 @@ TEST_CASE("limit sampling: every polyline point lies on the control mesh's Catmu
     CHECK(net->edge_count() == linear->edge_count());
     CHECK(net->live_point_count() == linear->live_point_count());
     // Ground truth straight from the subdivision library: limit positions of the level-3 vertices.
-    auto truth = catmull_clark::subdivide({pm.positions, pm.face_offsets, pm.face_vertices, {}}, 3);
+    auto truth = catmull_clark::subdivide({pm.view(), {}}, 3);
     REQUIRE(truth.ok());
     std::vector<std::array<double, 3>> on_surface;
     for (const Vec3& p : truth->limit_positions) on_surface.push_back({p.x(), p.y(), p.z()});
