@@ -284,6 +284,76 @@ constexpr double kLateKnee = 3;  // jitters: beyond it a late report costs linea
 // burst of held reports is cheaper to explain as a lost report, and the numbering stays one ahead.
 double misfit_cost(double miss) { return miss <= kLateKnee ? 0.5 * miss * miss : kLateKnee * (miss - 0.5 * kLateKnee); }
 
+
+// The whole log's frame numbers, from the causal ones (FrameNumbering). Where the arrival jitter spans more
+// than a period, a few reports cannot tell a lost report from late ones, but every report after a loss
+// arrives a period early against a numbering that missed it, and hundreds of them say so. So the numbers
+// are chosen all at once: a Viterbi path over the count of frames lost so far, within kRenumberBand of the
+// causal count, against one clock line through them all, refitted until the numbers stay.
+constexpr int kRenumberBand = 24;
+constexpr int kRenumberRounds = 8;
+
+std::vector<double> renumber_whole_log(std::span<const double> arrivals, std::span<const uint8_t> held,
+                                       std::vector<double> number) {
+  const size_t n = arrivals.size();
+  constexpr int kStates = 2 * kRenumberBand + 1;
+  std::vector<std::array<uint8_t, kStates>> from(n);  // per report and state: the best state of the report before
+  for (int round = 0; round < kRenumberRounds; ++round) {
+    double mean_n = 0, mean_t = 0, count = 0;
+    for (size_t k = 0; k < n; ++k)
+      if (!held[k]) mean_n += number[k], mean_t += arrivals[k], ++count;
+    if (count < 3) return number;
+    mean_n /= count;
+    mean_t /= count;
+    double snn = 0, snt = 0;
+    for (size_t k = 0; k < n; ++k)
+      if (!held[k]) snn += (number[k] - mean_n) * (number[k] - mean_n), snt += (number[k] - mean_n) * (arrivals[k] - mean_t);
+    if (!(snn > 0)) return number;
+    const double slope = snt / snn;
+    std::vector<double> misses;
+    for (size_t k = 0; k < n; ++k)
+      if (!held[k]) misses.push_back(std::abs(arrivals[k] - (mean_t + slope * (number[k] - mean_n))));
+    std::nth_element(misses.begin(), misses.begin() + static_cast<std::ptrdiff_t>(misses.size() / 2), misses.end());
+    const double sigma = std::max(kMinJitterUs, 1.4826 * misses[misses.size() / 2]);
+    // State j of report k: number centre(k) + j - kRenumberBand, about the numbers of the round before.
+    auto centre = [&](size_t k) { return number[k]; };
+    std::array<double, kStates> cost, next;
+    cost.fill(std::numeric_limits<double>::infinity());
+    cost[kRenumberBand] = 0;  // the first report is number 0 as it is
+    for (size_t k = 1; k < n; ++k) {
+      next.fill(std::numeric_limits<double>::infinity());
+      for (int j = 0; j < kStates; ++j) {
+        const double nk = centre(k) + j - kRenumberBand;
+        const double emit = held[k] ? 0.0 : misfit_cost((arrivals[k] - (mean_t + slope * (nk - mean_n))) / sigma);
+        int best_from = -1;
+        double best = std::numeric_limits<double>::infinity();
+        // Report k - 1 in state i had number centre(k - 1) + i - kRenumberBand; the frames lost between are
+        // nk minus that minus 1, from 0 to kMaxLostInARow (0 after a held report).
+        const int shift = static_cast<int>(centre(k) - centre(k - 1)) - 1;
+        const int max_lost = held[k - 1] ? 0 : kMaxLostInARow;
+        for (int i = std::max(0, j + shift - max_lost); i <= std::min(kStates - 1, j + shift); ++i) {
+          if (!std::isfinite(cost[size_t(i)])) continue;
+          const double lost = j + shift - i;
+          const double c = cost[size_t(i)] + kLostPenalty * lost;
+          if (c < best) best = c, best_from = i;
+        }
+        if (best_from >= 0) next[size_t(j)] = best + emit;
+        from[k][size_t(j)] = uint8_t(std::max(best_from, 0));
+      }
+      cost = next;
+    }
+    int j = static_cast<int>(std::min_element(cost.begin(), cost.end()) - cost.begin());
+    std::vector<double> chosen(n);
+    for (size_t k = n; k-- > 0;) {
+      chosen[k] = centre(k) + j - kRenumberBand;
+      if (k > 0) j = from[k][size_t(j)];
+    }
+    if (chosen == number) break;
+    number = std::move(chosen);
+  }
+  return number;
+}
+
 }  // namespace
 
 FrameNumbering::Line FrameNumbering::line() const {
@@ -378,10 +448,11 @@ void fit_frame_clock(CameraFrames& f) {
   for (size_t k = 0; k < n; ++k)
     number[k] = numbering.settle(std::span<const double>(arrivals).subspan(k, std::min(n - k, FrameNumbering::kLookahead + 1)),
                                  k > 0 ? arrivals[k - 1] : std::numeric_limits<double>::quiet_NaN());
-  // Per report, the least-squares line t = a + b n through its neighbours on both sides, leaving out
-  // the arrivals of reports held back and delivered with the next (FrameNumbering::settle).
   std::vector<uint8_t> held(n, 0);
   for (size_t k = 0; k + 1 < n; ++k) held[k] = arrivals[k] == arrivals[k + 1];
+  number = renumber_whole_log(arrivals, held, std::move(number));
+  // Per report, the least-squares line t = a + b n through its neighbours on both sides, leaving out
+  // the arrivals of reports held back and delivered with the next (FrameNumbering::settle).
   constexpr ptrdiff_t kHalfWindow = 200;  // +-2 s: long enough to average the jitter, short for slow drift
   for (ptrdiff_t k = 0; k < static_cast<ptrdiff_t>(n); ++k) {
     const auto lo = static_cast<size_t>(std::max<ptrdiff_t>(0, k - kHalfWindow));
