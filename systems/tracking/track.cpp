@@ -276,6 +276,9 @@ constexpr int kMaxLostInARow = 3;
 constexpr double kLostPenalty = 4.6;         // -log of a report's chance to be lost (about 1 %)
 constexpr double kDefaultJitterUs = 1000, kMinJitterUs = 100;
 constexpr size_t kJitterWindow = 101;
+// Below this jitter (of a period) reports that arrive together were held back by a burst, the earlier ones
+// delivered a period late or more; above it they may as well be a late report and the one it delayed.
+constexpr double kBurstJitter = 0.25;
 constexpr double kLateKnee = 3;  // jitters: beyond it a late report costs linearly, not quadratically
 
 // The cost of a report `miss` jitters from the clock's line. Bluetooth holds reports back (a late one
@@ -415,8 +418,10 @@ double FrameNumbering::settle(std::span<const double> waiting, double previous_a
     int d = static_cast<int>(std::min_element(cost.begin(), cost.end()) - cost.begin());
     for (size_t i = m; i-- > 1;) d = from[i][size_t(d)];
     number = previous + 1 + d;
-    // A held report's arrival would widen the jitter.
-    if (held(0)) return record(number, waiting[0]);
+    // A held report's arrival would widen the jitter. It is the next report's, so where bursts are told
+    // apart from late reports the line takes it a period earlier, near where it would have arrived: a fifth
+    // of the reports arriving a period late pulled the line 2 ms late, unevenly.
+    if (held(0)) return record(number, sigma < kBurstJitter * slope ? waiting[0] - slope : waiting[0]);
     residuals.push_back(std::abs(waiting[0] - (line0 + slope * number)));
     if (residuals.size() > kJitterWindow) residuals.pop_front();
   }
