@@ -28,7 +28,7 @@ int from_button(Button b) {
 }
 
 // The events that carry two numbers and nothing else: a cursor position, a scroll offset.
-void push_xy(GLFWwindow* w, EventKind kind, double x, double y) {
+void push_xy(GLFWwindow* w, WindowEventKind kind, double x, double y) {
   WindowEvent e;
   e.kind = kind;
   e.x = x;
@@ -36,24 +36,24 @@ void push_xy(GLFWwindow* w, EventKind kind, double x, double y) {
   owner(w)->events().push_back(e);
 }
 
-void on_cursor(GLFWwindow* w, double x, double y) { push_xy(w, EventKind::CursorMove, x, y); }
+void on_cursor(GLFWwindow* w, double x, double y) { push_xy(w, WindowEventKind::CursorMove, x, y); }
 
 void on_button(GLFWwindow* w, int button, int action, int mods) {
   if (action != GLFW_PRESS && action != GLFW_RELEASE) return;
   WindowEvent e;
-  e.kind = action == GLFW_PRESS ? EventKind::ButtonPress : EventKind::ButtonRelease;
+  e.kind = action == GLFW_PRESS ? WindowEventKind::ButtonPress : WindowEventKind::ButtonRelease;
   glfwGetCursorPos(w, &e.x, &e.y);
   e.button = to_button(button);
   e.mods = to_mods(mods);
   owner(w)->events().push_back(e);
 }
 
-void on_scroll(GLFWwindow* w, double dx, double dy) { push_xy(w, EventKind::Scroll, dx, dy); }
+void on_scroll(GLFWwindow* w, double dx, double dy) { push_xy(w, WindowEventKind::Scroll, dx, dy); }
 
 void on_key(GLFWwindow* w, int key, int, int action, int mods) {
   if (action != GLFW_PRESS && action != GLFW_REPEAT) return;
   WindowEvent e;
-  e.kind = EventKind::KeyPress;
+  e.kind = WindowEventKind::KeyPress;
   e.key = key;
   e.mods = to_mods(mods);
   owner(w)->events().push_back(e);
@@ -61,7 +61,7 @@ void on_key(GLFWwindow* w, int key, int, int action, int mods) {
 
 void on_close(GLFWwindow* w) {
   WindowEvent e;
-  e.kind = EventKind::Close;
+  e.kind = WindowEventKind::Close;
   owner(w)->events().push_back(e);
 }
 
@@ -144,25 +144,25 @@ void Window::inject(const WindowEvent& e) {
   };
   const int mods = ((e.mods & kShift) ? GLFW_MOD_SHIFT : 0) | ((e.mods & kCtrl) ? GLFW_MOD_CONTROL : 0);
   switch (e.kind) {
-    case EventKind::CursorMove:
+    case WindowEventKind::CursorMove:
       glfwSetCursorPos(window_, e.x, e.y);  // the real pointer, which the HUD polls; GLFW reports no warp of its own
       if (auto cb = installed(glfwSetCursorPosCallback)) cb(window_, e.x, e.y);
       break;
-    case EventKind::ButtonPress:
-    case EventKind::ButtonRelease:
+    case WindowEventKind::ButtonPress:
+    case WindowEventKind::ButtonRelease:
       if (auto cb = installed(glfwSetMouseButtonCallback))
-        cb(window_, from_button(e.button), e.kind == EventKind::ButtonPress ? GLFW_PRESS : GLFW_RELEASE, mods);
+        cb(window_, from_button(e.button), e.kind == WindowEventKind::ButtonPress ? GLFW_PRESS : GLFW_RELEASE, mods);
       break;
-    case EventKind::Scroll:
+    case WindowEventKind::Scroll:
       if (auto cb = installed(glfwSetScrollCallback)) cb(window_, e.x, e.y);
       break;
-    case EventKind::KeyPress:
+    case WindowEventKind::KeyPress:
       if (auto cb = installed(glfwSetKeyCallback)) {
         cb(window_, e.key, glfwGetKeyScancode(e.key), GLFW_PRESS, mods);
         cb(window_, e.key, glfwGetKeyScancode(e.key), GLFW_RELEASE, mods);
       }
       break;
-    case EventKind::Close:
+    case WindowEventKind::Close:
       // What the window manager's close button does: the flag, then the close callback.
       glfwSetWindowShouldClose(window_, GLFW_TRUE);
       if (auto cb = installed(glfwSetWindowCloseCallback)) cb(window_);

@@ -19,13 +19,13 @@ struct GLFWwindow;
 
 namespace fire::window {
 
-enum class EventKind : uint8_t { CursorMove, ButtonPress, ButtonRelease, Scroll, KeyPress, Close };
+enum class WindowEventKind : uint8_t { CursorMove, ButtonPress, ButtonRelease, Scroll, KeyPress, Close };
 enum class Button : uint8_t { Left, Right, Middle };
 // Key modifiers, as flags.
 inline constexpr uint8_t kShift = 1, kCtrl = 2;
 
 struct WindowEvent {
-  EventKind kind = EventKind::CursorMove;
+  WindowEventKind kind = WindowEventKind::CursorMove;
   double x = 0, y = 0;       // cursor position in window pixels; Scroll: x, y offsets
   Button button = Button::Left;
   int key = 0;               // KeyPress: the GLFW key code (GLFW_KEY_*), layout independent

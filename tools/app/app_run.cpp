@@ -315,10 +315,10 @@ int run_app(const AppOptions& a) {
   size_t next_script = 0;
 
   auto handle = [&](const window::WindowEvent& e) {
-    using window::EventKind;
+    using window::WindowEventKind;
     const bool ctrl = e.mods & window::kCtrl, shift = e.mods & window::kShift;
     switch (e.kind) {
-      case EventKind::CursorMove: {
+      case WindowEventKind::CursorMove: {
         const glm::vec2 now(float(e.x), float(e.y)), d = now - cursor;
         if (dragging) orbit.rotate(d.x, d.y);
         if (panning) orbit.pan(d.x, d.y, std::max(app.height(), 1u));
@@ -330,7 +330,7 @@ int run_app(const AppOptions& a) {
         cursor = now;
         break;
       }
-      case EventKind::ButtonPress:
+      case WindowEventKind::ButtonPress:
         cursor = glm::vec2(float(e.x), float(e.y));
         if (app.hud().wants_mouse() || dragging || panning || drawing) break;
         if (shift || e.button == window::Button::Middle) panning = true;
@@ -347,17 +347,17 @@ int run_app(const AppOptions& a) {
         } else if (e.button == window::Button::Right) dragging = true;
         else panning = true;
         break;
-      case EventKind::ButtonRelease:
+      case WindowEventKind::ButtonRelease:
         if (drawing) log_pen(fire::EventKind::Up);
         dragging = panning = drawing = false;
         break;
-      case EventKind::Scroll:
+      case WindowEventKind::Scroll:
         if (!app.hud().wants_mouse()) {
           orbit.zoom(float(e.y));
           view_moved = true;
         }
         break;
-      case EventKind::KeyPress:
+      case WindowEventKind::KeyPress:
         if (ctrl && e.key == GLFW_KEY_Z) log_command(shift ? CommandKind::Redo : CommandKind::Undo, Vec3::Zero());
         else if (ctrl && e.key == GLFW_KEY_Y) log_command(CommandKind::Redo, Vec3::Zero());
         else if (ctrl && e.key == GLFW_KEY_S) {
@@ -411,7 +411,7 @@ int run_app(const AppOptions& a) {
         else if (e.key == GLFW_KEY_H || e.key == GLFW_KEY_F1) hud_data.help = !hud_data.help;
         else if (e.key == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(window.handle(), GLFW_TRUE);
         break;
-      case EventKind::Close:
+      case WindowEventKind::Close:
         break;
     }
   };

@@ -42,10 +42,10 @@ Result<std::vector<ScriptEvent>> read_script(const std::string& path) {
     if (!(in >> kind)) return bad("expected an event after the frame");
     window::WindowEvent& e = s.event;
     if (kind == "move") {
-      e.kind = window::EventKind::CursorMove;
+      e.kind = window::WindowEventKind::CursorMove;
       if (!(in >> e.x >> e.y)) return bad("move needs X Y");
     } else if (kind == "press" || kind == "release") {
-      e.kind = kind == "press" ? window::EventKind::ButtonPress : window::EventKind::ButtonRelease;
+      e.kind = kind == "press" ? window::WindowEventKind::ButtonPress : window::WindowEventKind::ButtonRelease;
       std::string b;
       in >> b;
       if (b == "left") e.button = window::Button::Left;
@@ -53,10 +53,10 @@ Result<std::vector<ScriptEvent>> read_script(const std::string& path) {
       else if (b == "middle") e.button = window::Button::Middle;
       else return bad(kind + " needs left, right or middle");
     } else if (kind == "scroll") {
-      e.kind = window::EventKind::Scroll;
+      e.kind = window::WindowEventKind::Scroll;
       if (!(in >> e.y)) return bad("scroll needs DY");
     } else if (kind == "key") {
-      e.kind = window::EventKind::KeyPress;
+      e.kind = window::WindowEventKind::KeyPress;
       std::string name;
       in >> name;
       for (const auto& [prefix, flag] : {std::pair{"ctrl+", window::kCtrl}, std::pair{"shift+", window::kShift}})
@@ -71,7 +71,7 @@ Result<std::vector<ScriptEvent>> read_script(const std::string& path) {
       if (!(in >> s.resize_width >> s.resize_height) || s.resize_width < 64 || s.resize_height < 64)
         return bad("resize needs WIDTH HEIGHT, at least 64 each");
     } else if (kind == "close") {
-      e.kind = window::EventKind::Close;
+      e.kind = window::WindowEventKind::Close;
     } else {
       return bad("unknown event '" + kind + "' (move, press, release, scroll, key, resize, close)");
     }
