@@ -287,6 +287,39 @@ constexpr double kLateKnee = 3;  // jitters: beyond it a late report costs linea
 // burst of held reports is cheaper to explain as a lost report, and the numbering stays one ahead.
 double misfit_cost(double miss) { return miss <= kLateKnee ? 0.5 * miss * miss : kLateKnee * (miss - 0.5 * kLateKnee); }
 
+// The jitter from reports' distances to the clock's line: their median, as a standard deviation.
+double jitter_from(std::vector<double> misses) {
+  std::nth_element(misses.begin(), misses.begin() + static_cast<std::ptrdiff_t>(misses.size() / 2), misses.end());
+  return std::max(kMinJitterUs, 1.4826 * misses[misses.size() / 2]);
+}
+
+// The least-squares line through the (number, arrival) of reports lo..hi, leaving out those held back and
+// delivered with the next (their arrival is the next one's), unless fewer than 2 are left. A NaN slope: the
+// numbers do not spread.
+FrameNumbering::Line fit_line(std::span<const double> arrivals, std::span<const uint8_t> held,
+                              std::span<const double> number, size_t lo, size_t hi) {
+  FrameNumbering::Line l;
+  double count = 0;
+  for (size_t i = lo; i <= hi; ++i) count += held[i] ? 0 : 1;
+  // A window of reports all stamped alike (no real remote's) keeps them all.
+  const bool skip_held = count >= 2;
+  if (!skip_held) count = static_cast<double>(hi - lo + 1);
+  for (size_t i = lo; i <= hi; ++i) {
+    if (skip_held && held[i]) continue;
+    l.mean_n += number[i];
+    l.mean_t += arrivals[i];
+  }
+  l.mean_n /= count;
+  l.mean_t /= count;
+  double snn = 0, snt = 0;
+  for (size_t i = lo; i <= hi; ++i) {
+    if (skip_held && held[i]) continue;
+    snn += (number[i] - l.mean_n) * (number[i] - l.mean_n);
+    snt += (number[i] - l.mean_n) * (arrivals[i] - l.mean_t);
+  }
+  l.slope = snn > 0 ? snt / snn : std::numeric_limits<double>::quiet_NaN();
+  return l;
+}
 
 // The whole log's frame numbers, from the causal ones (FrameNumbering). Where the arrival jitter spans more
 // than a period, a few reports cannot tell a lost report from late ones, but every report after a loss
@@ -299,25 +332,16 @@ constexpr int kRenumberRounds = 8;
 std::vector<double> renumber_whole_log(std::span<const double> arrivals, std::span<const uint8_t> held,
                                        std::vector<double> number) {
   const size_t n = arrivals.size();
+  if (std::count(held.begin(), held.end(), uint8_t(0)) < 3) return number;
   constexpr int kStates = 2 * kRenumberBand + 1;
   std::vector<std::array<uint8_t, kStates>> from(n);  // per report and state: the best state of the report before
   for (int round = 0; round < kRenumberRounds; ++round) {
-    double mean_n = 0, mean_t = 0, count = 0;
-    for (size_t k = 0; k < n; ++k)
-      if (!held[k]) mean_n += number[k], mean_t += arrivals[k], ++count;
-    if (count < 3) return number;
-    mean_n /= count;
-    mean_t /= count;
-    double snn = 0, snt = 0;
-    for (size_t k = 0; k < n; ++k)
-      if (!held[k]) snn += (number[k] - mean_n) * (number[k] - mean_n), snt += (number[k] - mean_n) * (arrivals[k] - mean_t);
-    if (!(snn > 0)) return number;
-    const double slope = snt / snn;
+    const FrameNumbering::Line line = fit_line(arrivals, held, number, 0, n - 1);
+    if (std::isnan(line.slope)) return number;
     std::vector<double> misses;
     for (size_t k = 0; k < n; ++k)
-      if (!held[k]) misses.push_back(std::abs(arrivals[k] - (mean_t + slope * (number[k] - mean_n))));
-    std::nth_element(misses.begin(), misses.begin() + static_cast<std::ptrdiff_t>(misses.size() / 2), misses.end());
-    const double sigma = std::max(kMinJitterUs, 1.4826 * misses[misses.size() / 2]);
+      if (!held[k]) misses.push_back(std::abs(arrivals[k] - line.at(number[k])));
+    const double sigma = jitter_from(std::move(misses));
     // State j of report k: number centre(k) + j - kRenumberBand, about the numbers of the round before.
     auto centre = [&](size_t k) { return number[k]; };
     std::array<double, kStates> cost, next;
@@ -327,7 +351,7 @@ std::vector<double> renumber_whole_log(std::span<const double> arrivals, std::sp
       next.fill(std::numeric_limits<double>::infinity());
       for (int j = 0; j < kStates; ++j) {
         const double nk = centre(k) + j - kRenumberBand;
-        const double emit = held[k] ? 0.0 : misfit_cost((arrivals[k] - (mean_t + slope * (nk - mean_n))) / sigma);
+        const double emit = held[k] ? 0.0 : misfit_cost((arrivals[k] - line.at(nk)) / sigma);
         int best_from = -1;
         double best = std::numeric_limits<double>::infinity();
         // Report k - 1 in state i had number centre(k - 1) + i - kRenumberBand; the frames lost between are
@@ -385,12 +409,8 @@ double FrameNumbering::settle(std::span<const double> waiting, double previous_a
   double number = 0;
   if (!trailing.empty()) {
     const double previous = trailing.back()[0];
-    std::vector<double> r(residuals.begin(), residuals.end());
-    double sigma = kDefaultJitterUs;
-    if (r.size() >= 16) {
-      std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
-      sigma = std::max(kMinJitterUs, 1.4826 * r[r.size() / 2]);
-    }
+    const double sigma =
+        residuals.size() >= 16 ? jitter_from({residuals.begin(), residuals.end()}) : kDefaultJitterUs;
     const Line l = line();
     const double line0 = l.at(0), slope = l.at(1) - line0;
     const int max_skip = kMaxLostInARow * static_cast<int>(m) + 1;
@@ -462,26 +482,9 @@ void fit_frame_clock(CameraFrames& f) {
   for (ptrdiff_t k = 0; k < static_cast<ptrdiff_t>(n); ++k) {
     const auto lo = static_cast<size_t>(std::max<ptrdiff_t>(0, k - kHalfWindow));
     const auto hi = static_cast<size_t>(std::min<ptrdiff_t>(static_cast<ptrdiff_t>(n) - 1, k + kHalfWindow));
-    double mean_n = 0, mean_t = 0, count = 0;
-    for (size_t i = lo; i <= hi; ++i) count += held[i] ? 0 : 1;
-    // A window of reports all stamped alike (no real remote's) keeps them all.
-    const bool skip_held = count >= 2;
-    if (!skip_held) count = static_cast<double>(hi - lo + 1);
-    for (size_t i = lo; i <= hi; ++i) {
-      if (skip_held && held[i]) continue;
-      mean_n += number[i];
-      mean_t += arrivals[i];
-    }
-    mean_n /= count;
-    mean_t /= count;
-    double snn = 0, snt = 0;
-    for (size_t i = lo; i <= hi; ++i) {
-      if (skip_held && held[i]) continue;
-      snn += (number[i] - mean_n) * (number[i] - mean_n);
-      snt += (number[i] - mean_n) * (arrivals[i] - mean_t);
-    }
-    const double slope = snn > 0 ? snt / snn : numbering.instant(1) - numbering.instant(0);
-    const double t = t_origin + mean_t + slope * (number[size_t(k)] - mean_n);
+    FrameNumbering::Line line = fit_line(arrivals, held, number, lo, hi);
+    if (std::isnan(line.slope)) line.slope = numbering.instant(1) - numbering.instant(0);
+    const double t = t_origin + line.mean_t + line.slope * (number[size_t(k)] - line.mean_n);
     f.t_frame_us[size_t(k)] = k == 0 ? t : std::max(t, f.t_frame_us[size_t(k) - 1] + 1.0);
   }
 }
