@@ -8,6 +8,7 @@
 #include <numeric>
 #include <optional>
 #include <random>
+#include <set>
 #include <string>
 #include <unordered_map>
 
@@ -251,7 +252,8 @@ EdgeLoops edge_loops(const Control& c, std::span<const uint32_t> offsets) {
 // - any other family is numbered by breadth-first distance from its border loops (the border is always
 //   kept, so the kept loops are spaced K from it too), or from its first loop when it has none.
 // A loop with no linked neighbour is a family of its own and is kept.
-std::vector<uint8_t> kept_edges(const Control& c, std::span<const uint32_t> offsets, uint32_t k) {
+// Border loops and creases (`creased`, per edge) are always kept, and the count of loops starts from them.
+std::vector<uint8_t> kept_edges(const Control& c, std::span<const uint32_t> offsets, uint32_t k, const std::vector<uint8_t>& creased) {
   const size_t ne = c.edge_count();
   EdgeLoops el = edge_loops(c, offsets);
   UnionFind& loops = el.loops;
@@ -271,9 +273,9 @@ std::vector<uint8_t> kept_edges(const Control& c, std::span<const uint32_t> offs
       families.unite(a, b);
     }
   }
-  std::vector<uint8_t> has_border(ne, 0);  // indexed by loop root
+  std::vector<uint8_t> seed_loop(ne, 0);  // indexed by loop root: a border or a crease
   for (uint32_t e = 0; e < ne; ++e)
-    if (c.border(e)) has_border[loops.find(e)] = 1;
+    if (c.border(e) || creased[e]) seed_loop[loops.find(e)] = 1;
   std::vector<std::vector<uint32_t>> members(ne);  // indexed by family root, ascending loop roots
   for (uint32_t l = 0; l < ne; ++l) {
     if (loops.find(l) != l) continue;
@@ -289,7 +291,7 @@ std::vector<uint8_t> kept_edges(const Control& c, std::span<const uint32_t> offs
     if (family.empty()) continue;
     std::vector<uint32_t> seeds;
     for (uint32_t l : family)
-      if (has_border[l]) seeds.push_back(l);
+      if (seed_loop[l]) seeds.push_back(l);
     if (seeds.empty()) seeds.push_back(family[0]);
     const bool cycle = family.size() >= 3 &&
                        std::all_of(family.begin(), family.end(), [&](uint32_t l) { return adjacent[l].size() == 2; });
@@ -317,7 +319,7 @@ std::vector<uint8_t> kept_edges(const Control& c, std::span<const uint32_t> offs
     }
   }
   std::vector<uint8_t> kept(ne, 0);
-  for (uint32_t e = 0; e < ne; ++e) kept[e] = c.border(e) || number[loops.find(e)] % k == 0;
+  for (uint32_t e = 0; e < ne; ++e) kept[e] = c.border(e) || creased[e] || number[loops.find(e)] % k == 0;
   return kept;
 }
 
@@ -375,7 +377,11 @@ Result<Mesh> network_from_mesh(const PolygonMeshView& control, const UnrefineOpt
   const auto offsets = control.face_offsets;
   const size_t nv = c.vertex_count(), ne = c.edge_count(), nf = offsets.size() - 1;
 
-  std::vector<uint8_t> kept = kept_edges(c, offsets, o.unrefine);
+  std::set<std::pair<uint32_t, uint32_t>> crease;
+  for (size_t i = 0; i + 1 < o.sharp_edges.size(); i += 2) crease.insert(std::minmax(o.sharp_edges[i], o.sharp_edges[i + 1]));
+  std::vector<uint8_t> creased(ne, 0);
+  for (uint32_t e = 0; e < ne; ++e) creased[e] = crease.contains(std::minmax(c.edge_tail(e), c.edge_head(e)));
+  std::vector<uint8_t> kept = kept_edges(c, offsets, o.unrefine, creased);
   std::vector<uint32_t> kept_valence;
   prune_dangling(c, kept, kept_valence);
 
@@ -510,7 +516,7 @@ Result<Mesh> network_from_mesh(const PolygonMeshView& control, const UnrefineOpt
 
   std::optional<LimitCurves> limit;
   if (o.limit) {
-    auto built = LimitCurves::build(control, o.samples_per_edge);
+    auto built = LimitCurves::build(control, o.samples_per_edge, o.sharp_edges, o.border_corners);
     if (!built) return fail(built.error());
     limit = std::move(*built);
   }
@@ -548,6 +554,9 @@ Result<Mesh> network_from_mesh(const PolygonMeshView& control, const UnrefineOpt
       }
     }
     chain_edge[k] = mesh.add_edge(net_vertex[cv.front()], net_vertex[cv.back()], line);
+    bool sharp = !o.sharp_edges.empty();
+    for (size_t i = 0; i + 1 < cv.size() && sharp; ++i) sharp = crease.contains(std::minmax(cv[i], cv[i + 1]));
+    if (sharp) mesh.set_edge_flag(chain_edge[k], kSharpEdge, true);
   }
 
   for (uint32_t r = 0; r < nf; ++r) {
@@ -573,11 +582,13 @@ Result<Mesh> network_from_mesh(const PolygonMeshView& control, const UnrefineOpt
 
 namespace fire {
 
-Result<LimitCurves> LimitCurves::build(const PolygonMeshView& control, uint32_t samples_per_edge) {
+Result<LimitCurves> LimitCurves::build(const PolygonMeshView& control, uint32_t samples_per_edge, std::span<const uint32_t> sharp_edges,
+                                       std::span<const uint8_t> border_corners) {
   int levels = 0;
   while ((1u << levels) < samples_per_edge) ++levels;
   levels = std::max(levels, 1);
-  const catmull_clark::BaseTopology base{uint32_t(control.positions.size()), control.face_offsets, control.face_vertices, {}};
+  const catmull_clark::BaseTopology base{uint32_t(control.positions.size()), control.face_offsets, control.face_vertices, sharp_edges,
+                                        border_corners};
   auto refinement = catmull_clark::build_refinement(base, {levels, true});
   if (!refinement) return Result<LimitCurves>::failure(std::string(control.source) + ": " + refinement.error());
   auto stencils = catmull_clark::build_limit_stencils(*refinement);
@@ -623,8 +634,9 @@ bool LimitCurves::sample_chain(std::span<const uint32_t> chain, std::vector<Vec3
 
 namespace fire {
 
-Result<PolygonMesh> limit_mesh(const PolygonMeshView& control, int levels) {
-  Result<catmull_clark::SubdividedMesh> sub = catmull_clark::subdivide({control, {}}, levels);
+Result<PolygonMesh> limit_mesh(const PolygonMeshView& control, int levels, std::span<const uint32_t> sharp_edges,
+                               std::span<const uint8_t> border_corners) {
+  Result<catmull_clark::SubdividedMesh> sub = catmull_clark::subdivide({control, sharp_edges, border_corners}, levels);
   if (!sub) return Result<PolygonMesh>::failure(std::string(control.source) + ": " + sub.error());
   PolygonMesh out;
   out.positions = std::move(sub->limit_positions);

@@ -14,7 +14,7 @@
 namespace fire {
 
 struct UnrefineOptions {
-  uint32_t unrefine = 1;          // keep every K-th edge loop; 1 keeps every edge
+  uint32_t unrefine = 1;          // keep every K-th edge loop, counted from the border and creases (always kept); 1 keeps every edge
   double noise_percent = 0;       // Gaussian sigma, in percent of the mean control edge length
   // Correlation length of the noise along each polyline, in percent of the mean control edge length; 0
   // draws every point's noise independently.
@@ -25,6 +25,11 @@ struct UnrefineOptions {
   // their limit positions and each control edge contributes the limit positions of the level-L vertices
   // on it, 2^L >= samples_per_edge (so the network lies exactly on its ground truth).
   bool limit = false;
+  // The control mesh's subdivision tags (platform/obj.hpp's SubdivisionTags): vertex pairs of infinitely sharp
+  // creases, and border corners. The limit surface honours them, and a network curve whose control edges are
+  // all creases is marked sharp.
+  std::span<const uint32_t> sharp_edges = {};
+  std::span<const uint8_t> border_corners = {};
 };
 
 inline constexpr uint32_t kMinSamplesPerEdge = 8;
@@ -36,7 +41,8 @@ Result<Mesh> network_from_mesh(const PolygonMeshView& control, const UnrefineOpt
 
 // The control mesh's Catmull-Clark limit surface as quads: the level-`levels` mesh with every vertex at its
 // limit position. What the simulated cameras see the object as.
-Result<PolygonMesh> limit_mesh(const PolygonMeshView& control, int levels);
+Result<PolygonMesh> limit_mesh(const PolygonMeshView& control, int levels, std::span<const uint32_t> sharp_edges = {},
+                               std::span<const uint8_t> border_corners = {});
 
 // The polyline of one chain of control vertices: each control edge contributes `samples_per_edge` points
 // spaced linearly from its first end (inclusive) to its second (exclusive), then the chain's last vertex.
@@ -52,7 +58,8 @@ namespace fire {
 class LimitCurves {
  public:
   // samples_per_edge is rounded up to a power of two 2^L; the control mesh is refined L levels.
-  static Result<LimitCurves> build(const PolygonMeshView& control, uint32_t samples_per_edge);
+  static Result<LimitCurves> build(const PolygonMeshView& control, uint32_t samples_per_edge, std::span<const uint32_t> sharp_edges = {},
+                                   std::span<const uint8_t> border_corners = {});
   // Limit position of control vertex v.
   const Vec3& vertex(uint32_t v) const { return limit_[last_of_base_[v]]; }
   // Like sample_chain_linear, on the limit surface: 2^L points per control edge, then the last vertex.

@@ -7,6 +7,7 @@
 #include <set>
 #include <string>
 
+#include "platform/files.hpp"
 #include "platform/obj.hpp"
 #include "systems/catmull_clark/catmull_clark.hpp"
 #include "systems/synth/network_from_mesh.hpp"
@@ -452,4 +453,47 @@ TEST_CASE("limit sampling: every polyline point lies on the control mesh's Catmu
       CHECK(std::binary_search(on_surface.begin(), on_surface.end(), std::array<double, 3>{p.x(), p.y(), p.z()}));
     }
   }
+}
+
+TEST_CASE("creases: kept whatever K, marked sharp, and the limit curves along them are the box's straight edges", "[synth][limit][crease]") {
+  const std::string path = kMeshes + "box.obj";
+  auto text = read_text_file(path);
+  REQUIRE(text.ok());
+  auto pm = parse_obj(*text, path);
+  REQUIRE(pm.ok());
+  auto tags = parse_obj_tags(*text, path, *pm);
+  REQUIRE(tags.ok());
+  REQUIRE(tags->sharp_edges.size() == 2 * 48);  // 12 edges of the box, 4 control edges each
+  Vec3 lo = pm->positions[0], hi = lo;
+  for (const Vec3& p : pm->positions) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  // On a box's edge: two of the three coordinates at the box's extremes.
+  auto on_box_edge = [&](const Vec3& p) {
+    int at_side = 0;
+    for (int i = 0; i < 3; ++i) at_side += std::abs(p[i] - lo[i]) < 1e-9 || std::abs(p[i] - hi[i]) < 1e-9;
+    return at_side >= 2;
+  };
+  UnrefineOptions o{.unrefine = 2, .limit = true, .sharp_edges = tags->sharp_edges};
+  auto net = network_from_mesh(pm->view("box.obj"), o);
+  REQUIRE(net.ok());
+  REQUIRE(net->validate() == "");
+  // Every other grid line of each side, counted from the creases: 2 x 2 faces a side, each edge of the box two curves.
+  CHECK(net->face_count() == 24);
+  CHECK(net->edge_count() == 48);
+  size_t sharp = 0;
+  for (uint32_t e = 0; e < net->edge_slots(); ++e) {
+    if (!(net->edges.flags[e] & kSharpEdge)) continue;
+    ++sharp;
+    for (const Vec3& p : net->polyline(e)) {
+      INFO("edge " << e << " point " << p.transpose());
+      CHECK(on_box_edge(p));
+    }
+  }
+  CHECK(sharp == 24);
+  // Without the tags, K = 2 counts its loops from another line and drops the box's edges: the limit is round there.
+  auto smooth = network_from_mesh(pm->view("box.obj"), UnrefineOptions{.unrefine = 2, .limit = true});
+  REQUIRE(smooth.ok());
+  for (uint32_t e = 0; e < smooth->edge_slots(); ++e) CHECK_FALSE(smooth->edges.flags[e] & kSharpEdge);
+  size_t on_edges = 0;
+  for (uint32_t v = 0; v < smooth->vertex_slots(); ++v) on_edges += on_box_edge(smooth->vertices.position[v]);
+  CHECK(on_edges == 0);
 }
