@@ -8,6 +8,7 @@
 // diagonal of the reference limit surface). rms is the square root of the mean of the squared distances
 // over the samples of both directions together; hausdorff is the largest distance in either direction.
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -112,5 +113,12 @@ Result<TriangleMesh> reference_limit_surface(std::span<const Vec3> positions, st
                                              std::span<const uint32_t> face_vertices, int levels,
                                              std::span<const uint32_t> sharp_edges = {},
                                              std::span<const uint8_t> border_corners = {});
+
+// How far a surface bends across a curve on it, at point p with the curve's tangent t: the surface is cut by the
+// plane through p normal to t, and each of the cut's two branches is read as its chord from `radius` to twice
+// that from p (closest points of rings of probes), which p a little off the crease does not tilt. The result is
+// 180 degrees less the angle between the branches: 0 where the surface goes on flat across the curve, 90 across
+// a box's edge. nullopt where the cut does not show two branches there (p off the surface, or at its border).
+std::optional<double> bend_across_deg(const TriangleBvh& surface, const Vec3& p, const Vec3& t, double radius);
 
 }  // namespace fire::evaluate

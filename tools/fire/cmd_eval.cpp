@@ -23,6 +23,7 @@ struct EvalArgs {
   std::string surface_path, reference_path, network_path;
   int reference_levels = 5;
   double spacing = 0.002;  // sample spacing, a fraction of the reference diagonal
+  double crease_radius = 0.01;  // where the bend across a sharp curve is read, a fraction of the reference diagonal
 };
 
 int fail(const std::string& message) {
@@ -45,6 +46,40 @@ class Stages {
   bool on_terminal_ = ::isatty(STDERR_FILENO) != 0;
   std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
 };
+
+// How far the surface bends across each curve marked sharp, against the reference there: read every `radius`
+// along the curve, away from its ends (a corner bends two ways), on both surfaces at the same radius.
+struct CreasePoint {
+  uint32_t edge = 0, point = 0;
+  double surface_deg = 0, reference_deg = 0, error_deg = -1;
+};
+struct Creases {
+  size_t curves = 0, points = 0;
+  CreasePoint worst;
+};
+Creases measure_creases(const Mesh& network, const evaluate::TriangleBvh& surface, const evaluate::TriangleBvh& reference, double radius) {
+  Creases out;
+  for (uint32_t e = 0; e < network.edge_slots(); ++e) {
+    if (!network.edge_alive(e) || !(network.edges.flags[e] & kSharpEdge)) continue;
+    ++out.curves;
+    const auto line = network.polyline(e);
+    std::vector<double> arc(line.size(), 0);
+    for (size_t i = 1; i < line.size(); ++i) arc[i] = arc[i - 1] + (line[i] - line[i - 1]).norm();
+    double next = 3 * radius;
+    for (size_t i = 1; i + 1 < line.size(); ++i) {
+      if (arc[i] < next || arc[i] > arc.back() - 3 * radius) continue;
+      next = arc[i] + radius;
+      const Vec3 tangent = line[i + 1] - line[i - 1];
+      const std::optional<double> on_surface = evaluate::bend_across_deg(surface, line[i], tangent, radius);
+      const std::optional<double> on_reference = evaluate::bend_across_deg(reference, reference.closest(line[i]).point, tangent, radius);
+      if (!on_surface || !on_reference) continue;
+      ++out.points;
+      const double error = std::abs(*on_surface - *on_reference);
+      if (error > out.worst.error_deg) out.worst = {e, static_cast<uint32_t>(i), *on_surface, *on_reference, error};
+    }
+  }
+  return out;
+}
 
 int run_eval(const EvalArgs& a) {
   const Stages stages;
@@ -72,9 +107,11 @@ int run_eval(const EvalArgs& a) {
 
   std::vector<Vec3> network_points;
   std::vector<std::pair<uint32_t, uint32_t>> network_point_ids;  // (edge, index in its polyline) per point
+  std::optional<Mesh> network;
   if (!a.network_path.empty()) {
-    auto network = load_network(a.network_path);
-    if (!network) return fail(network.error());
+    auto loaded = load_network(a.network_path);
+    if (!loaded) return fail(loaded.error());
+    network = std::move(*loaded);
     for (uint32_t e = 0; e < network->edge_slots(); ++e)
       if (network->edge_alive(e)) {
         const auto polyline = network->polyline(e);
@@ -103,15 +140,27 @@ int run_eval(const EvalArgs& a) {
   out["surface_rms"] = d.a_to_b.rms() / diagonal;
   out["surface_max"] = d.a_to_b.max / diagonal;
   if (!network_points.empty()) {
-    const evaluate::OneSided network = evaluate::distances_to(network_points, out_bvh);
-    const double network_max = network.max / diagonal;
+    const evaluate::OneSided to_surface = evaluate::distances_to(network_points, out_bvh);
+    const double network_max = to_surface.max / diagonal;
     if (!std::isfinite(network_max)) return fail(a.network_path + ": network distance is not finite");
     out["network_max"] = network_max;
-    out["network_rms"] = network.rms() / diagonal;
-    const Vec3& worst = network_points[network.max_index];
-    out["network_max_at"] = {{"edge", network_point_ids[network.max_index].first},
-                             {"point", network_point_ids[network.max_index].second},
+    out["network_rms"] = to_surface.rms() / diagonal;
+    const Vec3& worst = network_points[to_surface.max_index];
+    out["network_max_at"] = {{"edge", network_point_ids[to_surface.max_index].first},
+                             {"point", network_point_ids[to_surface.max_index].second},
                              {"position", {worst.x(), worst.y(), worst.z()}}};
+  }
+  if (network) {
+    const Creases creases = measure_creases(*network, out_bvh, reference_bvh, a.crease_radius * diagonal);
+    out["sharp_curves"] = creases.curves;
+    if (creases.points > 0) {
+      out["crease_points"] = creases.points;
+      out["crease_error_max_deg"] = creases.worst.error_deg;
+      out["crease_error_at"] = {{"edge", creases.worst.edge},
+                                {"point", creases.worst.point},
+                                {"surface_deg", creases.worst.surface_deg},
+                                {"reference_deg", creases.worst.reference_deg}};
+    }
   }
   // Counted on SURFACE's polygons and on the reference's control mesh, which has its limit surface's topology.
   const evaluate::Topology topology = evaluate::topology(surface->positions, surface->face_offsets, surface->face_vertices);
@@ -142,7 +191,11 @@ void add_eval_commands(CLI::App& app, Registry& registry) {
       "root mean square) and network_max_at (that point: its network edge, its index in the edge's polyline, its position), "
       "euler_characteristic and border_loops (SURFACE's, counted after welding coincident vertices; border loops are the "
       "connected pieces of the edges one face uses), reference_euler_characteristic and reference_border_loops (the "
-      "control mesh's, which its limit surface has), diagonal, samples.");
+      "control mesh's, which its limit surface has), diagonal, samples; with --network also sharp_curves (the network's "
+      "curves marked sharp) and, where the bend across them could be read, crease_points and crease_error_max_deg, the "
+      "largest difference between how far SURFACE and the reference bend across a sharp curve (180 degrees less the "
+      "angle between the surface's two sides, read --crease-radius from the curve; 90 across a box's edge), with "
+      "crease_error_at (edge, point, surface_deg, reference_deg).");
   cmd->add_option("SURFACE", a->surface_path, "surface to measure: .obj, .ply, .stl or .glb as `fire reconstruct` writes")
       ->required();
   cmd->add_option("--reference", a->reference_path,
@@ -157,6 +210,10 @@ void add_eval_commands(CLI::App& app, Registry& registry) {
       ->capture_default_str();
   cmd->add_option("--spacing", a->spacing, "sample spacing on both surfaces, as a fraction of the reference diagonal")
       ->check(CLI::Range(0.0005, 0.1))
+      ->capture_default_str();
+  cmd->add_option("--crease-radius", a->crease_radius,
+                  "with --network: how far from a sharp curve the bend across it is read, as a fraction of the reference diagonal")
+      ->check(CLI::Range(0.001, 0.2))
       ->capture_default_str();
   cmd->callback([a, &registry] { registry.exit_code = run_eval(*a); });
 }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <numbers>
 #include <random>
 #include <unistd.h>
 
@@ -365,4 +366,63 @@ TEST_CASE("topology: Euler characteristic and border loops of every shared mesh,
   CHECK(open.euler_characteristic == 1);
   CHECK(open.border_loops == 1);
   CHECK(open.border_edges == 4);
+}
+
+namespace {
+
+// A strip along x, folded along the x axis: one side runs along +y in the plane z = 0, the other leaves the axis at
+// `fold_deg` from the first side's plane (0: flat on, 90: up, a box's edge); `rounded` > 0 replaces the fold by an
+// arc of that radius. Quads of 1 mm.
+TriangleMesh folded_strip(double fold_deg, double rounded = 0) {
+  std::vector<Vec3> profile;  // the cross-section in (y, z), from the far end of the flat side to the far end of the other
+  const double fold = fold_deg * std::numbers::pi / 180;
+  const Vec3 out(0, -std::cos(fold), std::sin(fold));  // the second side's direction, away from the axis
+  for (int i = 40; i >= 1; --i) profile.push_back(Vec3(0, 0.001 * i, 0));
+  if (rounded > 0) {
+    for (int k = 0; k <= 16; ++k) {  // an arc tangent to both sides, turning by `fold`
+      const double a = fold * k / 16;
+      profile.push_back(Vec3(0, -rounded * std::sin(a), rounded * (1 - std::cos(a))));
+    }
+  } else {
+    profile.push_back(Vec3::Zero());
+  }
+  const Vec3 start = profile.back();
+  for (int i = 1; i <= 40; ++i) profile.push_back(start + 0.001 * i * out);
+  TriangleMesh mesh;
+  const int columns = 61;  // x from -0.03 to 0.03
+  for (int c = 0; c < columns; ++c)
+    for (const Vec3& q : profile) mesh.positions.push_back(Vec3(0.001 * (c - 30), q.y(), q.z()));
+  const auto rows = static_cast<uint32_t>(profile.size());
+  for (uint32_t c = 0; c + 1 < columns; ++c)
+    for (uint32_t r = 0; r + 1 < rows; ++r) {
+      const uint32_t a = c * rows + r, b = a + rows;
+      mesh.triangles.insert(mesh.triangles.end(), {a, b, b + 1, a, b + 1, a + 1});
+    }
+  return mesh;
+}
+
+}  // namespace
+
+TEST_CASE("the bend across a curve: 0 on a plane, the fold's angle across a fold, less where it is rounded", "[evaluate][crease]") {
+  const Vec3 along = Vec3::UnitX();
+  for (double fold : {0.0, 30.0, 90.0, 120.0}) {
+    const TriangleMesh mesh = folded_strip(fold);
+    const TriangleBvh bvh(mesh);
+    const std::optional<double> bend = bend_across_deg(bvh, Vec3::Zero(), along, 0.005);
+    REQUIRE(bend);
+    CHECK(*bend == Approx(fold).margin(1.0));
+    // A point 1 mm off the fold, on the flat side (a tracked curve beside the crease), reads the same bend.
+    const std::optional<double> beside = bend_across_deg(bvh, Vec3(0, 0.001, 0), along, 0.005);
+    REQUIRE(beside);
+    CHECK(*beside == Approx(fold).margin(2.0));
+  }
+  // Rounded over 10 mm, a box's edge bends less within 5 mm of it: what a smooth surface does where a crease was meant.
+  const TriangleBvh rounded(folded_strip(90, 0.01));
+  const std::optional<double> smooth = bend_across_deg(rounded, Vec3::Zero(), along, 0.005);
+  REQUIRE(smooth);
+  CHECK(*smooth < 80);
+  // At the strip's border there is one side only.
+  const TriangleBvh flat(folded_strip(0));
+  CHECK_FALSE(bend_across_deg(flat, Vec3(0, 0.04, 0), along, 0.005));
+  CHECK_FALSE(bend_across_deg(flat, Vec3::Zero(), Vec3::Zero(), 0.005));
 }
