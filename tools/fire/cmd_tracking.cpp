@@ -177,7 +177,8 @@ int run_simulate_sketch(const SimulateArgs& a) {
   return write_simulation("sketch", a, simulate_sketch(a.rig, sketch, mesh->view()));
 }
 
-std::string obj_text(const std::vector<Vec3>& positions, const PolygonMesh& mesh, const std::string& comment) {
+// The crease tags go with it, so that fire eval measures against the same limit surface the person drew on.
+std::string obj_text(const std::vector<Vec3>& positions, const PolygonMesh& mesh, const SubdivisionTags& tags, const std::string& comment) {
   std::string out = "# " + comment + "\n";
   for (const Vec3& p : positions) out += "v " + format_double(p.x()) + ' ' + format_double(p.y()) + ' ' + format_double(p.z()) + '\n';
   for (size_t f = 0; f < mesh.face_count(); ++f) {
@@ -185,6 +186,10 @@ std::string obj_text(const std::vector<Vec3>& positions, const PolygonMesh& mesh
     for (uint32_t v : mesh.face(f)) out += ' ' + std::to_string(v + 1);
     out += '\n';
   }
+  for (size_t i = 0; i + 1 < tags.sharp_edges.size(); i += 2)
+    out += "t crease 2/1/0 " + std::to_string(tags.sharp_edges[i]) + ' ' + std::to_string(tags.sharp_edges[i + 1]) + " 10\n";
+  for (uint32_t v = 0; v < tags.border_corners.size(); ++v)
+    if (tags.border_corners[v]) out += "t corner 1/1/0 " + std::to_string(v) + " 10\n";
   return out;
 }
 
@@ -195,22 +200,27 @@ int run_simulate_drawing(const SimulateArgs& a) {
   auto object_file = object_path(a);
   if (!object_file) return fail(command, object_file.error());
   const std::string& mesh_path = *object_file;
-  Result<PolygonMesh> mesh = read_obj(mesh_path);
+  Result<std::string> mesh_text = read_text_file(mesh_path);
+  if (!mesh_text) return fail(command, mesh_text.error() + " (choose the object with --mesh)");
+  Result<PolygonMesh> mesh = parse_obj(*mesh_text, mesh_path);
   if (!mesh) return fail(command, mesh.error() + " (choose the object with --mesh)");
+  Result<SubdivisionTags> tags = parse_obj_tags(*mesh_text, mesh_path, *mesh);
+  if (!tags) return fail(command, tags.error());
   Result<std::vector<Vec3>> placed = object_frame(mesh->positions, a.drawing.height_m);
   if (!placed) return fail(command, mesh_path + ": " + placed.error());
   const PolygonMeshView control{*placed, mesh->face_offsets, mesh->face_vertices, mesh_path};
-  Result<Mesh> network = network_from_mesh(control, UnrefineOptions{.unrefine = a.unrefine, .limit = true});
+  Result<Mesh> network = network_from_mesh(
+      control, UnrefineOptions{.unrefine = a.unrefine, .limit = true, .sharp_edges = tags->sharp_edges, .border_corners = tags->border_corners});
   if (!network) return fail(command, network.error());
   DrawingOptions options = a.drawing;
   options.mesh_name = mesh_path.substr(mesh_path.find_last_of('/') + 1);
-  Result<PolygonMesh> surface = limit_mesh(control, kOccluderLevels);
+  Result<PolygonMesh> surface = limit_mesh(control, kOccluderLevels, tags->sharp_edges, tags->border_corners);
   if (!surface) return fail(command, surface.error());
   Result<SimulatedDrawing> drawing = simulate_drawing(a.rig, options, surface->view(), drawing_network(*network));
   if (!drawing) return fail(command, mesh_path + ": " + drawing.error());
 
   const std::string marks = marks_to_json(drawing->marks);
-  const std::string object = obj_text(*placed, *mesh, options.mesh_name + " scaled to " + format_double(options.height_m) +
+  const std::string object = obj_text(*placed, *mesh, *tags, options.mesh_name + " scaled to " + format_double(options.height_m) +
                                                          " m along +z, its base's centre at the origin (metres, the object's frame)");
   // Nothing is written unless everything can be: the log last, so a log never comes without its marks.
   if (Status w = write_file_atomic(a.marks_path, marks); !w) return fail(command, w.error);
@@ -226,6 +236,7 @@ int run_simulate_drawing(const SimulateArgs& a) {
   out["poses"] = st.poses;
   out["pieces"] = st.pieces;
   out["holes"] = st.holes;
+  out["sharp"] = st.sharp;
   out["mark_touches"] = st.mark_touches;
   out["curves_drawn"] = st.curves_drawn;
   out["curves_total"] = st.curves_total;

@@ -1,5 +1,6 @@
 // The simulated person drawing a control mesh's curve network through the rig, pose by pose, with its marks
 // and registrations (simulate_drawing), by the plan of drawing_plan.hpp.
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -89,13 +90,6 @@ bool seen_by_both(const SimulatedRig& rig, const Pose& pose, const Vec3& object_
   }
   return true;
 }
-
-// What the person does, in order.
-struct Step {
-  enum Kind { Register, Stroke, Undo, Hole } kind;
-  int pose = 0;
-  std::vector<Vec3> points;  // Stroke: object frame; Hole: the point touched
-};
 
 Status check_drawing(const DrawingOptions& d, const PolygonMeshView& object, const DrawingNetwork& net) {
   const std::pair<const char*, double> named[] = {{"speed", d.speed_m_s}, {"hold", d.hold_s}, {"mark hold", d.mark_hold_s},
@@ -208,24 +202,42 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
       }
       marks.push_back(*pick);
     }
-    // A pose that sees fewer than 3 of them gets more, on its curves where both cameras see them and away from
-    // where the object rests in it (its base, or its top upside down), each as far as can be from the marks it
-    // sees already.
+    // A pose that sees fewer than 3 of them, or only marks on one line (the rotation about it is undetermined),
+    // gets more, on its curves where both cameras see them and away from where the object rests in it (its base,
+    // or its top upside down), each as far as can be from the marks it sees already and from their line.
     auto marks_in = [&](size_t pose) {
       std::vector<uint32_t> out;
       for (uint32_t m = 0; m < marks.size(); ++m)
         if (seen_by_both(*rig, poses[pose], marks[m])) out.push_back(m);
       return out;
     };
+    // The line through marks (the principal axis of two or more), and how far p lies from it.
+    auto off_line = [&](const std::vector<uint32_t>& on, const Vec3& p) {
+      if (on.size() < 2) return std::numeric_limits<double>::infinity();
+      Vec3 centre = Vec3::Zero();
+      for (uint32_t m : on) centre += marks[m];
+      centre /= static_cast<double>(on.size());
+      Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+      for (uint32_t m : on) scatter += (marks[m] - centre) * (marks[m] - centre).transpose();
+      const Vec3 axis = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(2);
+      const Vec3 d = p - centre;
+      return (d - d.dot(axis) * axis).norm();
+    };
+    auto spread_out = [&](const std::vector<uint32_t>& on) {
+      if (on.size() < 3) return false;
+      for (uint32_t m : on)
+        if (off_line(on, marks[m]) >= kMarkSpacing / 2) return true;
+      return false;
+    };
     for (size_t j = 0; j < poses.size(); ++j) {
       const bool upside_down = sides == 2 && j >= poses.size() / 2;
-      for (std::vector<uint32_t> now = marks_in(j); now.size() < 3; now = marks_in(j)) {
+      for (std::vector<uint32_t> now = marks_in(j); !spread_out(now); now = marks_in(j)) {
         double best = kMarkSpacing;
         std::optional<Vec3> pick;
         for (const DrawingCurve& c : net.curves)
           for (const Vec3& p : c.points) {
             if (upside_down ? p.z() > 0.9 * top : p.z() < 0.1 * top) continue;
-            double spread = std::numeric_limits<double>::infinity();
+            double spread = off_line(now, p);
             for (const Vec3& m : marks) spread = std::min(spread, (p - m).norm());
             if (spread > best && seen_by_both(*rig, poses[j], p)) best = spread, pick = p;
           }
@@ -274,8 +286,7 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
   if (!planned && !closed) planned = attempt(2, 1);
   if (!planned) planned = attempt(2, static_cast<int>(kFurtherTilt_deg.size()));
   if (!planned) return R::failure(planned.error());
-  std::vector<Step> plan;
-  for (const PlanStep& s : planned->steps) plan.push_back({static_cast<Step::Kind>(s.kind), s.pose, s.points});
+  const std::vector<PlanStep>& plan = planned->steps;
 
   // The timeline: where the pen is, lit or not, and when each command is logged.
   constexpr double kAccel = 2.0;     // m/s^2, a hand drawing with care
@@ -310,10 +321,10 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
     t += seconds;
   };
   bool first = true;
-  for (const Step& step : plan) {
+  for (const PlanStep& step : plan) {
     const Pose& placed = poses[static_cast<size_t>(step.pose)];
     switch (step.kind) {
-      case Step::Register:
+      case PlanStep::Register:
         if (!first) {
           pose_from.emplace_back(t + 0.5 * kTurn_s, step.pose);
           travel_to(pen, kTurn_s);
@@ -330,7 +341,7 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
         command(t, CommandKind::Register);
         ++stats.registrations;
         break;
-      case Step::Stroke: {
+      case PlanStep::Stroke: {
         std::vector<Vec3> world;
         for (const Vec3& p : step.points) world.push_back(placed(p));
         Polyline path = make_polyline(std::move(world));
@@ -345,22 +356,25 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
         ++stats.strokes;
         break;
       }
-      case Step::Undo:
+      case PlanStep::Undo:
         travel_to(pen, kUndoWait_s);
         command(t, CommandKind::Undo);
         ++stats.undos;
         break;
-      case Step::Hole:
-        // The pen touches the face, unlit, and the pad's hole button is pressed.
+      case PlanStep::Hole:
+      case PlanStep::Sharp: {
+        // The pen touches the face to open or the curve to mark sharp, unlit, and the pad's button is pressed.
+        const bool hole = step.kind == PlanStep::Hole;
         travel_to(placed(step.points.front()), kTravel_s);
         hold(d.mark_hold_s);
-        command(t - 0.2, CommandKind::Hole, 0, step.points.front());
-        ++stats.holes;
+        command(t - 0.2, hole ? CommandKind::Hole : CommandKind::Sharp, 0, step.points.front());
+        ++(hole ? stats.holes : stats.sharp);
         break;
+      }
     }
   }
   std::vector<int> used;
-  for (const Step& step : plan) used.push_back(step.pose);
+  for (const PlanStep& step : plan) used.push_back(step.pose);
   std::sort(used.begin(), used.end());
   stats.poses = static_cast<int>(std::unique(used.begin(), used.end()) - used.begin());
   stats.border_strokes = planned->border_strokes;
@@ -399,7 +413,8 @@ DrawingNetwork drawing_network(const Mesh& m) {
     if (!m.edge_alive(e)) continue;
     const std::span<const Vec3> points = m.polyline(e);
     curve_of[e] = static_cast<uint32_t>(net.curves.size());
-    net.curves.push_back({m.edges.vertex[e][0], m.edges.vertex[e][1], {points.begin(), points.end()}, m.is_border_edge(e)});
+    net.curves.push_back({m.edges.vertex[e][0], m.edges.vertex[e][1], {points.begin(), points.end()}, m.is_border_edge(e),
+                          (m.edges.flags[e] & kSharpEdge) != 0});
   }
   for (uint32_t f = 0; f < m.face_slots(); ++f) {
     if (!m.face_alive(f)) continue;

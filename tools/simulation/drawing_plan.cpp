@@ -866,6 +866,30 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
       steps.push_back(std::move(again));
     }
   }
+  // The curves along a crease of the object, marked sharp once drawn with faces on both sides (the border is a
+  // crease already). The sketch holds a run of curves through vertices where only two meet as one curve, which
+  // one touch marks: it is touched once, in the middle of its longest curve.
+  drawing.update();
+  auto marks_sharp = [&](uint32_t k) { return net.curves[k].sharp && drawing.curve[k] && drawing.surface_beside(k) == 2; };
+  Sets runs(net.curves.size());
+  for (uint32_t v = 0; v < net.vertices.size(); ++v) {
+    std::vector<uint32_t> drawn_here;
+    for (uint32_t k : g.at[v])
+      if (drawing.curve[k]) drawn_here.push_back(k);
+    if (drawn_here.size() == 2 && marks_sharp(drawn_here[0]) && marks_sharp(drawn_here[1])) runs.join(drawn_here[0], drawn_here[1]);
+  }
+  std::vector<uint32_t> longest(net.curves.size(), kNoLoop);
+  for (uint32_t k = 0; k < net.curves.size(); ++k) {
+    if (!marks_sharp(k)) continue;
+    uint32_t& best = longest[runs.find(k)];
+    if (best == kNoLoop || chain_length(net, {{k, true}}) > chain_length(net, {{best, true}})) best = k;
+  }
+  for (uint32_t k : longest)
+    if (k != kNoLoop) {
+      const std::vector<Vec3>& points = net.curves[k].points;
+      steps.push_back({PlanStep::Sharp, steps.back().pose, {points[points.size() / 2]}});
+      ++plan.sharp;
+    }
   plan.curves_drawn = static_cast<size_t>(std::count(drawing.curve.begin(), drawing.curve.end(), 1));
   return plan;
 }

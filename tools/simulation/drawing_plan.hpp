@@ -23,9 +23,10 @@ namespace fire::simulation {
 std::vector<Vec3> chain_points(const DrawingNetwork& net, const Chain& chain);
 
 struct PlanStep {
-  enum Kind { Register, Stroke, Undo, Hole } kind;
+  enum Kind { Register, Stroke, Undo, Hole, Sharp } kind;
   int pose = 0;
-  // Stroke: the pen's path (object frame); Hole: one point, where the pen touches the face.
+  // Stroke: the pen's path (object frame); Hole: one point, where the pen touches the face; Sharp: one point, where
+  // it touches the curve.
   std::vector<Vec3> points;
 };
 
@@ -33,6 +34,7 @@ struct DrawingPlan {
   std::vector<PlanStep> steps;
   int border_strokes = 0;
   int holes = 0;
+  int sharp = 0;   // curves marked sharp
   int pieces = 0;  // strokes that end off the network, a curve drawn in pieces from several poses
   size_t curves_drawn = 0;
 };

@@ -105,6 +105,7 @@ struct DrawingCurve {
   uint32_t a = 0, b = 0;
   std::vector<Vec3> points;
   bool border = false;
+  bool sharp = false;  // along a crease of the object: the person marks it sharp (cmd sharp)
 };
 // A walk along network curves: each curve walked from a to b (forward) or back.
 struct Leg {
@@ -126,6 +127,7 @@ struct DrawingStats {
   int registrations = 0;    // one each time the object is put in a pose
   int poses = 0;            // how many different poses it was drawn in
   int holes = 0;            // faces opened with cmd hole
+  int sharp = 0;            // curves marked sharp with cmd sharp
   int pieces = 0;           // strokes that end off the network: a curve drawn in pieces, turning the object between
   int mark_touches = 0;
   size_t curves_drawn = 0;  // of the network's curves

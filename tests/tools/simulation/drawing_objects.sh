@@ -4,7 +4,9 @@
 # The simulated person draws every curve of OBJECT; the replay rejects no stroke and leaves nothing pending; the
 # surface has the object's Euler characteristic and border loops, and fire eval's rms is within 2e-3 of the
 # diagonal. The summary's counts are checked where the options ask for them: `--turns 3` on the lampshade
-# draws curves in pieces, continued after the object is turned and registered again.
+# draws curves in pieces, continued after the object is turned and registered again. HOLES=N: at least N holes
+# opened. SHARP=N (issue 44): a creased object's crease curves, at least N, marked sharp and still sharp after the
+# replay, and the surface bends across each within 10 degrees of the object's limit surface (fire eval).
 source "$(dirname "${BASH_SOURCE[0]}")/../../work_dir.sh"
 meshes="$3" object="$4" euler="$5" loops="$6"
 shift 6
@@ -27,4 +29,10 @@ case " $* " in
   *" --turns 3 "*) [ "$(field pieces drawing.json)" -ge 1 ] || fail "no curve was drawn in pieces: $(cat drawing.json)" ;;
 esac
 [ "$(field holes drawing.json)" -ge "${HOLES:-0}" ] || fail "fewer than ${HOLES:-0} holes opened: $(cat drawing.json)"
-echo "$object drawn: $(field curves_drawn drawing.json) curves, $(field poses drawing.json) poses, $(field pieces drawing.json) pieces, rms $(field rms eval.json)"
+[ "$(field sharp drawing.json)" -ge "${SHARP:-0}" ] || fail "fewer than ${SHARP:-0} curves marked sharp: $(cat drawing.json)"
+if [ "${SHARP:-0}" -gt 0 ]; then
+  [ "$(field sharp_curves eval.json)" -ge "$SHARP" ] || fail "the replayed network has fewer than $SHARP sharp curves: $(cat eval.json)"
+  awk -v e="$(field crease_error_max_deg eval.json)" 'BEGIN { exit !(e != "" && e <= 10) }' ||
+    fail "the surface does not keep the creases: $(cat eval.json)"
+fi
+echo "$object drawn: $(field curves_drawn drawing.json) curves, $(field poses drawing.json) poses, $(field pieces drawing.json) pieces, rms $(field rms eval.json), crease error $(field crease_error_max_deg eval.json) degrees"
