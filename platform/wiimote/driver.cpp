@@ -103,6 +103,17 @@ std::string describe(const Notice& n) {
   return "remote " + std::to_string(n.device) + " " + n.address + ": " + n.text;
 }
 
+std::string describe(const RemoteView& v) {
+  std::string line = std::string(role_name(v.role)) + " " + v.address + ": " + std::string(link_state_name(v.state));
+  if (v.status) {
+    line += ", battery " + std::to_string(battery_percent(*v.status)) + "%";
+    if (v.status->battery_low()) line += " LOW";
+  }
+  if (!v.error.empty()) line += " (" + v.error + ")";
+  else if (!v.warning.empty()) line += " (" + v.warning + ")";
+  return line;
+}
+
 void Driver::reopen(Link& link, int64_t now) {
   link.next_reopen = now + options_.reopen_every_ns;
   Result<std::unique_ptr<Device>> opened = Result<std::unique_ptr<Device>>::failure("not found");

@@ -52,6 +52,8 @@ struct Notice {
 inline constexpr int kPenNotice = -1;
 // "remote 0 00:1F:32:..: running", or "pen: the stroke ended".
 std::string describe(const Notice& notice);
+// A remote's line in the live views: "camera0 00:1F:32:..: running, battery 80% LOW (why)".
+std::string describe(const RemoteView& remote);
 
 // What open_all found besides the remotes it opened.
 struct Scan {

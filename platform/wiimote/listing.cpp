@@ -19,8 +19,6 @@ std::string_view listed_state_name(ListedState s) {
 
 }  // namespace
 
-int battery_percent(const StatusReport& status) { return std::min(100, status.battery * 100 / kBatteryFull); }
-
 Result<Listing> list_remotes(Backend& backend, const std::vector<RemoteAssignment>& assigned, int wait_ms) {
   Result<std::vector<DeviceInfo>> found = backend.enumerate();
   if (!found) return Result<Listing>::failure(found.error());

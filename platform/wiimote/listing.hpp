@@ -29,8 +29,6 @@ struct Listing {
 // Waits up to wait_ms (real time, through read timeouts) for each remote's status report.
 Result<Listing> list_remotes(Backend& backend, const std::vector<RemoteAssignment>& assigned, int wait_ms = 500);
 
-// Percent of a full battery.
-int battery_percent(const StatusReport& status);
 // The table `fire devices` prints; a line saying none was found when there is none.
 std::string format_listing(const Listing& listing);
 

@@ -77,6 +77,8 @@ std::optional<StatusReport> parse_status(std::span<const uint8_t> report) {
   return StatusReport{.flags = report[3], .battery = report[6]};
 }
 
+int battery_percent(const StatusReport& status) { return std::min(100, status.battery * 100 / kBatteryFull); }
+
 std::optional<uint16_t> core_buttons(std::span<const uint8_t> report) {
   if (report.empty()) return std::nullopt;
   const uint8_t id = report[0];

@@ -95,6 +95,8 @@ struct StatusReport {
 };
 inline constexpr uint8_t kBatteryFull = 0xC8;
 std::optional<StatusReport> parse_status(std::span<const uint8_t> report);
+// Percent of a full battery (fresher cells than kBatteryFull read 100).
+int battery_percent(const StatusReport& status);
 
 // The core buttons, as the first two payload bytes of the reports that carry them (0x20-0x22, and the
 // data reports 0x30-0x37, 0x3E, 0x3F) hold them, first byte high (wiibrew.org, "Core Buttons").

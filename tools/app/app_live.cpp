@@ -186,17 +186,7 @@ std::string AppLive::act(PadAction action) {
 
 void AppLive::fill_hud(window::HudData& hud) const {
   hud.live.clear();
-  for (const wiimote::RemoteView& v : driver_->remotes()) {
-    std::string line = std::string(wiimote::role_name(v.role)) + " " + v.address + ": " +
-                       std::string(wiimote::link_state_name(v.state));
-    if (v.status) {
-      line += ", battery " + std::to_string(int(v.status->battery) * 100 / wiimote::kBatteryFull) + "%";
-      if (v.status->battery_low()) line += " LOW";
-    }
-    if (!v.error.empty()) line += " (" + v.error + ")";
-    else if (!v.warning.empty()) line += " (" + v.warning + ")";
-    hud.live.push_back(line);
-  }
+  for (const wiimote::RemoteView& v : driver_->remotes()) hud.live.push_back(wiimote::describe(v));
   if (!marks_.empty()) {
     hud.live.push_back("next mark: " + std::to_string(shown_mark_) + " of " + std::to_string(marks_.size()) + " at " +
                        millimetres(marks_[shown_mark_]));
