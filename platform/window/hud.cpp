@@ -89,22 +89,67 @@ bool Hud::wants_mouse() const { return ImGui::GetIO().WantCaptureMouse; }
 
 namespace {
 
-// The camera's 1024 x 768 image at an eighth of its size, its blobs as discs that grow with their size;
-// framed green while it sees the pen, red while it does not.
-void draw_camera(int camera, const CameraView& view) {
-  constexpr float kScale = 1.0f / 8.0f, kWidth = kWiimoteWidth * kScale, kHeight = kWiimoteHeight * kScale;
+// The camera's 1024 x 768 image at `scale`, its blobs as discs that grow with their size, strays orange;
+// framed green while it sees the pen, red while it does not. For fire aim, also the working volume's cells
+// (teal where both cameras see it, dim red where only this one does) and the lines under the title.
+void draw_camera(int camera, const CameraView& view, float scale) {
+  const float width = kWiimoteWidth * scale, height = kWiimoteHeight * scale;
   ImGui::BeginGroup();
   ImGui::Text("camera %d: %s", camera, view.pen_seen ? "pen seen" : "no light");
+  for (const std::string& line : view.lines) ImGui::TextUnformatted(line.c_str());
   const ImVec2 corner = ImGui::GetCursorScreenPos();
   ImDrawList* draw = ImGui::GetWindowDrawList();
   const ImU32 frame = view.pen_seen ? IM_COL32(90, 220, 110, 255) : IM_COL32(230, 90, 80, 255);
-  draw->AddRectFilled(corner, ImVec2(corner.x + kWidth, corner.y + kHeight), IM_COL32(15, 15, 20, 230));
-  draw->AddRect(corner, ImVec2(corner.x + kWidth, corner.y + kHeight), frame);
+  draw->AddRectFilled(corner, ImVec2(corner.x + width, corner.y + height), IM_COL32(15, 15, 20, 230));
+  if (view.volume_columns > 0) {
+    const float cell = float(kWiimoteWidth) / float(view.volume_columns) * scale;
+    for (size_t k = 0; k < view.volume.size(); ++k) {
+      if (view.volume[k] == 0) continue;
+      const ImVec2 a(corner.x + float(k % size_t(view.volume_columns)) * cell,
+                     corner.y + float(k / size_t(view.volume_columns)) * cell);
+      draw->AddRectFilled(a, ImVec2(a.x + cell, a.y + cell),
+                          view.volume[k] == 2 ? IM_COL32(16, 64, 58, 255) : IM_COL32(72, 30, 28, 255));
+    }
+  }
+  draw->AddRect(corner, ImVec2(corner.x + width, corner.y + height), frame);
+  // The app's eighth-size view keeps its small discs; larger views grow them with the image (fire aim's PNGs').
+  auto radius = [&](const IrBlob& b) { return std::max(2.0f + float(b.size) * 0.5f, (6.0f + 2.0f * float(b.size)) * scale); };
+  const ImU32 orange = IM_COL32(255, 140, 0, 255);
+  for (const IrBlob& b : view.strays)
+    draw->AddCircleFilled(ImVec2(corner.x + b.x * scale, corner.y + b.y * scale), radius(b), orange);
   for (const IrBlob& b : view.blobs)
-    draw->AddCircleFilled(ImVec2(corner.x + b.x * kScale, corner.y + b.y * kScale), 2.0f + float(b.size) * 0.5f,
-                          IM_COL32(255, 255, 255, 255));
-  ImGui::Dummy(ImVec2(kWidth, kHeight));
+    draw->AddCircleFilled(ImVec2(corner.x + b.x * scale, corner.y + b.y * scale), radius(b),
+                          b.stray ? orange : IM_COL32(255, 255, 255, 255));
+  ImGui::Dummy(ImVec2(width, height));
   ImGui::EndGroup();
+}
+
+constexpr ImGuiWindowFlags kFixed = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
+                                    ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
+                                    ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoMove;
+
+// fire aim: the lines, the problems in red (or a green line saying there are none), both camera views side by
+// side at up to half the sensor's size, smaller when the window is narrow.
+void build_aiming(const HudData& d) {
+  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_Always);
+  ImGui::SetNextWindowBgAlpha(0.9f);
+  ImGui::Begin("FIRE aim", nullptr, kFixed);
+  for (const std::string& line : d.live) ImGui::TextUnformatted(line.c_str());
+  if (d.problems.empty()) ImGui::TextColored(ImVec4(0.5f, 0.9f, 0.55f, 1.0f), "no problems");
+  for (const std::string& p : d.problems) {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.5f, 0.4f, 1.0f));
+    ImGui::PushTextWrapPos(ImGui::GetIO().DisplaySize.x - 40);
+    ImGui::TextUnformatted(p.c_str());
+    ImGui::PopTextWrapPos();
+    ImGui::PopStyleColor();
+  }
+  const ImGuiStyle& style = ImGui::GetStyle();
+  const float room = ImGui::GetIO().DisplaySize.x - 20 - 2 * style.WindowPadding.x - style.ItemSpacing.x;
+  const float scale = std::clamp(room / (2.0f * kWiimoteWidth), 1.0f / 8.0f, 0.5f);
+  draw_camera(0, d.cameras[0], scale);
+  ImGui::SameLine();
+  draw_camera(1, d.cameras[1], scale);
+  ImGui::End();
 }
 
 }  // namespace
@@ -114,12 +159,14 @@ void Hud::build(const HudData& d) {
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
 
+  if (d.aiming) {
+    build_aiming(d);
+    ImGui::Render();
+    return;
+  }
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_Always);
   ImGui::SetNextWindowBgAlpha(0.75f);
-  const ImGuiWindowFlags fixed = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
-                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
-                                 ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoMove;
-  ImGui::Begin("FIRE", nullptr, fixed);
+  ImGui::Begin("FIRE", nullptr, kFixed);
   ImGui::Text("frame %.1f ms   system frames %llu", d.frame_ms, static_cast<unsigned long long>(d.frames));
   if (d.timings && ImGui::BeginTable("timings", 4, ImGuiTableFlags_SizingFixedFit)) {
     ImGui::TableSetupColumn("system");
@@ -165,9 +212,9 @@ void Hud::build(const HudData& d) {
     ImGui::Separator();
     for (const std::string& line : d.live) ImGui::TextUnformatted(line.c_str());
   }
-  if (d.cameras[0].present) draw_camera(0, d.cameras[0]);
+  if (d.cameras[0].present) draw_camera(0, d.cameras[0], 1.0f / 8.0f);
   if (d.cameras[0].present && d.cameras[1].present) ImGui::SameLine();
-  if (d.cameras[1].present) draw_camera(1, d.cameras[1]);
+  if (d.cameras[1].present) draw_camera(1, d.cameras[1], 1.0f / 8.0f);
   ImGui::TextDisabled("H: help");
   const float panel_right = ImGui::GetWindowPos().x + ImGui::GetWindowSize().x;
   ImGui::End();
@@ -177,7 +224,7 @@ void Hud::build(const HudData& d) {
     const ImGuiStyle& style = ImGui::GetStyle();
     ImGui::SetNextWindowPos(ImVec2(size.x - 10, 10), ImGuiCond_Always, ImVec2(1.0f, 0.0f));
     ImGui::SetNextWindowBgAlpha(0.85f);
-    ImGui::Begin("Keys", nullptr, fixed);
+    ImGui::Begin("Keys", nullptr, kFixed);
     ImGui::TextUnformatted("Keys and mouse");
     ImGui::Separator();
     // Each line is "key  description": the keys in a column, the descriptions wrapped to the room right of the

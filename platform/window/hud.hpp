@@ -1,7 +1,7 @@
 #pragma once
 // The HUD, drawn with Dear ImGui over the presented frame: frame time, per-system timings, the counts,
 // the sketch mode, the last rejected edit, the view toggles, the help overlay listing the keys, and in a live
-// session the remotes' states and each IR camera's view.
+// session the remotes' states and each IR camera's view; or, for fire aim, the camera views and their problems.
 // It shows what the app hands it in HudData (engine data read by the app); it calls nothing of the engine.
 #include <array>
 #include <memory>
@@ -18,11 +18,19 @@ namespace fire::window {
 struct IrBlob {
   float x = 0, y = 0;  // sensor pixels
   int size = 0;        // the report's blob size, 0 to 15
+  bool stray = false;  // a still light taken for a stray, not the pen (fire aim): drawn orange
 };
 struct CameraView {
   bool present = false;   // the camera has reported
   bool pen_seen = false;  // its last report shows a light
   std::vector<IrBlob> blobs;
+  // fire aim: lines under the view's title (rate, battery, sensitivity), the stray lights named so far, and
+  // where a rig's working volume lies in the image: `volume_columns` square cells a row, row by row, each
+  // 0 (outside), 1 (seen by this camera only) or 2 (by both cameras); none without a rig.
+  std::vector<std::string> lines;
+  std::vector<IrBlob> strays;
+  std::vector<uint8_t> volume;
+  int volume_columns = 0;
 };
 
 struct HudData {
@@ -43,6 +51,10 @@ struct HudData {
   // A live session's news: the remotes' states and batteries, the mark to touch next; and each camera's view.
   std::vector<std::string> live;
   std::array<CameraView, 2> cameras;
+  // fire aim: the HUD is the two camera views alone, as large as the window allows, with the `live` lines and
+  // the problems (none: a line saying so).
+  bool aiming = false;
+  std::vector<std::string> problems;
   // The keys, one line each: the key, two or more spaces, what it does ("Ctrl+Z  undo"); the help overlay
   // shows them in two columns.
   std::vector<std::string> keys;

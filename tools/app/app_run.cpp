@@ -417,11 +417,7 @@ int run_app(const AppOptions& a) {
   };
 
   while (app.status() && !window.should_close()) {
-    for (; next_script < script.size() && script[next_script].frame <= display_frame; ++next_script) {
-      const ScriptEvent& s = script[next_script];
-      if (s.resize_width) window.request_size(s.resize_width, s.resize_height);
-      else window.inject(s.event);
-    }
+    next_script = deliver_script(script, next_script, display_frame, window);
     window.poll();
     if (std::optional<std::string> done = cad_job.finished()) report(std::move(*done));
     for (const window::WindowEvent& e : window.events()) handle(e);

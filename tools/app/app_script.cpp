@@ -82,4 +82,13 @@ Result<std::vector<ScriptEvent>> read_script(const std::string& path) {
   return events;
 }
 
+size_t deliver_script(const std::vector<ScriptEvent>& script, size_t next, uint64_t frame, window::Window& window) {
+  for (; next < script.size() && script[next].frame <= frame; ++next) {
+    const ScriptEvent& s = script[next];
+    if (s.resize_width) window.request_size(s.resize_width, s.resize_height);
+    else window.inject(s.event);
+  }
+  return next;
+}
+
 }  // namespace fire::app

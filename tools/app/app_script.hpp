@@ -23,5 +23,8 @@ struct ScriptEvent {
 //   resize WIDTH HEIGHT | close
 // FRAME is the display frame (from 0) before which the event is delivered; frames never decrease.
 Result<std::vector<ScriptEvent>> read_script(const std::string& path);
+// Delivers `script`'s events from index `next` on that are due by display frame `frame` to `window`; returns the
+// index of the first one not yet due.
+size_t deliver_script(const std::vector<ScriptEvent>& script, size_t next, uint64_t frame, window::Window& window);
 
 }  // namespace fire::app

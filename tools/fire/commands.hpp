@@ -28,6 +28,8 @@ void add_reconstruct_commands(CLI::App& app, Registry& registry);
 
 // devices (the Wii Remotes this machine sees, platform/wiimote)
 void add_devices_commands(CLI::App& app, Registry& registry);
+// aim (each camera remote's IR view while the cameras are aimed, tools/app/aim_run.hpp)
+void add_aim_commands(CLI::App& app, Registry& registry);
 // render (headless Vulkan rendering to PNG, platform/render)
 void add_render_commands(CLI::App& app, Registry& registry);
 // app (the interactive window and HUD, platform/window)

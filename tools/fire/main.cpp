@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   fire::cli::add_eval_commands(app, registry);
   fire::cli::add_reconstruct_commands(app, registry);
   fire::cli::add_devices_commands(app, registry);
+  fire::cli::add_aim_commands(app, registry);
   fire::cli::add_render_commands(app, registry);
   fire::cli::add_app_commands(app, registry);
   // A first word that names no command: say so, not that a command is required.

@@ -21,6 +21,7 @@
 #include "platform/render/renderer.hpp"
 #include "systems/evaluate/evaluate.hpp"
 #include "tests/platform/window/pawn_drawing.hpp"
+#include "tools/simulation/simulate.hpp"
 
 namespace {
 
@@ -49,23 +50,27 @@ Run run(const std::string& command, const fs::path& dir) {
 
 bool has_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
 
-// fire app under a fresh X server; the validation layer on, LeakSanitizer's suppressions for Mesa in the
-// sanitizer build. Each test case searches for a free display from its own number: xvfb-run -a alone races
+// `fire COMMAND` (app, aim) under a fresh X server; the validation layer on, LeakSanitizer's suppressions for Mesa
+// in the sanitizer build. Each test case searches for a free display from its own number: xvfb-run -a alone races
 // when ctest -j starts two at once (both take :99). The app runs through record_exit.sh, so its exit status
 // is judged apart from xvfb-run's, which can fail in its own cleanup after the app exited; no status file
 // means xvfb-run never ran the app to its end, and exit_code stays -1.
-Run run_app(int display, const std::string& args, const fs::path& dir, const std::string& env = "") {
+Run run_window(int display, const std::string& command, const fs::path& dir, const std::string& env = "") {
   const fs::path status_file = dir / "app_status";
   fs::remove(status_file);
   Run r = run("env " + env + " FIRE_VK_VALIDATION=1 LSAN_OPTIONS=suppressions=" + FIRE_LSAN_SUPPRESSIONS +
                   ":print_suppressions=0 xvfb-run -a -n " + std::to_string(display) + " -s '-screen 0 1280x800x24' " +
                   quote(FIRE_RECORD_EXIT) + " " + quote(status_file.string()) + " timeout 240 " + quote(FIRE_BINARY) +
-                  " app " + args,
+                  " " + command,
               dir);
   r.runner_exit = r.exit_code;
   r.exit_code = -1;
   if (auto status = fire::read_text_file(status_file.string())) r.exit_code = std::atoi(status->c_str());
   return r;
+}
+
+Run run_app(int display, const std::string& args, const fs::path& dir, const std::string& env = "") {
+  return run_window(display, "app " + args, dir, env);
 }
 
 fs::path scratch(const std::string& name) {
@@ -792,5 +797,62 @@ TEST_CASE("fire app --live misused, or without remotes: a clear message, exit 1,
     CHECK(no_remotes.err.find("fire devices --rig") != std::string::npos);
     CHECK_FALSE(fs::exists(session));
   }
+  fs::remove_all(dir);
+}
+
+// Issue 42, item 2: `fire aim` in a window on the fake rig, 3 s of `fire simulate drawing --seed 1` (a 60th of a
+// second each displayed frame): both cameras' views side by side at half size, framed green with the pen's blob in
+// white, camera 1's stray light named and drawn orange, the true rig's working volume shaded.
+TEST_CASE("fire aim: both cameras' views in a window, the pen, the stray light named and drawn, the working volume",
+          "[aim][window]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("aim");
+  auto rig_json = fire::simulation::true_rig_json(fire::simulation::RigOptions{});
+  REQUIRE(rig_json);
+  const std::string rig = (dir / "rig.json").string(), script = (dir / "close.script").string(),
+                    shot = (dir / "shot.png").string();
+  REQUIRE(fire::write_file_atomic(rig, *rig_json));
+  REQUIRE(fire::write_file_atomic(script, "180 close\n"));
+  const Run aim = run_window(240,
+                             "aim --fake-rig 1 --rig " + quote(rig) + " --size 1100x620 --script " + quote(script) +
+                                 " --screenshot " + quote(shot),
+                             dir);
+  INFO("xvfb-run exit: " << aim.runner_exit << "\nstdout: " << aim.out << "\nstderr: " << aim.err);
+  REQUIRE(aim.exit_code == 0);
+  const size_t last_line = aim.out.rfind('\n', aim.out.size() - 2);  // the summary, after a line a second
+  const auto end = nlohmann::json::parse(aim.out.substr(last_line == std::string::npos ? 0 : last_line + 1));
+  CHECK(end["t_s"].get<double>() > 2.8);
+  REQUIRE(end["problems_named"].size() == 1);
+  CHECK(end["problems_named"][0].get<std::string>().rfind("camera 1 sees a still light at (87", 0) == 0);
+  CHECK(end["pictures"][0] == shot);
+
+  auto image = fire::render::read_png(shot);
+  REQUIRE(image);
+  const Image& im = *image;
+  // The HUD's colours as the sRGB swapchain shows them: the frames (90, 220, 110), the stray (255, 140, 0), the
+  // working volume both cameras see (16, 64, 58).
+  const uint8_t green[3] = {160, 239, 175}, orange[3] = {255, 196, 0}, teal[3] = {71, 137, 131},
+                white[3] = {255, 255, 255};
+  size_t green_pixels = 0, teal_pixels = 0, white_pixels = 0, orange_left = 0, orange_right = 0;
+  uint32_t green_x0 = im.width, green_x1 = 0;
+  for (uint32_t y = 0; y < im.height; ++y)
+    for (uint32_t x = 0; x < im.width; ++x) {
+      const uint8_t* p = im.pixel(x, y);
+      if (near(p, green, 12)) {
+        ++green_pixels;
+        green_x0 = std::min(green_x0, x), green_x1 = std::max(green_x1, x);
+      }
+      teal_pixels += near(p, teal, 12);
+      white_pixels += near(p, white, 10);
+      (x < im.width / 2 ? orange_left : orange_right) += near(p, orange, 12);
+    }
+  INFO("green " << green_pixels << " in x " << green_x0 << ".." << green_x1 << ", teal " << teal_pixels << ", white "
+                << white_pixels << ", orange " << orange_left << " left, " << orange_right << " right");
+  CHECK(green_pixels > 3000);                   // two 512 x 384 outlines: both cameras see the pen
+  CHECK(green_x1 - green_x0 > 1000);
+  CHECK(teal_pixels > 0.3 * 2 * 512 * 384);     // the working volume in both views
+  CHECK(white_pixels > 2 * 50);                 // the pen's disc in each
+  CHECK(orange_right > 50);                     // camera 1's stray, named and drawn
+  CHECK(orange_left == 0);
   fs::remove_all(dir);
 }
