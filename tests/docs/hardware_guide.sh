@@ -9,6 +9,9 @@
 #                              parse); then under Xvfb on fake remotes (--rig and --marks swapped for --fake-rig),
 #                              Ctrl+S and E pressed when -o and --export are given (their files must appear), closed
 #   fire app (not live)        under Xvfb, closed at once
+#   fire aim                   twice: as written, without a display, where it must stop only for want of remotes (so
+#                              the rig it names parses); then with --fake-rig 7 added: with --png-dir headless (both
+#                              pictures must appear), else under Xvfb, closed after 30 frames
 #   fire devices               as written: exit 0 with no remote found (1 only when remotes are there), never 2
 #   anything else              as written: exit 0
 # A placeholder (RIG, DIR, N) in a code block's `fire` line fails the run: write the guide's lines runnable.
@@ -197,6 +200,31 @@ for entry in "${lines[@]}"; do
         if [ -n "$f" ] && [ ! -s "$f" ]; then bad "$where: $o $f not written: fire ${w[*]}: $(tail -3 "$n.err")"; fi
       done
       ;;
+    aim)
+      if ! has --fake-rig "${w[@]}"; then
+        env -u DISPLAY -u WAYLAND_DISPLAY "$fire" "${w[@]}" </dev/null >"$n.out" 2>"$n.err" || rc=$?
+        if [ $rc -ne 1 ] || ! grep -q "needs two Wii Remotes as cameras and found [01]" "$n.err"; then
+          bad "$where: as written, exit $rc, not the want of remotes: fire ${w[*]}: $(cat "$n.err")"
+          continue
+        fi
+        w+=(--fake-rig 7)
+      fi
+      pictures=$(value_of --png-dir "${w[@]}")
+      if [ -n "$pictures" ]; then
+        rm -rf "$pictures"
+        rc=0
+        "$fire" "${w[@]}" </dev/null >"$n.out" 2>"$n.err" || rc=$?
+        if [ $rc -ne 0 ]; then bad "$where: exit $rc: fire ${w[*]}: $(tail -3 "$n.err")"; continue; fi
+        for c in 0 1; do
+          [ -s "$pictures/camera$c.png" ] || bad "$where: $pictures/camera$c.png not written: fire ${w[*]}"
+        done
+      else
+        echo "30 close" >"$n.script"
+        has --size "${w[@]}" || w+=(--size 320x240)
+        status=$(under_x "$n" "$fire" "${w[@]}" --script "$n.script")
+        if [ "$status" != 0 ]; then bad "$where: exit $status: fire ${w[*]}: $(tail -3 "$n.err")"; continue; fi
+      fi
+      ;;
     devices)
       "$fire" "${w[@]}" </dev/null >"$n.out" 2>"$n.err" || rc=$?
       if [ $rc -eq 2 ] || { grep -q "no Wii Remote found" "$n.out" && [ $rc -ne 0 ]; } || [ $rc -gt 1 ]; then
@@ -213,7 +241,7 @@ for entry in "${lines[@]}"; do
 done
 
 # The guide goes from the remotes to an exported surface: each step's command must be among those run.
-for c in simulate calibrate devices app replay reconstruct export-network eval track; do
+for c in simulate calibrate devices aim app replay reconstruct export-network eval track; do
   [ -n "${ran[$c]+set}" ] || bad "$guide runs no fire $c in its code blocks"
 done
 echo "${#lines[@]} lines of $guide run in $((SECONDS - start)) s; $problems failed"
