@@ -465,8 +465,11 @@ TEST_CASE("fire aim misused, or without remotes: a clear message naming the inpu
   CHECK(no_display.exit_code == 1);
   CHECK(no_display.err.find("no display") != std::string::npos);
 
-  // No --fake-rig: the remotes of this machine, which CI has none of.
-  const Run none = fire_aim("--png-dir " + quote((dir.path / "p").string()) + " --seconds 1", dir.path);
+  CHECK_FALSE(fs::exists(dir.path / "p"));  // none of these made the pictures' folder
+
+  // No --fake-rig: the remotes of this machine, which CI has none of; no empty folder is left behind.
+  const fs::path none_dir = dir.path / "none";
+  const Run none = fire_aim("--png-dir " + quote(none_dir.string()) + " --seconds 1", dir.path);
   INFO("stderr: " << none.err);
   if (none.exit_code == 0) {
     WARN("this machine has two Wii Remotes: the no-remote case is not checked");
@@ -474,5 +477,6 @@ TEST_CASE("fire aim misused, or without remotes: a clear message naming the inpu
     CHECK(none.exit_code == 1);
     CHECK(none.err.find("fire aim: needs two Wii Remotes as cameras and found 0") != std::string::npos);
     CHECK(none.err.find("fire devices lists") != std::string::npos);
+    CHECK_FALSE(fs::exists(none_dir));
   }
 }

@@ -317,13 +317,6 @@ int run_aim(const AimOptions& o) {
   const bool headless = !o.png_dir.empty();
   if (headless && (!o.script_path.empty() || !o.screenshot_path.empty()))
     return fail("--script and --screenshot are for the window; --png-dir writes the pictures without one");
-  if (headless) {
-    std::error_code error;
-    std::filesystem::create_directories(o.png_dir, error);
-    if (error || !std::filesystem::is_directory(o.png_dir) || ::access(o.png_dir.c_str(), W_OK) != 0)
-      return fail("--png-dir " + o.png_dir + ": cannot write pictures there" +
-                  (error ? " (" + error.message() + ")" : std::string()));
-  }
   // The rig, when there is one: the working volume each view shades, and the remotes' roles.
   std::vector<wiimote::RemoteAssignment> assigned;
   std::optional<std::array<std::vector<VolumeCell>, 2>> volume;
@@ -337,8 +330,21 @@ int run_aim(const AimOptions& o) {
     assigned = std::move(*roles);
     volume = volume_cells(rig->cam0, rig->cam1);
   }
+  // The pictures' folder is made before the remotes are watched, so that a bad one is said at once.
+  const bool made = headless && !std::filesystem::exists(o.png_dir);
+  if (headless) {
+    std::error_code error;
+    std::filesystem::create_directories(o.png_dir, error);
+    if (error || !std::filesystem::is_directory(o.png_dir) || ::access(o.png_dir.c_str(), W_OK) != 0)
+      return fail("--png-dir " + o.png_dir + ": cannot write pictures there" +
+                  (error ? " (" + error.message() + ")" : std::string()));
+  }
   auto remotes = AimRemotes::open(o, std::move(assigned));
-  if (!remotes) return fail(remotes.error());
+  if (!remotes) {
+    std::error_code ignored;
+    if (made) std::filesystem::remove(o.png_dir, ignored);  // no empty folder left behind by a failed start
+    return fail(remotes.error());
+  }
   AimMonitor monitor(o.ir_sensitivity);
   const auto* shaded = volume ? &*volume : nullptr;
   return headless ? run_headless(o, **remotes, monitor, shaded) : run_window(o, **remotes, monitor, shaded);
