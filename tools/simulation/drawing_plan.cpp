@@ -258,6 +258,18 @@ std::optional<Band> find_band(const Cells& g, const std::vector<char>& inside, c
       if (!ok || euler(g, band.cells) != 0) continue;
       std::vector<char> rim = rim_of(g, band.cells);
       for (const Leg& l : cycle) ok = ok && rim[l.curve], rim[l.curve] = 0;
+      // A far rim of two curves would be capped by a face of two sides: the band goes on across it, ring by
+      // ring (along a handle's tube), until its far rim has three curves or more.
+      while (ok && std::count(rim.begin(), rim.end(), 1) < 3) {
+        bool grew = false;
+        for (uint32_t k = 0; k < net.curves.size(); ++k)
+          if (rim[k])
+            for (uint32_t c : g.beside[k])
+              if (!band.cells[c] && inside[c]) band.cells[c] = 1, grew = true;
+        ok = grew && euler(g, band.cells) == 0;
+        rim = rim_of(g, band.cells);
+        for (const Leg& l : cycle) ok = ok && rim[l.curve], rim[l.curve] = 0;
+      }
       std::vector<char> used(net.curves.size(), 0);
       const auto first = std::find(rim.begin(), rim.end(), 1);
       if (!ok || first == rim.end()) continue;
@@ -430,8 +442,14 @@ struct Drawing {
     for (uint32_t k = 0; k < net.curves.size(); ++k) {
       const auto& b = g.beside[k];
       if (!curve[k]) {
-        for (size_t i = 1; i < b.size(); ++i)
-          if (surface[b[0]] && surface[b[i]]) cells.join(b[0], b[i]);
+        // Every cell with surface beside it, also where a cell without (a band's face) comes first: a capped
+        // rim's curve lies between a cap, the far side and the band.
+        uint32_t first = kNoLoop;
+        for (uint32_t c : b) {
+          if (!surface[c]) continue;
+          if (first == kNoLoop) first = c;
+          else cells.join(first, c);
+        }
       } else if (surface_beside(k) == 1) {
         loops.join(net.curves[k].a, net.curves[k].b);
       }
