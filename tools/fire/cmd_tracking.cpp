@@ -579,24 +579,26 @@ void add_tracking_commands(CLI::App& app, Registry& registry) {
   dr->add_option("--mark-hold-s", drawing->drawing.mark_hold_s, "seconds the pen rests on each mark; cmd mark is logged 0.2 s before it lifts")
       ->capture_default_str();
   dr->add_option("--tilt", drawing->drawing.tilt_deg, "degrees the object leans its top toward the cameras")->capture_default_str();
-  dr->add_option("--turns", drawing->drawing.turns, "poses the object may be turned to, evenly about its up axis")->capture_default_str();
+  dr->add_option("--turns", drawing->drawing.turns, "poses the object may be turned to, evenly about its up axis (twice as many where these show too little of it)")->capture_default_str();
   dr->add_option("--undo-after", drawing->drawing.undo_after, "the split stroke (1-based) undone with cmd undo and drawn again (0: none)")
       ->capture_default_str();
   dr->add_option("--max-strokes", drawing->drawing.max_strokes, "stop after this many strokes, the border always whole (0: the whole network)")
       ->capture_default_str();
   dr->footer(
       "The object stands before the rig, its middle where the cameras converge (--distance), and is turned, leaned "
-      "further and set upside down only as far as it needs to be (a closed object always goes upside down). Six marks are "
-      "network vertices around it at a fifth and half its height (a third and two thirds on a closed object), and more "
-      "on its curves where a pose sees fewer than 3. The person touches the marks both cameras see (the pen resting on "
-      "each, cmd mark N X Y Z logged), logs cmd register, and draws each part's first border loop (the lowest border, "
+      "further, set upside down and turned in finer steps (twice --turns) only as far as it needs to be (a closed "
+      "object always goes upside down). Six marks are network vertices around it at a fifth and half its height (a "
+      "third and two thirds on a closed object), and more on its curves where a pose sees fewer than 3, or only marks "
+      "on one line. The person touches the marks both cameras see (the pen resting on each, cmd mark N X Y Z logged), "
+      "logs cmd register, and draws each part's first border loop (the lowest border, "
       "or on a closed object a loop round its top faces or a handle), then splitting curves: chains of the network's "
       "curves between points already drawn, shortest first, each inside one face (an ear decomposition). The other "
       "border loops and a handle's ends are drawn round and opened with cmd hole; a handle and a closed object's "
-      "top are drawn last, across the hole, from loop to loop. When no stroke left is seen whole by both cameras, the "
-      "object is turned to a pose that shows one and registered again on the marks seen there; a chain no pose shows "
-      "whole is drawn in pieces, turning the object between them. The pen's LED is at its tip, on the limit surface, "
-      "which is what hides it from a camera. "
+      "top are drawn last, across the hole, from loop to loop. The curves along a crease of the object (OpenSubdiv's "
+      "t crease tags in --mesh) are marked sharp at the end, the pen touching each (cmd sharp X Y Z). When no stroke "
+      "left is seen whole by both cameras, the object is turned to a pose that shows one and registered again on the "
+      "marks seen there; a chain no pose shows whole is drawn in pieces, turning the object between them. The pen's "
+      "LED is at its tip, on the limit surface, which is what hides it from a camera. "
       "The stray reflection (--stray) as in every session. Hand occlusions (--occlusion) are off by default: while one "
       "camera follows the pen the tracker emits no samples, so a hand passing a corner of a stroke that runs along "
       "several curves makes a chord there, a later curve meant to end at that corner misses it and is rejected, and "

@@ -63,6 +63,7 @@ bool segment_meets_box(const Vec3& from, const Vec3& dir, double len, const std:
 constexpr double kSurfaceClearance = 0.006;
 constexpr double kImageMargin = 16;  // pixels: a blob this close to the image's edge may leave it
 constexpr double kMarkSpacing = 0.02;  // metres between marks the person adds: registration needs them apart
+constexpr int kMaxTurns = 36;
 // How much further than --tilt the object leans where that tilt shows too little (into a vessel, under a base).
 constexpr std::array<double, 4> kFurtherTilt_deg{0, 35, 60, 80};
 
@@ -101,7 +102,7 @@ Status check_drawing(const DrawingOptions& d, const PolygonMeshView& object, con
   if (!(d.mark_hold_s >= 0.8 && d.mark_hold_s <= 10))
     return Status::failure("mark hold must be within [0.8, 10] s (registration averages the pen's last 0.5 s on a mark)");
   if (!(std::abs(d.tilt_deg) <= 60)) return Status::failure("tilt must be within [-60, 60] degrees");
-  if (d.turns < 1 || d.turns > 36) return Status::failure("turns must be within 1..36");
+  if (d.turns < 1 || d.turns > kMaxTurns) return Status::failure("turns must be within 1.." + std::to_string(kMaxTurns));
   if (d.undo_after < 0 || d.max_strokes < 0) return Status::failure("undo-after and max-strokes must not be negative");
   if (object.positions.empty() || object.face_offsets.size() < 2) return Status::failure("the object has no faces");
   if (net.curves.empty()) return Status::failure("the network has no curves");
@@ -166,7 +167,7 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
   std::vector<std::vector<char>> shows;
   std::vector<std::vector<std::vector<char>>> seen;
   const bool closed = network_closed(net);
-  auto attempt = [&](int sides, int tilts) -> Result<DrawingPlan> {
+  auto attempt = [&](int sides, int tilts, int turns) -> Result<DrawingPlan> {
     Eigen::Matrix3d standing;
     standing << 1, 0, 0, 0, 0, -1, 0, 1, 0;
     const Eigen::Matrix3d over = Eigen::AngleAxisd(std::numbers::pi, Vec3::UnitX()).toRotationMatrix();
@@ -175,8 +176,8 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
       for (int tilt = 0; tilt < tilts; ++tilt) {
         const double lean_deg = d.tilt_deg + kFurtherTilt_deg[static_cast<size_t>(tilt)];
         const Eigen::Matrix3d lean = Eigen::AngleAxisd(lean_deg * std::numbers::pi / 180, Vec3::UnitX()).toRotationMatrix();
-        for (int j = 0; j < d.turns; ++j) {
-          const double turn = 2 * std::numbers::pi * j / d.turns;
+        for (int j = 0; j < turns; ++j) {
+          const double turn = 2 * std::numbers::pi * j / turns;
           Pose pose;
           pose.R = lean * standing * (side ? over : Eigen::Matrix3d::Identity()) * Eigen::AngleAxisd(-turn, Vec3::UnitZ()).toRotationMatrix();
           pose.t = Vec3(0, 0, o.target_distance_m) - pose.R * Vec3(0, 0, 0.5 * top);
@@ -261,7 +262,7 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
     PoseQuestions questions;
     // Poses nearest the current one first: the same way up and lean, then the other lean, then turned over.
     questions.order = [&](int current) {
-      const int side = current / (tilts * d.turns), tilt = current / d.turns % tilts, turn = current % d.turns;
+      const int side = current / (tilts * turns), tilt = current / turns % tilts, turn = current % turns;
       std::vector<int> order;
       for (int s : {side, 1 - side}) {
         if (s >= sides) continue;
@@ -269,10 +270,10 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
         std::iota(by_lean.begin(), by_lean.end(), 0);
         std::stable_sort(by_lean.begin(), by_lean.end(), [&](int x, int y) { return std::abs(x - tilt) < std::abs(y - tilt); });
         for (int t : by_lean) {
-          const int base = (s * tilts + t) * d.turns;
+          const int base = (s * tilts + t) * turns;
           order.push_back(base + turn);
-          for (int step = 1; step <= d.turns / 2; ++step)
-            for (int j : {(turn + step) % d.turns, (turn - step + d.turns) % d.turns})
+          for (int step = 1; step <= turns / 2; ++step)
+            for (int j : {(turn + step) % turns, (turn - step + turns) % turns})
               if (std::find(order.begin(), order.end(), base + j) == order.end()) order.push_back(base + j);
         }
       }
@@ -282,9 +283,12 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
     return plan_drawing(net, questions, d.max_strokes, d.undo_after);
   };
   // Upside down, and leaning further, only where the object needs it.
-  Result<DrawingPlan> planned = attempt(closed ? 2 : 1, 1);
-  if (!planned && !closed) planned = attempt(2, 1);
-  if (!planned) planned = attempt(2, static_cast<int>(kFurtherTilt_deg.size()));
+  const int tilts = static_cast<int>(kFurtherTilt_deg.size());
+  Result<DrawingPlan> planned = attempt(closed ? 2 : 1, 1, d.turns);
+  if (!planned && !closed) planned = attempt(2, 1, d.turns);
+  if (!planned) planned = attempt(2, tilts, d.turns);
+  // Turned in finer steps only where the coarse ones show too little: into a cup between its handle's roots.
+  if (!planned && 2 * d.turns <= kMaxTurns) planned = attempt(2, tilts, 2 * d.turns);
   if (!planned) return R::failure(planned.error());
   const std::vector<PlanStep>& plan = planned->steps;
 
