@@ -1,7 +1,6 @@
 #include "platform/wiimote/hidapi_backend.hpp"
 
 #include <hidapi.h>
-#include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
@@ -72,7 +71,7 @@ Result<std::unique_ptr<Device>> HidapiBackend::open(const DeviceInfo& info) {
   using R = Result<std::unique_ptr<Device>>;
   const std::string name = info.path + " (" + normalize_address(info.serial) + ")";
   if (!initialised_) return R::failure(name + ": hidapi could not be initialised");
-  if (::access(info.path.c_str(), R_OK | W_OK) != 0 && errno == EACCES) return R::failure(name + ": " + permission_advice(info.path));
+  if (permission_denied(info.path)) return R::failure(name + ": " + permission_advice(info.path));
   if (const auto binding = kernel_binding(info.path); binding && binding->driver == kKernelWiimoteDriver)
     return R::failure(name + ": " + unbind_advice(*binding));
   hid_device* handle = hid_open_path(info.path.c_str());

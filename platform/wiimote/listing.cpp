@@ -45,7 +45,10 @@ Result<Listing> list_remotes(Backend& backend, const std::vector<RemoteAssignmen
       }
       if (!r.status) {
         r.state = ListedState::NoAnswer;
-        r.problem = "no status report: is the kernel's hid-wiimote driver bound to it? (docs/wiimote.md)";
+        // The hidapi backend refuses a remote on hid-wiimote at open, so silence here is the remote or the radio.
+        r.problem = "no status report in " + std::to_string(wait_ms) +
+                    " ms: switch it off and on; if it stays silent, check its batteries and its distance to the "
+                    "Bluetooth adapter (docs/hardware.md section 1)";
       }
     }
     out.remotes.push_back(std::move(r));
@@ -56,8 +59,7 @@ Result<Listing> list_remotes(Backend& backend, const std::vector<RemoteAssignmen
 }
 
 std::string format_listing(const Listing& listing) {
-  if (listing.remotes.empty())
-    return "no Wii Remote found (pair and connect one first: docs/wiimote.md)\n";
+  if (listing.remotes.empty()) return {};
   std::string s;
   char line[256];
   std::snprintf(line, sizeof line, "%-17s  %-8s  %-11s  %-7s  %-8s  %s\n", "address", "role", "state", "battery", "product", "path");
@@ -69,7 +71,6 @@ std::string format_listing(const Listing& listing) {
                   r.role ? std::string(role_name(*r.role)).c_str() : "-", std::string(listed_state_name(r.state)).c_str(),
                   battery.c_str(), r.info.product, r.info.path.c_str());
     s += line;
-    if (!r.problem.empty()) s += "  " + r.address + ": " + r.problem + "\n";
   }
   return s;
 }

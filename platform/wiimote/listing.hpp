@@ -29,7 +29,8 @@ struct Listing {
 // Waits up to wait_ms (real time, through read timeouts) for each remote's status report.
 Result<Listing> list_remotes(Backend& backend, const std::vector<RemoteAssignment>& assigned, int wait_ms = 500);
 
-// The table `fire devices` prints; a line saying none was found when there is none.
+// The table `fire devices` prints, one row per remote (their problems are missed_steps' lines); empty
+// when there is none.
 std::string format_listing(const Listing& listing);
 
 }  // namespace fire::wiimote

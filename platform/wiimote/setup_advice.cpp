@@ -1,5 +1,8 @@
 #include "platform/wiimote/setup_advice.hpp"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -13,6 +16,10 @@ namespace fire::wiimote {
 namespace {
 
 namespace fs = std::filesystem;
+
+// Where the guide takes each step; wiimote.md has the reasons.
+constexpr const char* kKernelSection = " (docs/hardware.md section 6; details: docs/wiimote.md section 2)";
+constexpr const char* kUdevSection = " (docs/hardware.md section 6; details: docs/wiimote.md section 3)";
 
 // hid-core's parameter is an int (0600): "1" is what a write must say, and only root may read it.
 constexpr const char* kSpecialDriversParameter = "/sys/module/hid/parameters/ignore_special_drivers";
@@ -83,17 +90,17 @@ std::string verdict_message(const SysfsRemote& r, std::optional<bool> ignore_spe
       return who + ": held by the kernel's " + driver_title(r.driver) + " driver, which changes the reporting mode behind FIRE's back" +
              (ignore_special_drivers == true ? ", although hid.ignore_special_drivers is set (it was bound first): "
                                              : "; hid-generic takes a Wii Remote only while hid.ignore_special_drivers is set: ") +
-             to_generic_steps(r.hid_id, r.driver, r.address, ignore_special_drivers) + " (docs/wiimote.md)";
+             to_generic_steps(r.hid_id, r.driver, r.address, ignore_special_drivers) + kKernelSection;
     case SetupVerdict::NoNode:
       if (!r.driver.empty())
         return who + ": hid-generic holds it but made no hidraw node: sudo modprobe hidraw, then " +
                driver_command(r.hid_id, kKernelGenericDriver, "unbind") + "; " +
-               driver_command(r.hid_id, kKernelGenericDriver, "bind") + " (docs/wiimote.md)";
+               driver_command(r.hid_id, kKernelGenericDriver, "bind") + kKernelSection;
       return who + ": no HID driver is bound, so there is no hidraw node for FIRE to open" +
              (ignore_special_drivers == true ? ": "
                                              : " (as after blacklisting hid_wiimote: hid-generic refuses a Wii Remote until "
                                                "hid.ignore_special_drivers is set): ") +
-             to_generic_steps(r.hid_id, "", r.address, ignore_special_drivers) + " (docs/wiimote.md)";
+             to_generic_steps(r.hid_id, "", r.address, ignore_special_drivers) + kKernelSection;
   }
   return who;
 }
@@ -105,9 +112,12 @@ std::string udev_install_command() {
          " /etc/udev/rules.d/ && sudo udevadm control --reload-rules && sudo udevadm trigger";
 }
 
+bool permission_denied(const std::string& path) { return ::access(path.c_str(), R_OK | W_OK) != 0 && errno == EACCES; }
+
 std::string permission_advice(const std::string& path) {
   return "permission denied on " + path + ": install FIRE's udev rule (" + udev_install_command() +
-         "), then switch the remote off and on (docs/wiimote.md)";
+         "), then switch the remote off and on; from a login other than the seat's (ssh), also join its group: "
+         "sudo usermod -aG plugdev $USER, and log in again" + kUdevSection;
 }
 
 std::optional<KernelBinding> kernel_binding(const std::string& hidraw_path, const std::string& sysfs_root) {
@@ -127,14 +137,29 @@ std::string unbind_advice(const KernelBinding& b) {
   return "the kernel's " + driver_title(b.driver) + " driver is bound to " + b.hid_id +
          " and changes the reporting mode behind FIRE's back; hid-generic takes a Wii Remote only while "
          "hid.ignore_special_drivers is set: " +
-         to_generic_steps(b.hid_id, b.driver, "", std::nullopt) + " (docs/wiimote.md)";
+         to_generic_steps(b.hid_id, b.driver, "", std::nullopt) + kKernelSection;
 }
 
 SysfsSetup scan_sysfs(const std::string& sysfs_root) {
   const fs::path root(sysfs_root);
   SysfsSetup out{.devices_dir = (root / "bus" / "hid" / "devices").string(),
+                 .bluetooth_dir = (root / "class" / "bluetooth").string(),
+                 .adapters = {},
                  .ignore_special_drivers = read_flag((root / "module" / "hid" / "parameters" / "ignore_special_drivers").string()),
                  .remotes = {}};
+  // class/bluetooth holds the adapters (hciN) and their links (hciN:HANDLE); an adapter's rfkill switch is its child.
+  if (const Result<std::vector<std::string>> names = list_directory(out.bluetooth_dir); names)
+    for (const std::string& name : *names) {
+      if (name.rfind("hci", 0) != 0 || name.find(':') != std::string::npos) continue;
+      BluetoothAdapter a{.name = name, .blocked = false};
+      const fs::path dir = fs::path(out.bluetooth_dir) / name;
+      if (const Result<std::vector<std::string>> children = list_directory(dir.string()); children)
+        for (const std::string& child : *children)
+          if (child.rfind("rfkill", 0) == 0)
+            a.blocked = a.blocked || read_flag((dir / child / "soft").string()) == true ||
+                        read_flag((dir / child / "hard").string()) == true;
+      out.adapters.push_back(std::move(a));
+    }
   const Result<std::vector<std::string>> names = list_directory(out.devices_dir);
   if (!names) return out;
   for (const std::string& hid_id : *names) {

@@ -12,7 +12,9 @@ namespace fire::wiimote {
 // The udev rule FIRE ships, and the command that installs it, from the source tree's root.
 inline constexpr const char* kUdevRule = "platform/wiimote/99-fire-wiimote.rules";
 std::string udev_install_command();
-// For a device the user may not open.
+// Whether the user may not open `path` for reading and writing (EACCES; root always may).
+bool permission_denied(const std::string& path);
+// For a device the user may not open: the udev rule, and the group for a login other than the seat's.
 std::string permission_advice(const std::string& path);
 
 struct KernelBinding {
@@ -47,13 +49,21 @@ struct SysfsRemote {
   std::string message;  // names the device and, unless it is ready or not a remote, the missing step and its commands
 };
 
+struct BluetoothAdapter {
+  std::string name;      // hci0
+  bool blocked = false;  // rfkill blocks it (soft or hard): switched off
+};
+
 struct SysfsSetup {
   std::string devices_dir;                      // <root>/bus/hid/devices, for messages
+  std::string bluetooth_dir;                    // <root>/class/bluetooth, for messages
+  std::vector<BluetoothAdapter> adapters;       // by name; none: no adapter, or the bluetooth module is not loaded
   std::optional<bool> ignore_special_drivers;   // nullopt: absent or unreadable (only root may read it)
   std::vector<SysfsRemote> remotes;             // every device with a Wii Remote's ids, by hid id
 };
 
-// Reads <sysfs_root>/bus/hid/devices and <sysfs_root>/module/hid/parameters/ignore_special_drivers.
+// Reads <sysfs_root>/bus/hid/devices, <sysfs_root>/module/hid/parameters/ignore_special_drivers and the
+// adapters in <sysfs_root>/class/bluetooth with their rfkill switches.
 SysfsSetup scan_sysfs(const std::string& sysfs_root = "/sys");
 
 }  // namespace fire::wiimote

@@ -56,7 +56,7 @@ TEST_CASE("roles by address come from the rig file, which the rig reader still a
   CHECK_FALSE(remotes_from_rig_json("[1]", "r").ok());
 }
 
-TEST_CASE("fire devices' listing: none, a ready one with its battery, one that cannot be opened") {
+TEST_CASE("fire devices' table: none, a ready one with its battery, one that cannot be opened") {
   // The listing waits in real time, as it does for hidapi; so the remotes' radio latency runs on it too.
   FakeBus bus(system_clock());
   SECTION("none") {
@@ -65,7 +65,7 @@ TEST_CASE("fire devices' listing: none, a ready one with its battery, one that c
     REQUIRE(listing.ok());
     CHECK(listing->remotes.empty());
     CHECK(listing->others.size() == 1);
-    CHECK_THAT(format_listing(*listing), Catch::StartsWith("no Wii Remote found"));
+    CHECK(format_listing(*listing).empty());
   }
   SECTION("some") {
     bus.add_remote({.address = "00:1F:32:AA:BB:02", .product = kProductRemotePlus, .rate_hz = 100, .phase_ns = 0, .battery = 0x64});
@@ -84,9 +84,11 @@ TEST_CASE("fire devices' listing: none, a ready one with its battery, one that c
     REQUIRE(ready.status);
     CHECK(battery_percent(*ready.status) == 50);
     const std::string text = format_listing(*listing);
-    CHECK_THAT(text, Catch::Contains("00:1F:32:AA:BB:02  camera1   ready        50 %     0330"));
-    CHECK_THAT(text, Catch::Contains("00:1F:32:AA:BB:01: fake:00:1F:32:AA:BB:01: permission denied on /dev/hidraw3"));
-    CHECK_THAT(text, Catch::Contains("sudo install -m 644 platform/wiimote/99-fire-wiimote.rules /etc/udev/rules.d/"));
+    CHECK_THAT(text, Catch::StartsWith("address            role      state        battery  product   path\n"
+                                       "00:1F:32:AA:BB:01  camera0   cannot open  -        0306      fake:00:1F:32:AA:BB:01\n"
+                                       "00:1F:32:AA:BB:02  camera1   ready        50 %     0330"));
+    CHECK_THAT(denied.problem, Catch::Contains("fake:00:1F:32:AA:BB:01: permission denied on /dev/hidraw3"));
+    CHECK_THAT(denied.problem, Catch::Contains("sudo install -m 644 platform/wiimote/99-fire-wiimote.rules /etc/udev/rules.d/"));
   }
 }
 
@@ -157,6 +159,17 @@ struct FakeSysfs {
     if (!driver.empty()) fs::create_directory_symlink(root / "bus/hid/drivers" / driver, dev / "driver");
     if (!hidraw.empty()) fs::create_directories(dev / "hidraw" / hidraw);
   }
+  // An adapter as class/bluetooth links it, with its rfkill switch ("0" or "1"), and one of its links.
+  void adapter(const std::string& name, const std::string& soft, const std::string& hard) const {
+    const fs::path dev = root / "devices/pci0000:00/usb1/1-1/1-1:1.0/bluetooth" / name;
+    fs::create_directories(dev / "rfkill3");
+    fs::create_directories(dev / (name + ":11"));
+    fs::create_directories(root / "class/bluetooth");
+    fs::create_directory_symlink(dev, root / "class/bluetooth" / name);
+    fs::create_directory_symlink(dev / (name + ":11"), root / "class/bluetooth" / (name + ":11"));
+    REQUIRE(write_file_atomic((dev / "rfkill3/soft").string(), soft + "\n"));
+    REQUIRE(write_file_atomic((dev / "rfkill3/hard").string(), hard + "\n"));
+  }
   void parameter(const std::string& value) const {
     fs::create_directories(root / "module/hid/parameters");
     REQUIRE(write_file_atomic((root / "module/hid/parameters/ignore_special_drivers").string(), value + "\n"));
@@ -212,6 +225,7 @@ TEST_CASE("sysfs says, for each Wii Remote, which step stands between it and FIR
     CHECK_THAT(r.message, Catch::StartsWith("0005:057E:0306.0003 (00:1F:32:AA:BB:01): held by the kernel's hid-wiimote driver"));
     CHECK_THAT(r.message, Catch::Contains(std::string("1. set hid.ignore_special_drivers: ") + kSetParameter));
     CHECK_THAT(r.message, Catch::Contains(std::string("2. ") + kUnbindWiimote + "; " + kBindGeneric));
+    CHECK_THAT(r.message, Catch::EndsWith(" (docs/hardware.md section 6; details: docs/wiimote.md section 2)"));
   }
   SECTION("held by hid-wiimote, special drivers ignored: it was bound first, so only rebind or reconnect") {
     sys.parameter("1");
@@ -279,4 +293,20 @@ TEST_CASE("hid's ignore_special_drivers reads as the kernel writes it, and as a 
   CHECK_FALSE(scan_sysfs(sys.root.string()).ignore_special_drivers.has_value());
   CHECK_FALSE(scan_sysfs((sys.root / "nowhere").string()).ignore_special_drivers.has_value());
   CHECK(scan_sysfs((sys.root / "nowhere").string()).remotes.empty());
+}
+
+TEST_CASE("the Bluetooth adapters in class/bluetooth, switched off when rfkill blocks them, and not their links") {
+  FakeSysfs sys;
+  CHECK(scan_sysfs(sys.root.string()).adapters.empty());
+  sys.adapter("hci0", "1", "0");
+  sys.adapter("hci1", "0", "0");
+  sys.adapter("hci2", "0", "1");
+  const SysfsSetup setup = scan_sysfs(sys.root.string());
+  CHECK(setup.bluetooth_dir == (sys.root / "class/bluetooth").string());
+  REQUIRE(setup.adapters.size() == 3);
+  CHECK(setup.adapters[0].name == "hci0");
+  CHECK(setup.adapters[0].blocked);
+  CHECK(setup.adapters[1].name == "hci1");
+  CHECK_FALSE(setup.adapters[1].blocked);
+  CHECK(setup.adapters[2].blocked);
 }
