@@ -285,7 +285,15 @@ class FaceBySide {
     if (!h.found() || h.distance <= radius_ || m_.is_loose_edge(h.edge)) return kUntold;
     const std::span<const Vec3> line = m_.polyline(h.edge);
     if (h.point == 0 || h.point + 1 == line.size()) return kUntold;
-    const Vec3 tangent = line[h.point + 1] - line[h.point - 1];
+    // The curve's direction over a chord of a third of the snap radius (3 mm for a tracked pen, a few times its
+    // error): where the pen rested, at a curve's ends, neighbouring samples lie a fraction of a millimetre apart
+    // in any direction.
+    size_t before = h.point - 1, after = h.point + 1;
+    while ((line[after] - line[before]).norm() < radius_ / 3 && (before > 0 || after + 1 < line.size())) {
+      if (before > 0) --before;
+      if (after + 1 < line.size()) ++after;
+    }
+    const Vec3 tangent = line[after] - line[before];
     Vec3 normal = Vec3::Zero();
     for (uint32_t f : m_.edges.face[h.edge])
       if (f != kNone) normal += slab(f).normal;
