@@ -40,7 +40,7 @@ rig() {
 run() {
   local name="$1" want="$2" rc=0
   shift 2
-  $as_user "$fire" devices --sys-root "$PWD/$name" "$@" >"$name.out" 2>"$name.err" || rc=$?
+  $as_user "$bin" devices --sys-root "$PWD/$name" "$@" >"$name.out" 2>"$name.err" || rc=$?
   [ "$rc" = "$want" ] || fail "$name: exit $rc, expected $want: $(cat "$name.out" "$name.err")"
 }
 expect() { grep -qF -- "$2" "$1.out" || fail "$1: no \"$2\" in: $(cat "$1.out")"; }
@@ -57,9 +57,9 @@ in_order() {
     last=$n
   done
 }
-# Root may open any node, so a permission test runs as nobody when this runs as root.
+# Every case but the permission ones runs as whoever runs this; root may open any node, so those run as nobody (below).
 as_user=""
-if [ "$(id -u)" = 0 ]; then as_user="setpriv --reuid=nobody --regid=nogroup --clear-groups"; fi
+bin="$fire"
 
 id=0005:057E:0306.0003
 set_it="echo 1 | sudo tee /sys/module/hid/parameters/ignore_special_drivers"
@@ -148,6 +148,17 @@ run three 0
 expect three "3 Wii Remotes and no rig file, so the roles go by address order: 00:1F:32:AA:BB:01 camera0, 00:1F:32:AA:BB:02 camera1, 00:1F:32:AA:BB:03 pad: switch the pad off while you aim and calibrate"
 
 # --dev-root: a node the user may not open is named with the udev rule and the group, and the remote cannot be used.
+# Run as root, these cases run as nobody, from a folder and a copy of the binary that nobody can reach wherever
+# the checkout lies (a clone under /root, or in a folder of mode 700, is out of nobody's reach).
+if [ "$(id -u)" = 0 ]; then
+  stage=$(mktemp -d /tmp/fire_devices_sysfs.XXXXXX)
+  trap 'rm -rf "$stage"' EXIT
+  chmod 755 "$stage"
+  cp "$fire" "$stage/fire"
+  cd "$stage"
+  as_user="setpriv --reuid=nobody --regid=nogroup --clear-groups"
+  bin="$stage/fire"
+fi
 sysfs denied Y
 device denied $id "Nintendo RVL-CNT-01" 00:1f:32:aa:bb:01 hid-generic hidraw5
 device denied 0005:057E:0306.0004 "Nintendo RVL-CNT-01" 00:1f:32:aa:bb:02 hid-generic hidraw6
