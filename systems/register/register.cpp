@@ -1,6 +1,7 @@
 #include "systems/register/register.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -28,12 +29,16 @@ void touch_mark(const InputEvent& e, RegistrationState& s, std::vector<Rejection
     return;
   }
   mean /= double(n);
-  double spread = 0;
+  // RMS, not the farthest sample: a resting pen far from both cameras flickers in depth between two levels
+  // a pixel's step apart, and its mean is still where it rests; a pen that slides or wobbles spreads wider.
+  double squared = 0;
   for (const auto& [t, p] : s.recent)
-    if (t > e.t_us - kRestWindowUs && t <= e.t_us) spread = std::max(spread, (p - mean).norm());
+    if (t > e.t_us - kRestWindowUs && t <= e.t_us) squared += (p - mean).squaredNorm();
+  const double spread = std::sqrt(squared / double(n));
   if (spread > kRestSpread) {
-    rejections.push_back({e.t_us, e.line, what + "the pen moved " + format_mm(spread) + " from its mean while resting on the mark (at most " +
-                                              format_mm(kRestSpread) + "); hold it still"});
+    rejections.push_back({e.t_us, e.line, what + "the pen's samples spread " + format_mm(spread) +
+                                              " (rms) about their mean while resting on the mark (at most " + format_mm(kRestSpread) +
+                                              "); hold it still"});
     return;
   }
   // A mark touched again replaces its earlier touch.
@@ -120,10 +125,19 @@ void take(const InputEvent& e, bool tracked, RegistrationState& s, std::vector<I
     rejections.push_back({e.t_us, e.line, std::string(e.command == CommandKind::Mark ? "mark" : "register") +
                                             ": registration needs a tracked pen (a log of device reports, replayed with --rig)"});
   } else if (registering) {
-    if (e.command == CommandKind::Mark)
+    if (e.command == CommandKind::Mark) {
       touch_mark(e, s, rejections);
-    else
+      // The pen rests on a mark: what it drew since it went down, and draws until it lifts, is a touch. A pen
+      // far from both cameras flickers in depth by more than kTouchRadius even at rest, so part of it may have
+      // gone to the sketch system already, which the command tells to drop.
+      if (s.stroke_open) {
+        if (s.stroke_released) out.push_back(e);
+        s.stroke_released = false;
+        s.held.clear();
+      }
+    } else {
       register_marks(e, s, rejections);
+    }
   } else if (e.kind == EventKind::Hid || e.kind == EventKind::Truth || e.kind == EventKind::Meta) {
     // the triangulation system's, or not for replay
   } else if (!tracked || e.kind == EventKind::Command) {
@@ -137,6 +151,7 @@ void take(const InputEvent& e, bool tracked, RegistrationState& s, std::vector<I
       out.back().p = mapped(s, e.p);
       return;
     }
+    if (s.held.empty()) return;  // after a mark touched
     const bool left = s.held.size() >= 2 && (e.p - s.held[1].p).norm() > kTouchRadius;  // held[0] is the Down
     s.held.push_back(e);
     if (left) release(s, out);
@@ -146,7 +161,7 @@ void take(const InputEvent& e, bool tracked, RegistrationState& s, std::vector<I
     s.held.assign(1, e);
   } else {  // Up
     if (s.stroke_open && !s.stroke_released)
-      ++s.touches_dropped;  // the pen never left its first sample's neighbourhood: a touch, not a curve
+      ++s.touches_dropped;  // the pen rested on a mark, or never left its first sample's neighbourhood
     else
       out.push_back(e);
     s.stroke_open = s.stroke_released = false;
@@ -169,8 +184,8 @@ std::vector<std::string> describe_registration(const RegistrationState& s) {
     out.push_back("registration " + std::to_string(k + 1) + " (line " + std::to_string(s.done[k].line) + "): " +
                   std::to_string(s.done[k].marks) + " marks, residual " + format_mm(s.done[k].residual));
   if (s.touches_dropped)
-    out.push_back(std::to_string(s.touches_dropped) + " touch(es) of the pen that never moved " + format_mm(kTouchRadius) +
-                  " from where it started: not drawn");
+    out.push_back(std::to_string(s.touches_dropped) + " touch(es) of the pen, on a mark or never " + format_mm(kTouchRadius) +
+                  " from where it went down: not drawn");
   if (!s.touched.empty())
     out.push_back(std::to_string(s.touched.size()) + " mark(s) touched after the last registration, not registered");
   return out;

@@ -3,6 +3,7 @@
 // frame's pen events and the registration commands (engine/INPUT_LOG.md):
 //   cmd mark N X Y Z  the pen tip rests on mark N of the object, at (X, Y, Z) in the object's frame: the pen's
 //                     position is the mean of its samples over the last kRestWindowUs, which must hold still
+//                     (their RMS distance from it at most kRestSpread)
 //   cmd register      the rigid transform from the marks touched since the last registration (Umeyama,
 //                     tracking::register_rigid); from then on every pen sample is mapped into the object's frame
 // A registration that cannot be made (fewer than 3 marks, collinear marks, a residual over kMaxResidual) is
@@ -10,7 +11,8 @@
 // later registration (the object turned) replaces the transform, and curves already drawn stay where they
 // are. Before the first registration samples pass unchanged.
 // A touch is not a curve: a stroke is held back until the pen leaves kTouchRadius around its first sample, and
-// one that never does (the pen resting on a mark) is dropped.
+// one that never does (the pen resting on a mark) is dropped. So is one during which a mark is touched: what
+// was released of it is dropped by the sketch system on the mark command, which it is passed for that.
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -24,7 +26,7 @@
 namespace fire {
 
 inline constexpr int64_t kRestWindowUs = 500'000;  // the pen rests at least this long on a mark
-inline constexpr double kRestSpread = 0.002;       // metres: a resting pen's samples stay this close to their mean
+inline constexpr double kRestSpread = 0.002;       // metres: a resting pen's samples' RMS distance from their mean
 inline constexpr size_t kRestSamples = 10;         // fewer in the window: the pen was not seen on the mark
 inline constexpr double kMaxResidual = 0.005;      // metres: more means a mark touched in the wrong place
 inline constexpr double kTouchRadius = 0.003;      // metres: a stroke that stays this close to its start is a touch
@@ -46,6 +48,7 @@ struct RegistrationState {
   std::vector<MarkTouch> touched;                     // since the last registration, one per mark (the latest touch)
   std::vector<std::pair<int64_t, Vec3>> recent;       // the pen's samples (instant, rig frame) of the last kRestWindowUs
   // The stroke being drawn: held back (its Down and samples, rig frame) until the pen leaves the touch radius.
+  // Open, not released and nothing held: a mark was touched, and the pen's samples until it lifts are not drawn.
   bool stroke_open = false, stroke_released = false;
   std::vector<InputEvent> held;
   std::vector<Registration> done;  // every registration made, in order
@@ -56,7 +59,8 @@ struct RegistrationState {
 };
 
 // Writes to `object_events` (cleared first) what the person did in the frame, for the sketch system: the pen's
-// events, in the object's frame, and the commands other than mark and register, which it takes. The frame's
+// events, in the object's frame, and the commands other than mark and register, which it takes (a mark
+// touched during a stroke part of which was released is passed on: the sketch system drops that stroke). The frame's
 // events are read first, then the pen's events the triangulation system made of them (`pen_events`, empty
 // without a rig). `tracked`: the pen comes from the rig (device reports); without it the pen is in the
 // model's frame already, the events pass unchanged and mark and register are rejected. A rejected command is

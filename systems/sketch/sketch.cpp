@@ -813,7 +813,14 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
       }
       case EventKind::Command: {
         EditRequest r{RequestKind::Edit, {}, ev.t_us, ev.line};
-        if (ev.command == CommandKind::Mark || ev.command == CommandKind::Register) break;  // the registration system's
+        if (ev.command == CommandKind::Mark) {
+          // The registration system's: the pen was resting on a mark, and what it drew since it went down was a
+          // touch of it (a pen far from the cameras flickers in depth), not a stroke.
+          state.pen_down = false;
+          state.stroke.clear();
+          break;
+        }
+        if (ev.command == CommandKind::Register) break;  // the registration system's
         if (ev.command == CommandKind::Undo) r.kind = RequestKind::Undo;
         else if (ev.command == CommandKind::Redo) r.kind = RequestKind::Redo;
         else if (ev.command == CommandKind::Close) {
