@@ -29,6 +29,9 @@ constexpr double kFirstSearchUs = 50'000;    // the first estimate looks this fa
 constexpr double kNextSearchUs = 10'000;     // ... later ones this far either side of the value in use
 
 constexpr double kJumpGate_m = 0.02;      // pen positions this far apart are different things
+// A stroke's first fit and one with a light that only appears in camera 1's next frame, farther apart than a
+// pixel's step in depth (the pen far from both cameras), are two things: the pen and a reflection.
+constexpr double kStartAgree_m = 0.004;
 constexpr double kMaxPenSpeed_m_s = 5.0;  // a hand moves the pen no faster
 constexpr double kBridgeSpeed_m_s = 1.0;  // a drawing hand, while both cameras lose the pen, moves it no faster
 constexpr double kSpeedUp_m_s = 1.0;      // a hand speeds the pen up by no more than this from one frame to the next
@@ -347,7 +350,7 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
     }
     // A light that appears in camera 1's later frame is not interpolated yet; the pen put down between
     // the two frames is one, and then the reflection level with it is all camera 1 offers, and fits
-    // centimetres off. Such a light that fits elsewhere makes the start wait for the next frame.
+    // millimetres to centimetres off. Such a light that fits elsewhere makes the start wait for the next frame.
     if (best >= 0 && ip.frame + 1 < f1.size()) {
       const size_t later = ip.frame + 1;
       for (int b = 0; b < f1.blob_count[later] && best >= 0; ++b) {
@@ -355,7 +358,7 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
         for (int i = 0; i < f0.blob_count[k] && best >= 0; ++i) {
           const tracking::Triangulation tri = tracking::triangulate(rig.cam0, rig.cam1, f0.blobs[k][i], f1.blobs[later][b],
                                                                     options.method, options.max_reprojection_px);
-          if (tri.accepted && (tri.X - fits[best].X).norm() > kJumpGate_m) best = -1;
+          if (tri.accepted && (tri.X - fits[best].X).norm() > kStartAgree_m) best = -1;
         }
       }
     }
