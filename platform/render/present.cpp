@@ -93,6 +93,7 @@ Status Presenter::create_swapchain(uint32_t width, uint32_t height) {
   extent_ = extent;
   if (extent.width == 0 || extent.height == 0) return Status::success();  // minimised: no swapchain until restored
   can_capture_ = caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+  takes_copies_ = caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_DST_BIT;
 
   uint32_t min_images = std::max(caps.minImageCount + 1, 2u);  // one to draw while one is shown
   if (caps.maxImageCount) min_images = std::min(min_images, caps.maxImageCount);
@@ -103,7 +104,8 @@ Status Presenter::create_swapchain(uint32_t width, uint32_t height) {
   info.imageColorSpace = format_.colorSpace;
   info.imageExtent = extent;
   info.imageArrayLayers = 1;
-  info.imageUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | (can_capture_ ? VK_IMAGE_USAGE_TRANSFER_SRC_BIT : 0);
+  info.imageUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | (can_capture_ ? VK_IMAGE_USAGE_TRANSFER_SRC_BIT : 0) |
+                    (takes_copies_ ? VK_IMAGE_USAGE_TRANSFER_DST_BIT : 0);
   info.imageSharingMode = VK_SHARING_MODE_EXCLUSIVE;
   info.preTransform = caps.currentTransform;
   info.compositeAlpha = VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR;
@@ -243,9 +245,9 @@ Result<Presented> Presenter::frame(Renderer& renderer, const Camera& camera, con
   if (VkResult r = vkBeginCommandBuffer(cmd, &begin); r != VK_SUCCESS) return fail("vkBeginCommandBuffer", r);
 
   const VkImage image = images_[index];
-  // Drawn straight into the swapchain image: the acquire semaphore's wait (at the submit, before colour
-  // output) orders this after the presentation engine's read.
-  renderer.record(cmd, camera, options, image, views_[index]);
+  // Drawn straight into the swapchain image, or a still frame's layer copied into it: the acquire semaphore's
+  // wait (at the submit, before colour output and copies) orders this after the presentation engine's read.
+  renderer.record(cmd, camera, options, image, views_[index], takes_copies_);
 
   VkRenderPassBeginInfo pass{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
   pass.renderPass = overlay_pass_;
@@ -260,7 +262,7 @@ Result<Presented> Presenter::frame(Renderer& renderer, const Camera& camera, con
 
   VkSemaphoreSubmitInfo wait_acquire{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
   wait_acquire.semaphore = acquired_;
-  wait_acquire.stageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+  wait_acquire.stageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_2_COPY_BIT;
   VkSemaphoreSubmitInfo signal_rendered{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
   signal_rendered.semaphore = rendered_[index];
   signal_rendered.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;

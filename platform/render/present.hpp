@@ -62,6 +62,7 @@ class Presenter {
   VkSwapchainKHR swapchain_ = VK_NULL_HANDLE;
   VkExtent2D extent_{0, 0};
   bool can_capture_ = false;  // the swapchain images can be a transfer source
+  bool takes_copies_ = false;  // ... and destination (a still frame's layer is copied into them)
   std::vector<VkImage> images_;
   std::vector<VkImageView> views_;
   std::vector<VkFramebuffer> framebuffers_;

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <tuple>
 #include <unordered_map>
 
 #include "platform/render/barriers.hpp"
@@ -99,13 +100,16 @@ Status Renderer::init() {
 }
 
 Status Renderer::create_targets() {
-  if (samples_ != VK_SAMPLE_COUNT_1_BIT)
-    FIRE_TRY(create_target(color_, color_format_, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSIENT_ATTACHMENT_BIT,
-                           samples_, VK_IMAGE_ASPECT_COLOR_BIT));
-  FIRE_TRY(create_target(resolve_, color_format_, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                         VK_SAMPLE_COUNT_1_BIT, VK_IMAGE_ASPECT_COLOR_BIT));
-  FIRE_TRY(create_target(depth_, depth_format_, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, samples_,
-                         VK_IMAGE_ASPECT_DEPTH_BIT));
+  // The frame's targets take the still frame's layer by copy (record()).
+  constexpr VkImageUsageFlags color = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT, depth = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
+  constexpr VkImageUsageFlags from = VK_IMAGE_USAGE_TRANSFER_SRC_BIT, into = VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+  if (samples_ != VK_SAMPLE_COUNT_1_BIT) FIRE_TRY(create_target(color_, color_format_, color | into, samples_, VK_IMAGE_ASPECT_COLOR_BIT));
+  FIRE_TRY(create_target(resolve_, color_format_, color | from | into, VK_SAMPLE_COUNT_1_BIT, VK_IMAGE_ASPECT_COLOR_BIT));
+  FIRE_TRY(create_target(depth_, depth_format_, depth | into, samples_, VK_IMAGE_ASPECT_DEPTH_BIT));
+  FIRE_TRY(create_target(layer_color_, color_format_, color | from, samples_, VK_IMAGE_ASPECT_COLOR_BIT));
+  FIRE_TRY(create_target(layer_depth_, depth_format_, depth | from, samples_, VK_IMAGE_ASPECT_DEPTH_BIT));
+  last_key_.reset();
+  layer_ready_ = false;
   bool grown = false;
   return reserve(readback_, VkDeviceSize(settings_.width) * settings_.height * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, grown);
 }
@@ -114,7 +118,7 @@ Status Renderer::resize(uint32_t width, uint32_t height) {
   if (width == 0 || height == 0 || width > 8192 || height > 8192)
     return Status::failure("image size must be 1 to 8192 pixels a side");
   FIRE_VK_TRY(vkDeviceWaitIdle(context_.device()));  // the old targets may still be in use
-  for (Target* t : {&color_, &resolve_, &depth_}) destroy(*t);
+  for (Target* t : {&color_, &resolve_, &depth_, &layer_color_, &layer_depth_}) destroy(*t);
   destroy(readback_);
   settings_.width = width;
   settings_.height = height;
@@ -185,7 +189,7 @@ Renderer::~Renderer() {
   for (Buffer* b : {&readback_, &points_, &vertices_, &surface_vertices_, &surface_indices_, &reference_vertices_,
                     &reference_indices_, &stroke_, &pen_, &marks_})
     destroy(*b);
-  for (Target* t : {&color_, &resolve_, &depth_}) destroy(*t);
+  for (Target* t : {&color_, &resolve_, &depth_, &layer_color_, &layer_depth_}) destroy(*t);
   for (VkPipeline p : {surface_, reference_pipeline_, curves_, markers_, wireframe_, pen_face_})
     if (p) vkDestroyPipeline(device, p, nullptr);
   if (layout_) vkDestroyPipelineLayout(device, layout_, nullptr);
@@ -321,10 +325,15 @@ void Renderer::copy_into(Buffer& buffer, VkDeviceSize offset, const void* data, 
 
 Status Renderer::upload(const Mesh& network, const SurfaceLevels& surface) {
   stats_ = {};
+  // What the still frame's layer draws from, besides the buffers' bytes.
+  const auto drawn = std::tuple(curve_draws_, pending_draws_, marker_draws_, surface_draws_, surface_settled_);
   FIRE_TRY(upload_points(network));
   FIRE_TRY(upload_vertices(network));
   network_frame_ = network.frame();
-  return upload_surface(surface);
+  FIRE_TRY(upload_surface(surface));
+  if (stats_.bytes || drawn != std::tuple(curve_draws_, pending_draws_, marker_draws_, surface_draws_, surface_settled_))
+    ++scene_version_;
+  return Status::success();
 }
 
 Status Renderer::upload_points(const Mesh& network) {
@@ -609,6 +618,7 @@ Status Renderer::set_pen_feedback(const Mesh& network, const PenFeedback& feedba
 }
 
 Status Renderer::set_reference(std::span<const Vec3> positions, std::span<const uint32_t> triangles) {
+  ++scene_version_;
   reference_index_count_ = 0;
   if (triangles.empty()) return Status::success();
   // Area-weighted vertex normals; the shader lights both sides, so orientation does not matter.
@@ -635,48 +645,82 @@ Status Renderer::set_reference(std::span<const Vec3> positions, std::span<const 
   return Status::success();
 }
 
-void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options, VkImage target,
-                      VkImageView target_view) {
-  // Every target starts undefined: the frame clears or overwrites all of it.
-  auto to_attachment = [](VkImage image, VkImageLayout layout, VkImageAspectFlags aspect, VkPipelineStageFlags2 stage,
-                          VkAccessFlags2 access) {
-    // The source is the previous frame's copy or depth use.
-    return image_barrier(image, aspect, VK_IMAGE_LAYOUT_UNDEFINED, layout, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0, stage,
-                         access);
-  };
-  std::vector<VkImageMemoryBarrier2> barriers;
-  const VkPipelineStageFlags2 color_stage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-  const VkAccessFlags2 color_access = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT;
-  barriers.push_back(to_attachment(target, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_ASPECT_COLOR_BIT,
-                                   color_stage, color_access));
-  if (color_.image)
-    barriers.push_back(to_attachment(color_.image, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_ASPECT_COLOR_BIT,
-                                     color_stage, color_access));
-  barriers.push_back(to_attachment(depth_.image, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_ASPECT_DEPTH_BIT,
-                                   VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                                   VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT));
+namespace {
+
+// Every draw's push constants start from the camera's; line and marker sizes follow the image height so a small
+// test image looks like a large one scaled down.
+PushConstants camera_constants(const Camera& camera, uint32_t width, uint32_t height) {
+  PushConstants pc{};
+  pc.view_proj = camera.view_projection();
+  pc.eye = glm::vec4(camera.eye, 1.0f);
+  pc.params = {0.0f, float(width), float(height), 0.0f};
+  pc.light = glm::vec4(camera.key_light, 0.0f);
+  return pc;
+}
+
+// One pass's draws: each binds its pipeline with the push constants as they are then.
+struct Pass {
+  VkCommandBuffer cmd;
+  VkPipelineLayout layout;
+  PushConstants pc;
+  void push() const {
+    vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof pc, &pc);
+  }
+  // For `pipeline`'s draws: it, the push constants as they are now, and `vertices` from `offset` on.
+  void bind(VkPipeline pipeline, VkBuffer vertices, VkDeviceSize offset = 0) const {
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
+    push();
+    vkCmdBindVertexBuffers(cmd, 0, 1, &vertices, &offset);
+  }
+};
+
+constexpr VkPipelineStageFlags2 kColorStage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+constexpr VkAccessFlags2 kColorAccess = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT;
+constexpr VkPipelineStageFlags2 kDepthStage =
+    VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
+constexpr VkAccessFlags2 kDepthAccess =
+    VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+
+void record_barriers(VkCommandBuffer cmd, const std::vector<VkImageMemoryBarrier2>& barriers) {
   VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
   dependency.imageMemoryBarrierCount = uint32_t(barriers.size());
   dependency.pImageMemoryBarriers = barriers.data();
   vkCmdPipelineBarrier2(cmd, &dependency);
+}
 
+// An image whose content the frame clears or overwrites whole: from whatever the previous frame did with it.
+VkImageMemoryBarrier2 overwrite(VkImage image, VkImageLayout layout, VkImageAspectFlags aspect, VkPipelineStageFlags2 stage,
+                                VkAccessFlags2 access) {
+  return image_barrier(image, aspect, VK_IMAGE_LAYOUT_UNDEFINED, layout, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0, stage, access);
+}
+
+}  // namespace
+
+bool Renderer::LayerKey::operator==(const LayerKey& o) const {
+  return view_proj == o.view_proj && eye == o.eye && light == o.light && line_depth_pull == o.line_depth_pull &&
+         options.surface == o.options.surface && options.curves == o.options.curves &&
+         options.wireframe == o.options.wireframe && scene == o.scene;
+}
+
+void Renderer::begin_rendering(VkCommandBuffer cmd, VkImageView color_view, VkImageView resolve_view, VkImageView depth_view,
+                               bool clear, bool keep) {
   VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-  color.imageView = color_.image ? color_.view : target_view;
+  color.imageView = color_view;
   color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-  color.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;  // the background: a clear, no full-screen shading on lavapipe
+  color.loadOp = clear ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_LOAD;  // the background: a clear, no full-screen shading on lavapipe
   const glm::vec4 background = linear(Palette::background);
   color.clearValue.color = {{background.r, background.g, background.b, 1.0f}};
-  color.storeOp = color_.image ? VK_ATTACHMENT_STORE_OP_DONT_CARE : VK_ATTACHMENT_STORE_OP_STORE;
-  if (color_.image) {
+  color.storeOp = keep || !resolve_view ? VK_ATTACHMENT_STORE_OP_STORE : VK_ATTACHMENT_STORE_OP_DONT_CARE;
+  if (resolve_view) {
     color.resolveMode = VK_RESOLVE_MODE_AVERAGE_BIT;
-    color.resolveImageView = target_view;
+    color.resolveImageView = resolve_view;
     color.resolveImageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
   }
   VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-  depth.imageView = depth_.view;
+  depth.imageView = depth_view;
   depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
-  depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-  depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+  depth.loadOp = clear ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_LOAD;
+  depth.storeOp = keep ? VK_ATTACHMENT_STORE_OP_STORE : VK_ATTACHMENT_STORE_OP_DONT_CARE;
   depth.clearValue.depthStencil = {1.0f, 0};
   VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
   rendering.renderArea = {{0, 0}, {settings_.width, settings_.height}};
@@ -685,38 +729,25 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
   rendering.pColorAttachments = &color;
   rendering.pDepthAttachment = &depth;
   vkCmdBeginRendering(cmd, &rendering);
-
   VkViewport viewport{0.0f, 0.0f, float(settings_.width), float(settings_.height), 0.0f, 1.0f};
   VkRect2D scissor{{0, 0}, {settings_.width, settings_.height}};
   vkCmdSetViewport(cmd, 0, 1, &viewport);
   vkCmdSetScissor(cmd, 0, 1, &scissor);
+}
 
-  // Line and marker sizes follow the image height so a small test image looks like a large one scaled down.
+void Renderer::record_layer(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options) {
   const float scale = float(settings_.height) / 720.0f;
-  PushConstants pc{};
-  pc.view_proj = camera.view_projection();
-  pc.eye = glm::vec4(camera.eye, 1.0f);
-  pc.params = {0.0f, float(settings_.width), float(settings_.height), 0.0f};
-  pc.light = glm::vec4(camera.key_light, 0.0f);
-  auto push = [&] {
-    vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof pc, &pc);
-  };
-  // For `pipeline`'s draws: it, the push constants as they are now, and `vertices` from `offset` on.
-  auto bind = [&](VkPipeline pipeline, VkBuffer vertices, VkDeviceSize offset = 0) {
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
-    push();
-    vkCmdBindVertexBuffers(cmd, 0, 1, &vertices, &offset);
-  };
-
+  Pass pass{cmd, layout_, camera_constants(camera, settings_.width, settings_.height)};
+  PushConstants& pc = pass.pc;
   if (!surface_draws_.empty() && options.surface) {
     pc.color = linear(surface_settled_ ? Palette::surface : Palette::provisional_surface);
-    bind(surface_, surface_vertices_.buffer);
+    pass.bind(surface_, surface_vertices_.buffer);
     vkCmdBindIndexBuffer(cmd, surface_indices_.buffer, 0, VK_INDEX_TYPE_UINT32);
     for (const auto& [first, count] : surface_draws_) vkCmdDrawIndexed(cmd, count, 1, first, 0, 0);
   }
   if (!surface_draws_.empty() && options.wireframe && wireframe_) {
     pc.color = linear(Palette::wireframe);
-    bind(wireframe_, surface_vertices_.buffer);
+    pass.bind(wireframe_, surface_vertices_.buffer);
     vkCmdBindIndexBuffer(cmd, surface_indices_.buffer, 0, VK_INDEX_TYPE_UINT32);
     for (const auto& [first, count] : surface_draws_) vkCmdDrawIndexed(cmd, count, 1, first, 0, 0);
   }
@@ -724,39 +755,45 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
     pc.color = linear(Palette::curve);
     pc.params.x = std::max(1.0f, 1.6f * scale);
     pc.params.w = camera.line_depth_pull;
-    bind(curves_, points_.buffer);
+    pass.bind(curves_, points_.buffer);
     for (const auto& [first, count] : curve_draws_) vkCmdDraw(cmd, 6, count - 1, 0, first);
   }
   if (!pending_draws_.empty() && options.curves) {  // as the stroke being drawn: not yet a curve
     pc.color = linear(Palette::stroke);
     pc.params.x = std::max(1.0f, 2.0f * scale);
     pc.params.w = camera.line_depth_pull;
-    bind(curves_, points_.buffer);
+    pass.bind(curves_, points_.buffer);
     for (const auto& [first, count] : pending_draws_) vkCmdDraw(cmd, 6, count - 1, 0, first);
   }
   if (!marker_draws_.empty() && options.curves) {
     pc.color = linear(Palette::marker);
     pc.params.x = std::max(2.5f, 4.5f * scale);
     pc.params.w = camera.line_depth_pull * 2.0f;
-    bind(markers_, vertices_.buffer);
+    pass.bind(markers_, vertices_.buffer);
     for (const auto& [first, count] : marker_draws_) vkCmdDraw(cmd, 6, count, 0, first);
   }
   if (reference_index_count_) {
     pc.color = linear(Palette::reference, 0.35f);
-    bind(reference_pipeline_, reference_vertices_.buffer);
+    pass.bind(reference_pipeline_, reference_vertices_.buffer);
     vkCmdBindIndexBuffer(cmd, reference_indices_.buffer, 0, VK_INDEX_TYPE_UINT32);
     vkCmdDrawIndexed(cmd, reference_index_count_, 1, 0, 0, 0);
   }
+}
+
+void Renderer::record_overlays(VkCommandBuffer cmd, const Camera& camera) {
+  const float scale = float(settings_.height) / 720.0f;
+  Pass pass{cmd, layout_, camera_constants(camera, settings_.width, settings_.height)};
+  PushConstants& pc = pass.pc;
   if (pen_face_vertices_) {  // over the see-through reference, which would wash it out
     pc.color = linear(Palette::pen_face, Palette::pen_face_alpha);
-    bind(pen_face_, pen_.buffer);
+    pass.bind(pen_face_, pen_.buffer);
     vkCmdDraw(cmd, pen_face_vertices_, 1, 0, 0);
   }
   if (stroke_count_) {  // after the see-through reference, so the pen's trace shows in full
     pc.color = linear(Palette::stroke);
     pc.params.x = std::max(1.0f, 2.0f * scale);
     pc.params.w = camera.line_depth_pull * 2.0f;
-    bind(curves_, stroke_.buffer);
+    pass.bind(curves_, stroke_.buffer);
     vkCmdDraw(cmd, 6, stroke_count_ - 1, 0, 0);
   }
   if (!marks_copy_.empty()) {  // over the surface, so a mark under it still shows where to touch
@@ -764,12 +801,12 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
     pc.color = linear(Palette::mark);
     pc.params.x = std::max(3.0f, 6.0f * scale);
     pc.params.w = camera.line_depth_pull * 3.0f;
-    bind(markers_, marks_.buffer);
+    pass.bind(markers_, marks_.buffer);
     vkCmdDraw(cmd, 6, count, 0, 0);
     if (next_mark_ < count) {
       pc.color = linear(Palette::next_mark);
       pc.params.x = std::max(5.0f, 11.0f * scale);
-      push();
+      pass.push();
       vkCmdDraw(cmd, 6, 1, 0, uint32_t(next_mark_));
     }
   }
@@ -777,9 +814,80 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
     pc.color = linear(pen_closes_ ? Palette::close_border : Palette::snap_target);
     pc.params.x = std::max(4.0f, (pen_closes_ ? 10.0f : 7.5f) * scale);
     pc.params.w = camera.line_depth_pull * 3.0f;
-    bind(markers_, pen_.buffer, VkDeviceSize(2 * pen_face_vertices_) * sizeof(glm::vec3));
+    pass.bind(markers_, pen_.buffer, VkDeviceSize(2 * pen_face_vertices_) * sizeof(glm::vec3));
     vkCmdDraw(cmd, 6, 1, 0, 0);
   }
+}
+
+void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options, VkImage target,
+                      VkImageView target_view, bool target_takes_copies) {
+  const LayerKey key{camera.view_projection(), camera.eye, camera.key_light, camera.line_depth_pull, options, scene_version_};
+  const bool still = last_key_ && *last_key_ == key;
+  last_key_ = key;
+  const VkImage frame_color = color_.image ? color_.image : target;
+  const VkImageView frame_view = color_.image ? color_.view : target_view;
+  const VkImageView resolve_view = color_.image ? target_view : VK_NULL_HANDLE;
+  std::vector<VkImageMemoryBarrier2> barriers;
+  if (!still || !(color_.image || target_takes_copies)) {
+    // A frame unlike the one before: drawn whole into the frame's targets, as no layer would be used twice.
+    layer_ready_ = false;
+    layer_uses_ = 0;
+    barriers.push_back(overwrite(target, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_ASPECT_COLOR_BIT, kColorStage, kColorAccess));
+    if (color_.image)
+      barriers.push_back(overwrite(color_.image, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_ASPECT_COLOR_BIT, kColorStage, kColorAccess));
+    barriers.push_back(overwrite(depth_.image, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_ASPECT_DEPTH_BIT, kDepthStage, kDepthAccess));
+    record_barriers(cmd, barriers);
+    begin_rendering(cmd, frame_view, resolve_view, depth_.view, true, false);
+    record_layer(cmd, camera, options);
+    record_overlays(cmd, camera);
+    vkCmdEndRendering(cmd);
+    return;
+  }
+  // A still frame: the layer (everything but the pen's feedback, the stroke and the marks) is drawn once into
+  // images of its own, then copied into each frame, and only the rest is drawn over it.
+  if (!layer_ready_) {
+    barriers.push_back(overwrite(layer_color_.image, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_ASPECT_COLOR_BIT, kColorStage, kColorAccess));
+    barriers.push_back(overwrite(layer_depth_.image, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_ASPECT_DEPTH_BIT, kDepthStage, kDepthAccess));
+    record_barriers(cmd, barriers);
+    barriers.clear();
+    begin_rendering(cmd, layer_color_.view, VK_NULL_HANDLE, layer_depth_.view, true, true);
+    record_layer(cmd, camera, options);
+    vkCmdEndRendering(cmd);
+    barriers.push_back(image_barrier(layer_color_.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                                     VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, kColorStage, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                                     VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT));
+    barriers.push_back(image_barrier(layer_depth_.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                                     VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, kDepthStage, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                                     VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT));
+    layer_ready_ = true;
+  }
+  ++layer_uses_;
+  barriers.push_back(overwrite(frame_color, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_ASPECT_COLOR_BIT,
+                               VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT));
+  barriers.push_back(overwrite(depth_.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_ASPECT_DEPTH_BIT,
+                               VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT));
+  if (color_.image)
+    barriers.push_back(overwrite(target, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_ASPECT_COLOR_BIT, kColorStage, kColorAccess));
+  record_barriers(cmd, barriers);
+  barriers.clear();
+  auto copy = [&](VkImage from, VkImage to, VkImageAspectFlags aspect) {
+    VkImageCopy region{};
+    region.srcSubresource = {aspect, 0, 0, 1};
+    region.dstSubresource = {aspect, 0, 0, 1};
+    region.extent = {settings_.width, settings_.height, 1};
+    vkCmdCopyImage(cmd, from, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, to, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+  };
+  copy(layer_color_.image, frame_color, VK_IMAGE_ASPECT_COLOR_BIT);
+  copy(layer_depth_.image, depth_.image, VK_IMAGE_ASPECT_DEPTH_BIT);
+  barriers.push_back(image_barrier(frame_color, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                   VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
+                                   VK_ACCESS_2_TRANSFER_WRITE_BIT, kColorStage, kColorAccess));
+  barriers.push_back(image_barrier(depth_.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                   VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
+                                   VK_ACCESS_2_TRANSFER_WRITE_BIT, kDepthStage, kDepthAccess));
+  record_barriers(cmd, barriers);
+  begin_rendering(cmd, frame_view, resolve_view, depth_.view, false, false);
+  record_overlays(cmd, camera);
   vkCmdEndRendering(cmd);
 }
 
@@ -791,7 +899,7 @@ Status Renderer::draw(const Camera& camera, const DrawOptions& options) {
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   FIRE_VK_TRY(vkBeginCommandBuffer(cmd, &begin));
-  record(cmd, camera, options, resolve_.image, resolve_.view);
+  record(cmd, camera, options, resolve_.image, resolve_.view, true);
   record_readback(cmd, resolve_.image, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, {settings_.width, settings_.height},
                   readback_.buffer);
   FIRE_VK_TRY(vkEndCommandBuffer(cmd));

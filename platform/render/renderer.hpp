@@ -9,6 +9,8 @@
 // (engine/pen_feedback.hpp): the face under the pen tinted see-through over everything but the stroke, the snap target as a
 // large marker, and the border's first vertex as a larger one when a stroke ending at the pen would close it;
 // in a live session the object's registration marks, the one to touch next larger and red.
+// A frame the same as the one before but for the stroke, the pen's feedback and the marks (record()) copies
+// the rest from the layer it kept, so a still scene is rasterised once.
 //
 // Uploads copy only what changed and count the bytes (UploadStats, per upload() call, i.e. per frame):
 // - points: the GPU keeps a float copy of the point pool at the pool's indices. An edge's points are
@@ -27,6 +29,7 @@
 // buffers grow by half again, and are laid out afresh when freed blocks outnumber the used ones.
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -112,8 +115,15 @@ class Renderer {
   // The present path (present.hpp): records the frame into `cmd` without submitting it, drawn (or resolved)
   // straight into `target`, an image of color_format() and width() x height() (a swapchain image: no copy of
   // the frame on the way). `target` is left in COLOR_ATTACHMENT_OPTIMAL, written at COLOR_ATTACHMENT_OUTPUT.
+  // A still frame (the camera, the options and what upload() and set_reference() gave unchanged since the
+  // frame before) is not drawn again: the layer of everything but the stroke, the pen's feedback and the marks
+  // is drawn once into images of the renderer's own and copied into every frame after it, and only those are
+  // drawn over it, with the same pixels as a frame drawn whole. Without a multisampled target this needs
+  // `target_takes_copies` (TRANSFER_DST usage); else every frame is drawn whole.
   void record(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options, VkImage target,
-              VkImageView target_view);
+              VkImageView target_view, bool target_takes_copies);
+  // How many frames in a row were still frames, copied from the layer (0 after a frame drawn whole).
+  uint64_t layer_frames() const { return layer_uses_; }
   VkFormat color_format() const { return color_format_; }
   // New target size (a resized window); waits for the device first. Uploaded data is kept.
   Status resize(uint32_t width, uint32_t height);
@@ -146,6 +156,10 @@ class Renderer {
   void destroy(Buffer& buffer);
   void destroy(Target& target);
   Status create_pipelines();
+  void begin_rendering(VkCommandBuffer cmd, VkImageView color_view, VkImageView resolve_view, VkImageView depth_view,
+                       bool clear, bool keep);
+  void record_layer(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options);
+  void record_overlays(VkCommandBuffer cmd, const Camera& camera);
   void copy_into(Buffer& buffer, VkDeviceSize offset, const void* data, VkDeviceSize bytes);
   Status upload_points(const Mesh& network);
   Status upload_vertices(const Mesh& network);
@@ -161,6 +175,20 @@ class Renderer {
   VkFormat color_format_ = VK_FORMAT_R8G8B8A8_SRGB;
   VkFormat depth_format_ = VK_FORMAT_D32_SFLOAT;
   Target color_, resolve_, depth_;
+  // The still frame's layer, and what it was drawn for.
+  struct LayerKey {
+    glm::mat4 view_proj;
+    glm::vec3 eye, light;
+    float line_depth_pull;
+    DrawOptions options;
+    uint64_t scene;
+    bool operator==(const LayerKey& other) const;
+  };
+  Target layer_color_, layer_depth_;
+  std::optional<LayerKey> last_key_;  // the previous frame's
+  bool layer_ready_ = false;          // the layer images hold last_key_'s layer
+  uint64_t layer_uses_ = 0;
+  uint64_t scene_version_ = 0;        // moves whenever upload() or set_reference() changes what the layer shows
   Buffer readback_;
   VkCommandPool pool_ = VK_NULL_HANDLE;
   VkCommandBuffer commands_ = VK_NULL_HANDLE;

@@ -464,6 +464,78 @@ TEST_CASE("the pen's feedback: the face under the pen tinted, the snap target an
   CHECK_FALSE(near(pixel_at(draw(border, closing), a), Palette::close_border, 30));
 }
 
+TEST_CASE("a still frame is not drawn again: its layer is copied and the stroke drawn over it, with a whole frame's pixels",
+          "[render][still]") {
+  auto context = make_context();
+  auto renderer = Renderer::create(*context, {kWidth, kHeight});
+  REQUIRE(renderer);
+  Renderer& r = **renderer;
+  Scene scene = demo_scene();
+  const Camera camera = frame_box(box_of(scene), View::iso, kWidth, kHeight);
+  const Camera elsewhere = frame_box(box_of(scene), View::top, kWidth, kHeight);
+  const Mesh& net = scene.network;
+  uint32_t face = 0;
+  while (!net.face_alive(face)) ++face;
+  const uint32_t edge = edge_of(net.face_loop(face)[0]);
+  PenFeedback feedback;
+  feedback.pen_seen = true;
+  feedback.face = net.face_id(face);
+  feedback.target_edge = net.edge_id(edge);
+  feedback.target_point = net.edges.point_count[edge] / 2;
+  feedback.target = net.polyline(edge)[feedback.target_point];
+  const std::vector<Vec3> marks{net.vertices.position[net.edges.vertex[edge][0]]};
+  std::vector<Vec3> stroke{net.polyline(edge).begin(), net.polyline(edge).end()};
+  auto draw = [&](const Camera& c) {
+    REQUIRE(r.upload(scene.network, scene.surface));
+    REQUIRE(r.set_stroke(stroke));
+    REQUIRE(r.set_pen_feedback(scene.network, feedback));
+    REQUIRE(r.set_marks(marks, 0));
+    REQUIRE(r.draw(c));
+    CHECK(context->validation_message_count() == 0);
+    return r.image();
+  };
+  auto same = [](const Image& a, const Image& b) { return a.rgba == b.rgba; };
+
+  const Image whole = draw(camera);
+  CHECK(r.layer_frames() == 0);
+  const Image first_still = draw(camera);  // the layer drawn, then copied
+  CHECK(r.layer_frames() == 1);
+  const Image second_still = draw(camera);  // copied
+  CHECK(r.layer_frames() == 2);
+  CHECK(same(whole, first_still));
+  CHECK(same(whole, second_still));
+
+  // The stroke, the pen's feedback and the marks are drawn over the layer: a new stroke keeps the frame still.
+  stroke.resize(stroke.size() / 2);
+  feedback.target_point = 1;
+  feedback.target = net.polyline(edge)[1];
+  const Image shorter = draw(camera);
+  CHECK(r.layer_frames() == 3);
+  CHECK_FALSE(same(shorter, whole));
+  draw(elsewhere);
+  CHECK(r.layer_frames() == 0);
+  CHECK(same(draw(camera), shorter));  // drawn whole again: the still frame had its pixels
+  CHECK(r.layer_frames() == 0);
+
+  // What upload() changes is drawn whole: a settled surface turned provisional.
+  draw(camera);
+  CHECK(r.layer_frames() == 1);
+  scene.surface.settled = !scene.surface.settled;
+  const Image tinted = draw(camera);
+  CHECK(r.layer_frames() == 0);
+  CHECK_FALSE(same(tinted, shorter));
+  CHECK(same(draw(camera), tinted));
+  CHECK(r.layer_frames() == 1);
+  // So is a reference mesh shown: a triangle across the box's top, above the surface.
+  const Box box = box_of(scene);
+  const Vec3 lo(box.lo.x, box.lo.y, box.hi.z), hi(box.hi.x, box.hi.y, box.hi.z);
+  const std::vector<Vec3> triangle{lo, Vec3(hi.x(), lo.y(), hi.z()), hi};
+  REQUIRE(r.set_reference(triangle, std::vector<uint32_t>{0, 1, 2}));
+  const Image with_reference = draw(camera);
+  CHECK(r.layer_frames() == 0);
+  CHECK_FALSE(same(with_reference, tinted));
+}
+
 TEST_CASE("Vulkan failures name the call") {
   CHECK(vk_failure("vkCreateDevice(physical_, &device, nullptr, &device_)", VK_ERROR_DEVICE_LOST) ==
         "vkCreateDevice failed: VK_ERROR_DEVICE_LOST (-4)");
