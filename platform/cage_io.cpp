@@ -53,10 +53,11 @@ Status check_cage_path(const std::string& path) {
   return Status::failure(path + ": unknown cage format '" + ext + "' (the extension must be .obj or .usda)");
 }
 
-Result<std::string> encode_cage_obj(const Cage& cage, LengthUnit unit) {
+Result<std::string> encode_cage_obj(const Cage& cage, LengthUnit unit, std::string_view title) {
   if (Status s = check_cage(cage); !s) return Result<std::string>::failure(s.error);
   const double scale = units_per_metre(unit);
-  std::string out = "# FIRE subdivision cage: Catmull-Clark, " + std::to_string(cage.mesh.positions.size()) + " vertices, " +
+  std::string out = title.empty() ? std::string() : "# " + std::string(title) + "\n";
+  out += "# FIRE subdivision cage: Catmull-Clark, " + std::to_string(cage.mesh.positions.size()) + " vertices, " +
                     std::to_string(cage.mesh.face_count()) + " faces; OpenSubdiv's tags below (vertex indices from 0)\n" +
                     "# units: " + unit_name(unit) + ", up: +Z\n";
   for (const Vec3& p : cage.mesh.positions) {

@@ -18,7 +18,8 @@ inline constexpr double kInfiniteSharpness = 10.0;
 
 // From the extension: .obj or .usda; an error names the path and the two known.
 Status check_cage_path(const std::string& path);
-Result<std::string> encode_cage_obj(const Cage& cage, LengthUnit unit);
+// `title`, when given, is the file's first line (a comment saying what the cage is).
+Result<std::string> encode_cage_obj(const Cage& cage, LengthUnit unit, std::string_view title = {});
 Result<std::string> encode_cage_usda(const Cage& cage, LengthUnit unit);
 Status write_cage(const Cage& cage, const std::string& path, LengthUnit unit = kDefaultExportUnit);
 

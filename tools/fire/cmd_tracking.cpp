@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "engine/input_log.hpp"
+#include "platform/cage_io.hpp"
 #include "platform/files.hpp"
 #include "platform/obj.hpp"
 #include "platform/wiimote/device.hpp"
@@ -177,22 +178,6 @@ int run_simulate_sketch(const SimulateArgs& a) {
   return write_simulation("sketch", a, simulate_sketch(a.rig, sketch, mesh->view()));
 }
 
-// The crease tags go with it, so that fire eval measures against the same limit surface the person drew on.
-std::string obj_text(const std::vector<Vec3>& positions, const PolygonMesh& mesh, const SubdivisionTags& tags, const std::string& comment) {
-  std::string out = "# " + comment + "\n";
-  for (const Vec3& p : positions) out += "v " + format_double(p.x()) + ' ' + format_double(p.y()) + ' ' + format_double(p.z()) + '\n';
-  for (size_t f = 0; f < mesh.face_count(); ++f) {
-    out += 'f';
-    for (uint32_t v : mesh.face(f)) out += ' ' + std::to_string(v + 1);
-    out += '\n';
-  }
-  for (size_t i = 0; i + 1 < tags.sharp_edges.size(); i += 2)
-    out += "t crease 2/1/0 " + std::to_string(tags.sharp_edges[i]) + ' ' + std::to_string(tags.sharp_edges[i + 1]) + " 10\n";
-  for (uint32_t v = 0; v < tags.border_corners.size(); ++v)
-    if (tags.border_corners[v]) out += "t corner 1/1/0 " + std::to_string(v) + " 10\n";
-  return out;
-}
-
 int run_simulate_drawing(const SimulateArgs& a) {
   const std::string command = "simulate drawing";
   if (!output_chosen("drawing", a)) return 1;
@@ -220,11 +205,19 @@ int run_simulate_drawing(const SimulateArgs& a) {
   if (!drawing) return fail(command, mesh_path + ": " + drawing.error());
 
   const std::string marks = marks_to_json(drawing->marks);
-  const std::string object = obj_text(*placed, *mesh, *tags, options.mesh_name + " scaled to " + format_double(options.height_m) +
-                                                         " m along +z, its base's centre at the origin (metres, the object's frame)");
+  // The object as a cage, its crease tags with it, so that fire eval measures against the limit surface drawn on.
+  Cage placed_object;
+  placed_object.mesh = *mesh;
+  placed_object.mesh.positions = *placed;
+  placed_object.sharp_edges = tags->sharp_edges;
+  placed_object.border_corners = tags->border_corners;
+  const Result<std::string> object =
+      encode_cage_obj(placed_object, LengthUnit::m, options.mesh_name + " scaled to " + format_double(options.height_m) +
+                                                        " m along +z, its base's centre at the origin (metres, the object's frame)");
+  if (!object) return fail(command, mesh_path + ": " + object.error());
   // Nothing is written unless everything can be: the log last, so a log never comes without its marks.
   if (Status w = write_file_atomic(a.marks_path, marks); !w) return fail(command, w.error);
-  if (Status w = write_file_atomic(a.object_path, object); !w) return fail(command, w.error);
+  if (Status w = write_file_atomic(a.object_path, *object); !w) return fail(command, w.error);
   if (Status w = write_log_or_session(a, drawing->session.events, marks); !w) return fail(command, w.error);
   ordered_json out = simulation_json("drawing", a, drawing->session);
   const DrawingStats& st = drawing->drawing;
