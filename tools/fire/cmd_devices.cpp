@@ -30,14 +30,11 @@ int report_steps(const wiimote::DevicesSeen& seen) {
 }
 
 // The --sys-root hook: sysfs alone (and the nodes under --dev-root), so a test needs neither Bluetooth nor hidapi.
+// It exits as the command does: 1 only for a remote found that cannot be used, 0 with none found.
 int report_sysfs(const wiimote::DevicesSeen& seen) {
-  int remotes = 0;
-  for (const wiimote::SysfsRemote& r : seen.sysfs.remotes) {
+  for (const wiimote::SysfsRemote& r : seen.sysfs.remotes)
     if (r.verdict == wiimote::SetupVerdict::NotARemote || r.verdict == wiimote::SetupVerdict::Ready) std::cout << r.message << "\n";
-    remotes += r.verdict != wiimote::SetupVerdict::NotARemote;
-  }
-  const int stuck = report_steps(seen);
-  return remotes == 0 ? 1 : stuck;
+  return report_steps(seen);
 }
 
 }  // namespace
