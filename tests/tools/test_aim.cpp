@@ -427,6 +427,8 @@ TEST_CASE("fire aim --fake-rig 1 --png-dir: the simulated pen where the simulati
   const Run bare = fire_aim("--fake-rig 1 --seconds 1 --png-dir " + quote(pictures.string()), dir.path);
   REQUIRE(bare.exit_code == 0);
   CHECK(bare.err.find("needs a rig: give --rig RIG.json") != std::string::npos);
+  // No pen is drawn while aiming: the driver's words about one ("pen: the stroke ended") are not shown.
+  CHECK(bare.err.find("pen: ") == std::string::npos);
   CHECK(last_line(bare.out)["overlap"].is_null());
   auto plain = render::read_png((pictures / "camera0.png").string());
   REQUIRE(plain);

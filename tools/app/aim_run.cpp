@@ -86,7 +86,9 @@ class AimRemotes {
       for (const wiimote::RemoteView& v : driver_->remotes())
         if (wiimote::is_camera(v.role) && v.status)
           monitor.battery(v.device, wiimote::battery_percent(*v.status), v.status->battery_low());
-      for (const wiimote::Notice& n : driver_->take_notices()) std::cerr << "fire aim: " << wiimote::describe(n) << "\n";
+      // No pen is drawn while aiming: the driver's pen notices would be about the lamp or the wand.
+      for (const wiimote::Notice& n : driver_->take_notices())
+        if (n.device != wiimote::kPenNotice) std::cerr << "fire aim: " << wiimote::describe(n) << "\n";
       monitor.advance(now);
       if (origin_us_ < 0 && driver_->cameras(wiimote::LinkState::Running) == 2) origin_us_ = now;
       each(now);

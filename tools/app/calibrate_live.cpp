@@ -150,8 +150,9 @@ Result<std::vector<InputEvent>> record_live_wand(const LiveWandOptions& o) {
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
     live.step();
+    // No pen is drawn while calibrating: the driver's pen notices ("the stroke ended") would be about the wand.
     for (const wiimote::Notice& n : driver.take_notices())
-      std::cerr << "fire calibrate: " << wiimote::describe(n) << "\n";
+      if (n.device != wiimote::kPenNotice) std::cerr << "fire calibrate: " << wiimote::describe(n) << "\n";
     const int64_t now = clock();
     if (now >= next_progress_ns) {
       std::cerr << "fire calibrate: " << coverage.line() << "\n";
