@@ -18,12 +18,14 @@ VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageAspectFlags aspect, Vk
   return b;
 }
 
-void record_barrier(VkCommandBuffer cmd, const VkImageMemoryBarrier2& barrier) {
+void record_barriers(VkCommandBuffer cmd, std::span<const VkImageMemoryBarrier2> barriers) {
   VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-  dependency.imageMemoryBarrierCount = 1;
-  dependency.pImageMemoryBarriers = &barrier;
+  dependency.imageMemoryBarrierCount = uint32_t(barriers.size());
+  dependency.pImageMemoryBarriers = barriers.data();
   vkCmdPipelineBarrier2(cmd, &dependency);
 }
+
+void record_barrier(VkCommandBuffer cmd, const VkImageMemoryBarrier2& barrier) { record_barriers(cmd, {&barrier, 1}); }
 
 void record_readback(VkCommandBuffer cmd, VkImage image, VkImageLayout layout, VkExtent2D extent, VkBuffer buffer) {
   record_barrier(cmd, image_barrier(image, VK_IMAGE_ASPECT_COLOR_BIT, layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,

@@ -681,13 +681,6 @@ constexpr VkPipelineStageFlags2 kDepthStage =
 constexpr VkAccessFlags2 kDepthAccess =
     VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
 
-void record_barriers(VkCommandBuffer cmd, const std::vector<VkImageMemoryBarrier2>& barriers) {
-  VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-  dependency.imageMemoryBarrierCount = uint32_t(barriers.size());
-  dependency.pImageMemoryBarriers = barriers.data();
-  vkCmdPipelineBarrier2(cmd, &dependency);
-}
-
 // An image whose content the frame clears or overwrites whole: from whatever the previous frame did with it.
 VkImageMemoryBarrier2 overwrite(VkImage image, VkImageLayout layout, VkImageAspectFlags aspect, VkPipelineStageFlags2 stage,
                                 VkAccessFlags2 access) {
