@@ -112,23 +112,29 @@ Result<InputLog> parse_input_log(std::string_view text, const std::string& sourc
     } else if (kind == "cmd") {
       e.kind = EventKind::Command;
       if (f.size() < 3)
-        return fail(line_no, "cmd needs a command: undo, redo, close, delete x y z, sharp x y z, hole x y z, mark N x y z or register");
+        return fail(line_no, "cmd needs a command: undo, redo, close, delete x y z, sharp x y z, hole x y z, mark N [x y z], "
+                              "measure N, table or register");
       std::string_view c = f[2];
-      if (c == "undo" || c == "redo" || c == "close" || c == "register") {
-        e.command = c == "undo"   ? CommandKind::Undo
-                    : c == "redo" ? CommandKind::Redo
+      if (c == "undo" || c == "redo" || c == "close" || c == "register" || c == "table") {
+        e.command = c == "undo"    ? CommandKind::Undo
+                    : c == "redo"  ? CommandKind::Redo
                     : c == "close" ? CommandKind::Close
+                    : c == "table" ? CommandKind::Table
                                    : CommandKind::Register;
         if (f.size() != 3) return fail(line_no, "cmd " + std::string(c) + " takes no fields");
       } else if (c == "delete" || c == "sharp" || c == "hole") {
         e.command = c == "delete" ? CommandKind::Delete : c == "sharp" ? CommandKind::Sharp : CommandKind::Hole;
         if (!parse_point(f, 3, e.p)) return fail(line_no, "cmd " + std::string(c) + " needs three numbers x y z");
-      } else if (c == "mark") {
-        e.command = CommandKind::Mark;
+      } else if (c == "mark" || c == "measure") {
+        // A mark's coordinates come with it, or from its measuring (cmd measure N) earlier in the session.
+        const bool measure = c == "measure", given = f.size() == 7;
+        e.command = measure ? CommandKind::Measure : given ? CommandKind::Mark : CommandKind::MarkMeasured;
         int64_t mark = -1;
-        if (f.size() != 7 || !parse_int64(f[3], mark) || mark < 0 || mark > int64_t(UINT32_MAX) || !parse_point(f, 4, e.p) ||
-            !is_finite(e.p))
-          return fail(line_no, "cmd mark needs the mark's number (0 or more) and its finite object coordinates x y z");
+        const bool number = f.size() >= 4 && parse_int64(f[3], mark) && mark >= 0 && mark <= int64_t(UINT32_MAX);
+        if (measure && (f.size() != 4 || !number)) return fail(line_no, "cmd measure needs the mark's number (0 or more) and nothing else");
+        if (!measure && (!number || (f.size() != 4 && !given) || (given && (!parse_point(f, 4, e.p) || !is_finite(e.p)))))
+          return fail(line_no, "cmd mark needs the mark's number (0 or more), then its finite object coordinates x y z unless it "
+                               "was measured (cmd measure N)");
         e.mark = uint32_t(mark);
       } else {
         return fail(line_no, "unknown command '" + std::string(c) + "'");
@@ -201,6 +207,9 @@ std::string format_event(const InputEvent& e) {
         case CommandKind::Hole: s += "cmd hole " + point(e.p); break;
         case CommandKind::Mark: s += "cmd mark " + std::to_string(e.mark) + ' ' + point(e.p); break;
         case CommandKind::Register: s += "cmd register"; break;
+        case CommandKind::Table: s += "cmd table"; break;
+        case CommandKind::Measure: s += "cmd measure " + std::to_string(e.mark); break;
+        case CommandKind::MarkMeasured: s += "cmd mark " + std::to_string(e.mark); break;
       }
       break;
     case EventKind::Hid: {

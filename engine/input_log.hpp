@@ -10,7 +10,15 @@
 namespace fire {
 
 enum class EventKind : uint8_t { Pen, Down, Up, Command, Hid, Truth, Meta };
-enum class CommandKind : uint8_t { Undo, Redo, Close, Delete, Sharp, Mark, Register, Hole };
+// Appended in order only: a session's snapshot stores the kind's number.
+enum class CommandKind : uint8_t { Undo, Redo, Close, Delete, Sharp, Mark, Register, Hole, Table, Measure, MarkMeasured };
+inline constexpr CommandKind kLastCommandKind = CommandKind::MarkMeasured;
+
+// The registration system's commands that the pen's rest on a point makes: a mark (given or measured), a
+// mark being measured, the table. What the pen drew since it went down was that touch, not a stroke.
+inline bool is_touch_command(CommandKind c) {
+  return c == CommandKind::Mark || c == CommandKind::MarkMeasured || c == CommandKind::Measure || c == CommandKind::Table;
+}
 
 struct InputEvent {
   int64_t t_us = 0;
@@ -18,7 +26,7 @@ struct InputEvent {
   Vec3 p = Vec3::Zero();              // Pen sample; Delete, Sharp and Hole commands' pick point; Mark: the mark in the object's frame
   double snap = 0;                    // Pen: snap radius for a stroke end at this sample; 0: the session's setting
   CommandKind command = CommandKind::Undo;
-  uint32_t mark = 0;                  // Mark command: the mark's number
+  uint32_t mark = 0;                  // Mark, MarkMeasured and Measure commands: the mark's number
   int device = 0;                     // Hid
   bool hid_ok = true;                 // Hid: false when the hex was garbled (bytes then empty)
   std::vector<uint8_t> bytes;         // Hid: the report, report id first

@@ -1,5 +1,6 @@
 #include "systems/register/register.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -11,10 +12,14 @@
 namespace fire {
 namespace {
 
+constexpr uint8_t kMeasuredMarksRecord = 2;
+
 Vec3 mapped(const RegistrationState& s, const Vec3& p) { return s.transform ? Vec3(s.transform->R * p + s.transform->t) : p; }
 
-void touch_mark(const InputEvent& e, RegistrationState& s, std::vector<Rejection>& rejections) {
-  const std::string what = "mark " + std::to_string(e.mark) + ": ";
+// Where the pen rests at the command `e`: the mean of its samples over the last kRestWindowUs, or none
+// (rejected, in words starting with `what`) when too few samples were seen or they spread too far.
+std::optional<Vec3> resting_pen(const InputEvent& e, const RegistrationState& s, const std::string& what,
+                                std::vector<Rejection>& rejections) {
   Vec3 mean = Vec3::Zero();
   size_t n = 0;
   for (const auto& [t, p] : s.recent)
@@ -24,9 +29,9 @@ void touch_mark(const InputEvent& e, RegistrationState& s, std::vector<Rejection
     }
   if (n < kRestSamples) {
     rejections.push_back({e.t_us, e.line, what + "the pen was seen " + std::to_string(n) + " time(s) in the " +
-                                              std::to_string(kRestWindowUs / 1000) + " ms before the command; rest it on the mark (at least " +
+                                              std::to_string(kRestWindowUs / 1000) + " ms before the command; rest it there (at least " +
                                               std::to_string(kRestSamples) + " samples)"});
-    return;
+    return std::nullopt;
   }
   mean /= double(n);
   // RMS, not the farthest sample: a resting pen far from both cameras flickers in depth between two levels
@@ -37,13 +42,168 @@ void touch_mark(const InputEvent& e, RegistrationState& s, std::vector<Rejection
   const double spread = std::sqrt(squared / double(n));
   if (spread > kRestSpread) {
     rejections.push_back({e.t_us, e.line, what + "the pen's samples spread " + format_mm(spread) +
-                                              " (rms) about their mean while resting on the mark (at most " + format_mm(kRestSpread) +
+                                              " (rms) about their mean while resting (at most " + format_mm(kRestSpread) +
                                               "); hold it still"});
-    return;
+    return std::nullopt;
   }
+  return mean;
+}
+
+std::string mark_ids(const std::vector<MeasuredMark>& marks) {
+  std::string ids;
+  for (const MeasuredMark& m : marks) ids += (ids.empty() ? "" : ", ") + std::to_string(m.mark);
+  return ids;
+}
+
+// A mark touched for the next registration: at its given coordinates (cmd mark N X Y Z) or its measured ones.
+void touch_mark(const InputEvent& e, RegistrationState& s, std::vector<Rejection>& rejections) {
+  const std::string what = "mark " + std::to_string(e.mark) + ": ";
+  Vec3 model = e.p;
+  if (e.command == CommandKind::MarkMeasured) {
+    const MeasuredMark* m = s.measured_mark(e.mark);
+    if (!m) {
+      rejections.push_back({e.t_us, e.line, what + "not measured (" +
+                                                (s.measured.empty() ? std::string("no mark is") : "marks " + mark_ids(s.measured) + " are") +
+                                                "); measure it first (cmd measure N), or give its coordinates (cmd mark N X Y Z)"});
+      return;
+    }
+    if (!s.transform) {
+      rejections.push_back({e.t_us, e.line, what + "measured, but the object has no frame yet: the first cmd register makes it "
+                                                   "from the table and the marks measured"});
+      return;
+    }
+    model = m->p;
+  }
+  const std::optional<Vec3> rest = resting_pen(e, s, what, rejections);
+  if (!rest) return;
   // A mark touched again replaces its earlier touch.
   std::erase_if(s.touched, [&](const MarkTouch& m) { return m.mark == e.mark; });
-  s.touched.push_back({e.mark, mean, e.p});
+  s.touched.push_back({e.mark, *rest, model});
+}
+
+// Of `points`, the one nearer than kMarkSpacing to `p`, if any.
+std::optional<size_t> too_near(const std::vector<Vec3>& points, const Vec3& p) {
+  for (size_t k = 0; k < points.size(); ++k)
+    if ((points[k] - p).norm() < kMarkSpacing) return k;
+  return std::nullopt;
+}
+
+void measure_mark(const InputEvent& e, RegistrationState& s, std::vector<Rejection>& rejections) {
+  const std::string what = "measure mark " + std::to_string(e.mark) + ": ";
+  if (const MeasuredMark* m = s.measured_mark(e.mark)) {
+    rejections.push_back({e.t_us, e.line, what + "measured already (line " + std::to_string(m->line) +
+                                              "); to register on it, touch it with cmd mark " + std::to_string(e.mark) +
+                                              ", or measure another mark under a new number"});
+    return;
+  }
+  const std::optional<Vec3> rest = resting_pen(e, s, what, rejections);
+  if (!rest) return;
+  const Vec3 p = mapped(s, *rest);
+  std::vector<Vec3> others;
+  for (const MeasuredMark& m : s.measured) others.push_back(m.p);
+  if (const std::optional<size_t> k = too_near(others, p)) {
+    rejections.push_back({e.t_us, e.line, what + "the pen rests " + format_mm((others[*k] - p).norm()) + " from mark " +
+                                              std::to_string(s.measured[*k].mark) + " (at most " + format_mm(kMarkSpacing) +
+                                              " apart): the same mark touched twice? Marks must be further apart"});
+    return;
+  }
+  s.measured.push_back({e.mark, p, e.line});
+}
+
+void touch_table(const InputEvent& e, RegistrationState& s, std::vector<Rejection>& rejections) {
+  const std::string what = "table: ";
+  if (s.transform) {
+    rejections.push_back({e.t_us, e.line, what + "the object's frame is made already (registration at line " +
+                                              std::to_string(s.done.back().line) + "); table touches only make the first"});
+    return;
+  }
+  const std::optional<Vec3> rest = resting_pen(e, s, what, rejections);
+  if (!rest) return;
+  if (const std::optional<size_t> k = too_near(s.table, *rest)) {
+    rejections.push_back({e.t_us, e.line, what + "the pen rests " + format_mm((s.table[*k] - *rest).norm()) +
+                                              " from table touch " + std::to_string(*k + 1) + " (at least " + format_mm(kMarkSpacing) +
+                                              " apart); touch the table at points around the object"});
+    return;
+  }
+  s.table.push_back(*rest);
+}
+
+struct Spread {
+  Vec3 centre = Vec3::Zero();
+  Eigen::Matrix3d axes;     // columns: the principal directions, the widest last
+  double off_line = 0;      // the farthest point from the widest direction's line through the centre
+  double off_plane_rms = 0;  // RMS distance from the plane of the two widest directions
+};
+
+Spread spread_of(const std::vector<Vec3>& points) {
+  Spread out;
+  for (const Vec3& p : points) out.centre += p;
+  out.centre /= double(points.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const Vec3& p : points) scatter += (p - out.centre) * (p - out.centre).transpose();
+  out.axes = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors();
+  double squared = 0;
+  for (const Vec3& p : points) {
+    const Vec3 d = p - out.centre;
+    out.off_line = std::max(out.off_line, (d - d.dot(out.axes.col(2)) * out.axes.col(2)).norm());
+    squared += std::pow(d.dot(out.axes.col(0)), 2);
+  }
+  out.off_plane_rms = std::sqrt(squared / double(points.size()));
+  return out;
+}
+
+// The first registration on measured marks: the object's frame from the table and the marks (register.hpp).
+void make_frame(const InputEvent& e, RegistrationState& s, std::vector<Rejection>& rejections) {
+  auto reject = [&](const std::string& why) {
+    rejections.push_back({e.t_us, e.line, "register: " + why + "; the touches are kept"});
+  };
+  if (s.table.size() < kTableTouches) {
+    reject("the object's frame needs " + std::to_string(kTableTouches) + " touches on the table around the object (cmd table), " +
+           std::to_string(s.table.size()) + " made");
+    return;
+  }
+  if (s.measured.size() < 3) {
+    reject("the object's frame needs at least 3 measured marks (cmd measure N), " + std::to_string(s.measured.size()) + " measured");
+    return;
+  }
+  const Spread table = spread_of(s.table);
+  if (table.off_line < kMarkSpacing) {
+    reject("the table touches lie on a line (the farthest " + format_mm(table.off_line) + " from it, at least " +
+           format_mm(kMarkSpacing) + "): touch the table at points around the object");
+    return;
+  }
+  std::vector<Vec3> marks;
+  for (const MeasuredMark& m : s.measured) marks.push_back(m.p);
+  if (const Spread spread = spread_of(marks); spread.off_line < kMarkSpacing) {
+    reject("the measured marks lie on a line (the farthest " + format_mm(spread.off_line) + " from it, at least " +
+           format_mm(kMarkSpacing) + "): measure a mark off that line");
+    return;
+  }
+  // The cameras look down on the table: its normal toward camera 0, at the rig frame's origin.
+  Vec3 up = table.axes.col(0);
+  if (up.dot(-table.centre) < 0) up = -up;
+  for (const MeasuredMark& m : s.measured)
+    if (const double height = up.dot(m.p - table.centre); height < -kMarkSpacing) {
+      reject("mark " + std::to_string(m.mark) + " lies " + format_mm(-height) + " below the table touched: measure it again, "
+             "or touch the table where the object stands");
+      return;
+    }
+  Vec3 x = Vec3::UnitX() - up.x() * up;
+  if (x.norm() < 0.1) x = Vec3::UnitY() - up.y() * up;  // camera 0 looks along the table
+  x.normalize();
+  Eigen::Matrix3d R;
+  R.row(0) = x.transpose();
+  R.row(1) = up.cross(x).transpose();
+  R.row(2) = up.transpose();
+  const Vec3 centroid = spread_of(marks).centre;
+  const Vec3 origin = centroid - up.dot(centroid - table.centre) * up;
+  tracking::RigidTransform T;
+  T.R = R;
+  T.t = -R * origin;
+  T.rms_residual = table.off_plane_rms;
+  s.transform = T;
+  for (MeasuredMark& m : s.measured) m.p = mapped(s, m.p);
+  s.done.push_back({e.line, uint32_t(s.measured.size()), T.rms_residual, true});
 }
 
 // The rigid motion of the marks touched, but the one at `left_out` (none left out by default).
@@ -82,9 +242,19 @@ void register_marks(const InputEvent& e, RegistrationState& s, std::vector<Rejec
   auto reject = [&](const std::string& why) {
     rejections.push_back({e.t_us, e.line, "register: " + why + "; the marks touched are kept"});
   };
+  if (s.touched.empty() && !s.transform && !s.measured.empty()) {
+    make_frame(e, s, rejections);
+    return;
+  }
+  if (s.touched.size() < 3 && s.transform && !s.measured.empty()) {
+    reject(std::to_string(s.touched.size()) + " mark(s) touched since the last registration, a registration needs at least 3: " +
+           "touch 3 of the marks measured (" + mark_ids(s.measured) + ") that both cameras see (cmd mark N); where fewer face them, " +
+           "turn the object back, measure marks (cmd measure N) on the side that will face them, and turn it again");
+    return;
+  }
   if (s.touched.size() < 3) {
     reject(std::to_string(s.touched.size()) + " mark(s) touched since the last registration, a registration needs at least 3 " +
-           "(rest the pen on each mark and log cmd mark N X Y Z)");
+           "(rest the pen on each mark and log cmd mark N X Y Z, or measure the marks with cmd table and cmd measure N)");
     return;
   }
   Result<tracking::RigidTransform> T = fit_marks(s.touched);
@@ -103,7 +273,10 @@ void register_marks(const InputEvent& e, RegistrationState& s, std::vector<Rejec
       reject(misfit + "a mark was touched in the wrong place or logged with the wrong number or coordinates");
     return;
   }
+  const bool first = !s.transform;
   s.transform = *T;
+  if (first)  // marks measured before it wait for it
+    for (MeasuredMark& m : s.measured) m.p = mapped(s, m.p);
   s.done.push_back({e.line, uint32_t(s.touched.size()), T->rms_residual});
   s.touched.clear();
 }
@@ -120,14 +293,20 @@ void release(RegistrationState& s, std::vector<InputEvent>& out) {
 // What one event of the frame does: see register_system.
 void take(const InputEvent& e, bool tracked, RegistrationState& s, std::vector<InputEvent>& out,
           std::vector<Rejection>& rejections) {
-  const bool registering = e.kind == EventKind::Command && (e.command == CommandKind::Mark || e.command == CommandKind::Register);
+  const bool touch = e.kind == EventKind::Command && is_touch_command(e.command);
+  const bool registering = touch || (e.kind == EventKind::Command && e.command == CommandKind::Register);
   if (registering && !tracked) {
-    rejections.push_back({e.t_us, e.line, std::string(e.command == CommandKind::Mark ? "mark" : "register") +
-                                            ": registration needs a tracked pen (a log of device reports, replayed with --rig)"});
+    const char* name = e.command == CommandKind::Register ? "register"
+                       : e.command == CommandKind::Table  ? "table"
+                       : e.command == CommandKind::Measure ? "measure"
+                                                           : "mark";
+    rejections.push_back({e.t_us, e.line, std::string(name) + ": registration needs a tracked pen (a log of device reports, replayed with --rig)"});
   } else if (registering) {
-    if (e.command == CommandKind::Mark) {
-      touch_mark(e, s, rejections);
-      // The pen rests on a mark: what it drew since it went down, and draws until it lifts, is a touch. A pen
+    if (touch) {
+      if (e.command == CommandKind::Table) touch_table(e, s, rejections);
+      else if (e.command == CommandKind::Measure) measure_mark(e, s, rejections);
+      else touch_mark(e, s, rejections);
+      // The pen rests on a mark or the table: what it drew since it went down, and draws until it lifts, is a touch. A pen
       // far from both cameras flickers in depth by more than kTouchRadius even at rest, so part of it may have
       // gone to the sketch system already, which the command tells to drop.
       if (s.stroke_open) {
@@ -178,11 +357,26 @@ void register_system(const std::vector<InputEvent>& frame_events, const std::vec
   for (const InputEvent& e : pen_events) take(e, tracked, s, out, rejections);
 }
 
+const MeasuredMark* RegistrationState::measured_mark(uint32_t mark) const {
+  for (const MeasuredMark& m : measured)
+    if (m.mark == mark) return &m;
+  return nullptr;
+}
+
 std::vector<std::string> describe_registration(const RegistrationState& s) {
   std::vector<std::string> out;
-  for (size_t k = 0; k < s.done.size(); ++k)
-    out.push_back("registration " + std::to_string(k + 1) + " (line " + std::to_string(s.done[k].line) + "): " +
-                  std::to_string(s.done[k].marks) + " marks, residual " + format_mm(s.done[k].residual));
+  for (size_t k = 0; k < s.done.size(); ++k) {
+    const Registration& r = s.done[k];
+    const std::string head = "registration " + std::to_string(k + 1) + " (line " + std::to_string(r.line) + "): ";
+    if (r.measured_frame)
+      out.push_back(head + "the object's frame from the table (touches " + format_mm(r.residual) + " rms from their plane) and " +
+                    std::to_string(r.marks) + " marks measured");
+    else
+      out.push_back(head + std::to_string(r.marks) + " marks, residual " + format_mm(r.residual));
+  }
+  if (!s.measured.empty())
+    out.push_back(std::to_string(s.measured.size()) + " mark(s) measured: " + mark_ids(s.measured) +
+                  (s.transform ? "" : " (no frame made yet: cmd register makes it)"));
   if (s.touches_dropped)
     out.push_back(std::to_string(s.touches_dropped) + " touch(es) of the pen, on a mark or never " + format_mm(kTouchRadius) +
                   " from where it went down: not drawn");
@@ -223,6 +417,16 @@ void RegistrationState::save(SnapshotWriter& out) const {
     out.put(r.residual);
   }
   out.put(touches_dropped);
+  // Since marks are measured by touch; older snapshots end above.
+  out.put(kMeasuredMarksRecord);
+  out.put(table);
+  out.put(uint64_t(measured.size()));
+  for (const MeasuredMark& m : measured) {
+    out.put(m.mark);
+    out.put(m.p);
+    out.put(m.line);
+  }
+  for (const Registration& r : done) out.put(uint8_t(r.measured_frame));
 }
 
 bool RegistrationState::load(SnapshotReader& in) {
@@ -269,6 +473,25 @@ bool RegistrationState::load(SnapshotReader& in) {
     in.get(r.residual);
   }
   in.get(touches_dropped);
+  if (in.ok() && !in.at_end()) {
+    uint8_t record = 0;
+    in.get(record);
+    if (record != kMeasuredMarksRecord) in.fail();
+    in.get(table);
+    in.get(n);
+    for (uint64_t k = 0; k < n && in.ok(); ++k) {
+      MeasuredMark& m = measured.emplace_back();
+      in.get(m.mark);
+      in.get(m.p);
+      in.get(m.line);
+    }
+    for (Registration& r : done) {
+      uint8_t flag = 0;
+      in.get(flag);
+      if (flag > 1) in.fail();
+      r.measured_frame = flag != 0;
+    }
+  }
   if (has > 1 || open > 1 || released > 1) in.fail();
   return in.ok();
 }

@@ -6,6 +6,15 @@
 //                     (their RMS distance from it at most kRestSpread)
 //   cmd register      the rigid transform from the marks touched since the last registration (Umeyama,
 //                     tracking::register_rigid); from then on every pen sample is mapped into the object's frame
+// An object nobody modelled has no marks file: its marks are measured by touch.
+//   cmd table         the pen rests on the table (three such touches, before the first registration)
+//   cmd measure N     the pen rests on mark N, whose position is measured: in the object's frame after a
+//                     registration; before the first, it waits for that registration to make the frame
+//   cmd mark N        as cmd mark N X Y Z, with mark N's measured position
+// The first cmd register with no mark touched but marks measured makes the object's frame from them: +z the
+// table's normal toward the cameras, the origin the measured marks' centroid dropped onto the table, +x
+// camera 0's x axis laid on the table. A mark measured twice, marks closer than kMarkSpacing or on one line,
+// a table whose touches lie on a line, or a mark touched but never measured are rejected in words.
 // A registration that cannot be made (fewer than 3 marks, collinear marks, a residual over kMaxResidual) is
 // rejected in words, naming the mark that fits worst where the others fit, and keeps the marks touched; a
 // later registration (the object turned) replaces the transform, and curves already drawn stay where they
@@ -30,6 +39,8 @@ inline constexpr double kRestSpread = 0.002;       // metres: a resting pen's sa
 inline constexpr size_t kRestSamples = 10;         // fewer in the window: the pen was not seen on the mark
 inline constexpr double kMaxResidual = 0.005;      // metres: more means a mark touched in the wrong place
 inline constexpr double kTouchRadius = 0.003;      // metres: a stroke that stays this close to its start is a touch
+inline constexpr double kMarkSpacing = 0.01;       // metres: measured marks (and table touches) at least this far apart and off a line
+inline constexpr size_t kTableTouches = 3;         // touches on the table that give the object's +z
 
 struct MarkTouch {
   uint32_t mark = 0;
@@ -37,10 +48,17 @@ struct MarkTouch {
   Vec3 model = Vec3::Zero();     // the mark, object frame
 };
 
+struct MeasuredMark {
+  uint32_t mark = 0;
+  Vec3 p = Vec3::Zero();  // object frame; rig frame while `RegistrationState::transform` is none
+  uint32_t line = 0;      // of its cmd measure
+};
+
 struct Registration {
   uint32_t line = 0;  // of its cmd register
   uint32_t marks = 0;
-  double residual = 0;  // metres, RMS over the marks
+  double residual = 0;  // metres, RMS over the marks; for the frame made by measuring, the table touches' from their plane
+  bool measured_frame = false;  // the frame made from the table and the marks measured, not fitted to given marks
 };
 
 struct RegistrationState {
@@ -53,9 +71,14 @@ struct RegistrationState {
   std::vector<InputEvent> held;
   std::vector<Registration> done;  // every registration made, in order
   uint32_t touches_dropped = 0;
+  std::vector<Vec3> table;            // the table touches (rig frame) before the first registration
+  std::vector<MeasuredMark> measured;  // every mark measured, in the order measured
 
+  const MeasuredMark* measured_mark(uint32_t mark) const;
   void save(SnapshotWriter& out) const;
-  bool load(SnapshotReader& in);  // false (and `in` failed) on a malformed record
+  // False (and `in` failed) on a malformed record. A snapshot written before marks were measured by touch
+  // ends before `table` and `measured`: they are read empty.
+  bool load(SnapshotReader& in);
 };
 
 // Writes to `object_events` (cleared first) what the person did in the frame, for the sketch system: the pen's

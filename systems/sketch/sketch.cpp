@@ -813,7 +813,7 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
       }
       case EventKind::Command: {
         EditRequest r{RequestKind::Edit, {}, ev.t_us, ev.line};
-        if (ev.command == CommandKind::Mark) {
+        if (is_touch_command(ev.command)) {
           // The registration system's: the pen was resting on a mark, and what it drew since it went down was a
           // touch of it (a pen far from the cameras flickers in depth), not a stroke.
           state.pen_down = false;

@@ -100,6 +100,29 @@ TEST_CASE("input log: truncated, unknown version and malformed lines are refused
   refuse("FIRE-LOG 1\n10 hid 0 3300\n5 up\n", "back in time");
   refuse("FIRE-LOG 1\nabc down\n", "bad timestamp");
   refuse("FIRE-LOG 1\n10 cmd jump\n", "unknown command");
+  refuse("FIRE-LOG 1\n10 cmd measure\n", "cmd measure needs the mark's number (0 or more) and nothing else");
+  refuse("FIRE-LOG 1\n10 cmd measure 2 0 0 0\n", "cmd measure needs the mark's number");
+  refuse("FIRE-LOG 1\n10 cmd measure -1\n", "cmd measure needs the mark's number");
+  refuse("FIRE-LOG 1\n10 cmd mark 3 0.1 0.2\n", "cmd mark needs the mark's number (0 or more), then its finite object coordinates");
+  refuse("FIRE-LOG 1\n10 cmd mark x\n", "cmd mark needs the mark's number");
+  refuse("FIRE-LOG 1\n10 cmd mark 3 nan 0 0\n", "cmd mark needs the mark's number");
+  refuse("FIRE-LOG 1\n10 cmd table 1\n", "cmd table takes no fields");
+}
+
+TEST_CASE("input log: marks measured by touch read and format back: cmd table, cmd measure N, cmd mark N", "[files]") {
+  const std::string text = "FIRE-LOG 2\n10 cmd table\n20 cmd measure 4\n30 cmd mark 4\n40 cmd mark 4 0.5 0 1\n";
+  auto log = parse_input_log(text, "m.log");
+  REQUIRE(log.ok());
+  REQUIRE(log->events.size() == 4);
+  CHECK(log->events[0].command == CommandKind::Table);
+  CHECK(log->events[1].command == CommandKind::Measure);
+  CHECK(log->events[1].mark == 4);
+  CHECK(log->events[2].command == CommandKind::MarkMeasured);
+  CHECK(log->events[2].mark == 4);
+  CHECK(log->events[3].command == CommandKind::Mark);
+  CHECK(log->events[3].p == Vec3(0.5, 0, 1));
+  for (const InputEvent& e : log->events) CHECK(is_touch_command(e.command));
+  CHECK(format_input_log(log->events) == "FIRE-LOG 2\n10 cmd table\n20 cmd measure 4\n30 cmd mark 4\n40 cmd mark 4 0.5 0 1\n");
 }
 
 TEST_CASE("input log: a garbled device report is counted, not fatal", "[files]") {

@@ -74,6 +74,9 @@ std::vector<PadPress> pad_presses_for(const std::vector<InputEvent>& commands, s
       case CommandKind::Sharp: action = PadAction::SharpLastCurve; break;
       case CommandKind::Register: action = PadAction::Register; break;
       case CommandKind::Hole: action = PadAction::HoleLastTouched; break;
+      case CommandKind::Table:
+      case CommandKind::Measure:
+      case CommandKind::MarkMeasured: continue;  // the pad measures no marks: the app registers on a marks file
       case CommandKind::Mark: {
         if (mark_count == 0 || c.mark >= mark_count) continue;
         // The shorter way round to the mark, the presses ending just before the touch.

@@ -45,7 +45,7 @@ bool load_event(SnapshotReader& in, InputEvent& e) {
   in.get(e.values);
   in.get(e.text);
   in.get(e.line);
-  if (kind > uint8_t(EventKind::Meta) || command > uint8_t(CommandKind::Register)) in.fail();
+  if (kind > uint8_t(EventKind::Meta) || command > uint8_t(kLastCommandKind)) in.fail();
   e.kind = EventKind(kind);
   e.command = CommandKind(command);
   e.device = device;

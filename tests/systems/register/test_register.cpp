@@ -49,21 +49,28 @@ InputEvent register_command(int64_t t_us, uint32_t line) {
   return e;
 }
 
-// The pen rests 0.8 s on `object` (a touch: down, samples 10 ms apart, up), then `cmd mark n`, one frame per
-// event; returns the frames' output events.
-std::vector<InputEvent> touch(RegistrationState& s, std::vector<Rejection>& rejections, int64_t& t, uint32_t n,
-                              const Vec3& object, uint32_t line, double wobble = 0) {
+// The pen rests 0.8 s at `rig_point` (a touch: down, samples 10 ms apart, up), then `command` is logged, one
+// frame per event; returns the frames' output events.
+std::vector<InputEvent> rest(RegistrationState& s, std::vector<Rejection>& rejections, int64_t& t, const Vec3& rig_point,
+                             InputEvent command, double wobble = 0) {
   std::vector<InputEvent> out;
   auto frame = [&](InputEvent e) {
     const std::vector<InputEvent> passed = run(s, rejections, {std::move(e)});
     out.insert(out.end(), passed.begin(), passed.end());
   };
   frame(event(t, EventKind::Down));
-  for (int k = 0; k < 80; ++k, t += 10'000) frame(pen(t, to_rig(object) + Vec3(k % 2 ? wobble : -wobble, 0, 0)));
-  frame(mark(t, n, object, line));
+  for (int k = 0; k < 80; ++k, t += 10'000) frame(pen(t, rig_point + Vec3(k % 2 ? wobble : -wobble, 0, 0)));
+  command.t_us = t;
+  frame(std::move(command));
   frame(event(t, EventKind::Up));
   t += 500'000;
   return out;
+}
+
+// The pen rests on mark n at `object` and `cmd mark n X Y Z` is logged.
+std::vector<InputEvent> touch(RegistrationState& s, std::vector<Rejection>& rejections, int64_t& t, uint32_t n,
+                              const Vec3& object, uint32_t line, double wobble = 0) {
+  return rest(s, rejections, t, to_rig(object), mark(t, n, object, line), wobble);
 }
 
 const Vec3 kMarks[] = {{0.03, 0, 0.01}, {-0.03, 0.01, 0.05}, {0, -0.03, 0.12}, {0.01, 0.02, 0.18}};
@@ -308,4 +315,223 @@ TEST_CASE("a resting pen whose depth flickers between two levels touches the mar
   REQUIRE(rejections.size() == 1);
   CHECK(rejections[0].reason.find("mark 1: the pen's samples spread 2.") == 0);
   CHECK(s.touched.size() == 1);
+}
+
+namespace {
+
+// Marks measured by touch: the command with no coordinates (cmd table, cmd measure N, cmd mark N).
+InputEvent touch_command(CommandKind kind, uint32_t n, uint32_t line) {
+  InputEvent e = event(0, EventKind::Command);
+  e.command = kind;
+  e.mark = n;
+  e.line = line;
+  return e;
+}
+
+// The table the object stands on: its z = 0, in the object's frame, touched around it.
+const Vec3 kTable[] = {{0.1, 0, 0}, {-0.05, 0.08, 0}, {-0.05, -0.08, 0}};
+
+// The object stood at `pose` (object = A rig + b): the pen rests at `object`, then `kind` is logged.
+void rest_at(RegistrationState& s, std::vector<Rejection>& rejections, int64_t& t, const Vec3& object, CommandKind kind,
+             uint32_t n, uint32_t line, const Eigen::Matrix3d& A = kA, const Vec3& b = kB) {
+  rest(s, rejections, t, A.transpose() * (object - b), touch_command(kind, n, line));
+}
+
+// Three table touches and marks 0..3 measured, then registered: the object's frame made.
+void measure_all(RegistrationState& s, std::vector<Rejection>& rejections, int64_t& t) {
+  for (uint32_t k = 0; k < 3; ++k) rest_at(s, rejections, t, kTable[k], CommandKind::Table, 0, 1 + k);
+  for (uint32_t n = 0; n < 4; ++n) rest_at(s, rejections, t, kMarks[n], CommandKind::Measure, n, 10 + n);
+  run(s, rejections, {register_command(t, 20)});
+}
+
+}  // namespace
+
+TEST_CASE("marks measured by touch make the object's frame: +z the table's normal, the origin under the marks, +x camera 0's x") {
+  RegistrationState s;
+  std::vector<Rejection> rejections;
+  int64_t t = 0;
+  for (uint32_t k = 0; k < 3; ++k) rest_at(s, rejections, t, kTable[k], CommandKind::Table, 0, 1 + k);
+  for (uint32_t n = 0; n < 4; ++n) rest_at(s, rejections, t, kMarks[n], CommandKind::Measure, n, 10 + n);
+  CHECK(s.table.size() == 3);
+  REQUIRE(s.measured.size() == 4);
+  CHECK(!s.transform);  // the marks wait, in the rig's frame, for the registration
+  CHECK((s.measured[2].p - to_rig(kMarks[2])).norm() < 1e-12);
+  CHECK(s.touches_dropped == 7);  // no touch is drawn
+  run(s, rejections, {register_command(t, 20)});
+  CHECK(rejections.empty());
+  REQUIRE(s.transform);
+  REQUIRE(s.done.size() == 1);
+  CHECK(s.done[0].measured_frame);
+  CHECK(s.done[0].marks == 4);
+  const tracking::RigidTransform T = *s.transform;
+  CHECK((T.R * T.R.transpose() - Eigen::Matrix3d::Identity()).norm() < 1e-12);
+  CHECK(T.R.determinant() > 0);
+  // Heights above the table and distances between marks are the object's; the centroid stands on the origin.
+  Vec3 centroid = Vec3::Zero();
+  for (uint32_t n = 0; n < 4; ++n) {
+    CHECK(s.measured[n].mark == n);
+    CHECK(s.measured[n].line == 10 + n);
+    CHECK(std::abs(s.measured[n].p.z() - kMarks[n].z()) < 1e-9);
+    CHECK(std::abs((s.measured[n].p - s.measured[0].p).norm() - (kMarks[n] - kMarks[0]).norm()) < 1e-9);
+    centroid += s.measured[n].p / 4;
+  }
+  CHECK(std::abs(centroid.x()) < 1e-12);
+  CHECK(std::abs(centroid.y()) < 1e-12);
+  for (const Vec3& p : kTable) CHECK(std::abs((T.R * to_rig(p) + T.t).z()) < 1e-9);
+  // +x: camera 0's x axis laid on the table.
+  const Vec3 up = T.R.row(2).transpose(), x = Vec3::UnitX() - up.x() * up;
+  CHECK((T.R.row(0).transpose() - x.normalized()).norm() < 1e-12);
+  CHECK(up.dot(Vec3::Zero() - to_rig(Vec3::Zero())) > 0);  // toward the camera
+
+  // The object turned: registered on three measured marks (cmd mark N), the same point of it maps to the same place.
+  const Eigen::Matrix3d A2 = Eigen::AngleAxisd(-1.1, Vec3(0.1, 0.3, 1).normalized()).toRotationMatrix();
+  const Vec3 b2(-0.02, 0.05, 0.45);
+  for (uint32_t n : {1u, 2u, 3u}) rest_at(s, rejections, t, kMarks[n], CommandKind::MarkMeasured, n, 30 + n, A2, b2);
+  run(s, rejections, {register_command(t, 40)});
+  CHECK(rejections.empty());
+  REQUIRE(s.done.size() == 2);
+  CHECK(!s.done[1].measured_frame);
+  CHECK(s.done[1].residual < 1e-9);
+  const Vec3 before = T.R * to_rig(Vec3(0.02, 0.01, 0.07)) + T.t;
+  const Vec3 after = s.transform->R * (A2.transpose() * (Vec3(0.02, 0.01, 0.07) - b2)) + s.transform->t;
+  CHECK((after - before).norm() < 1e-9);
+  // A mark measured after the turn is placed in the same frame.
+  rest_at(s, rejections, t, Vec3(0.04, -0.02, 0.09), CommandKind::Measure, 7, 41, A2, b2);
+  REQUIRE(s.measured.size() == 5);
+  CHECK((s.measured[4].p - (T.R * to_rig(Vec3(0.04, -0.02, 0.09)) + T.t)).norm() < 1e-9);
+  const std::vector<std::string> said = describe_registration(s);
+  REQUIRE(said.size() >= 3);
+  CHECK(said[0].find("registration 1 (line 20): the object's frame from the table") == 0);
+  CHECK(said[2] == "5 mark(s) measured: 0, 1, 2, 3, 7");
+}
+
+TEST_CASE("a mark measured twice, marks too close or on a line, a table on a line and too few table touches are rejected") {
+  std::vector<Rejection> rejections;
+  int64_t t = 0;
+  {
+    RegistrationState s;
+    rest_at(s, rejections, t, kTable[0], CommandKind::Table, 0, 1);
+    rest_at(s, rejections, t, kTable[1], CommandKind::Table, 0, 2);
+    rest_at(s, rejections, t, kTable[0] + Vec3(0.004, 0, 0), CommandKind::Table, 0, 3);  // the same point again
+    REQUIRE(rejections.size() == 1);
+    CHECK(rejections[0].reason.find("table: the pen rests 4.00 mm from table touch 1") == 0);
+    for (uint32_t n = 0; n < 3; ++n) rest_at(s, rejections, t, kMarks[n], CommandKind::Measure, n, 10 + n);
+    rest_at(s, rejections, t, kMarks[1], CommandKind::Measure, 1, 14);  // the same number again
+    REQUIRE(rejections.size() == 2);
+    CHECK(rejections[1].line == 14);
+    CHECK(rejections[1].reason.find("measure mark 1: measured already (line 11)") == 0);
+    rest_at(s, rejections, t, kMarks[2] + Vec3(0, 0.006, 0), CommandKind::Measure, 5, 15);  // the same mark, a new number
+    REQUIRE(rejections.size() == 3);
+    CHECK(rejections[2].reason.find("measure mark 5: the pen rests 6.00 mm from mark 2") == 0);
+    CHECK(rejections[2].reason.find("the same mark touched twice?") != std::string::npos);
+    CHECK(s.measured.size() == 3);
+    run(s, rejections, {register_command(t, 16)});
+    REQUIRE(rejections.size() == 4);
+    CHECK(rejections[3].reason.find("register: the object's frame needs 3 touches on the table around the object (cmd table), 2 made") == 0);
+    CHECK(!s.transform);
+    // A third table touch, but on the line of the first two.
+    rest_at(s, rejections, t, 0.5 * (kTable[0] + kTable[1]) + Vec3(0, 0.002, 0), CommandKind::Table, 0, 17);
+    run(s, rejections, {register_command(t, 18)});
+    REQUIRE(rejections.size() == 5);
+    CHECK(rejections[4].reason.find("register: the table touches lie on a line") == 0);
+    CHECK(rejections[4].reason.find("; the touches are kept") != std::string::npos);
+    CHECK(s.table.size() == 3);
+    CHECK(!s.transform);
+  }
+  {
+    RegistrationState s;
+    rejections.clear();
+    for (uint32_t k = 0; k < 3; ++k) rest_at(s, rejections, t, kTable[k], CommandKind::Table, 0, 1 + k);
+    for (uint32_t n = 0; n < 3; ++n) rest_at(s, rejections, t, Vec3(0.01, 0, 0.03 + 0.04 * n), CommandKind::Measure, n, 10 + n);
+    run(s, rejections, {register_command(t, 20)});
+    REQUIRE(rejections.size() == 1);
+    CHECK(rejections[0].reason.find("register: the measured marks lie on a line") == 0);
+    CHECK(!s.transform);
+    rest_at(s, rejections, t, kMarks[1], CommandKind::Measure, 3, 21);  // off the line: the frame is made
+    run(s, rejections, {register_command(t, 22)});
+    CHECK(rejections.size() == 1);
+    CHECK(s.transform);
+    rest_at(s, rejections, t, kTable[0], CommandKind::Table, 0, 23);
+    REQUIRE(rejections.size() == 2);
+    CHECK(rejections[1].reason.find("table: the object's frame is made already (registration at line 22)") == 0);
+  }
+}
+
+TEST_CASE("a mark never measured, too few measured marks after a turn and a measured mark that fits badly are named") {
+  RegistrationState s;
+  std::vector<Rejection> rejections;
+  int64_t t = 0;
+  rest_at(s, rejections, t, kMarks[0], CommandKind::MarkMeasured, 0, 5);
+  REQUIRE(rejections.size() == 1);
+  CHECK(rejections[0].reason.find("mark 0: not measured (no mark is); measure it first (cmd measure N)") == 0);
+  measure_all(s, rejections, t);
+  REQUIRE(rejections.size() == 1);
+  REQUIRE(s.transform);
+  const tracking::RigidTransform first = *s.transform;
+
+  const Eigen::Matrix3d A2 = Eigen::AngleAxisd(2.0, Vec3(0.3, 0.2, 1).normalized()).toRotationMatrix();
+  const Vec3 b2(0.01, -0.03, 0.42);
+  rest_at(s, rejections, t, kMarks[0], CommandKind::MarkMeasured, 9, 30, A2, b2);
+  REQUIRE(rejections.size() == 2);
+  CHECK(rejections[1].reason.find("mark 9: not measured (marks 0, 1, 2, 3 are)") == 0);
+  // After the turn only two measured marks face the cameras.
+  for (uint32_t n : {0u, 1u}) rest_at(s, rejections, t, kMarks[n], CommandKind::MarkMeasured, n, 31 + n, A2, b2);
+  run(s, rejections, {register_command(t, 33)});
+  REQUIRE(rejections.size() == 3);
+  CHECK(rejections[2].reason.find("register: 2 mark(s) touched since the last registration, a registration needs at least 3: "
+                                  "touch 3 of the marks measured (0, 1, 2, 3) that both cameras see") == 0);
+  CHECK(rejections[2].reason.find("measure marks (cmd measure N) on the side that will face them") != std::string::npos);
+  CHECK(s.transform->t == first.t);  // the frame is kept
+  // Two more, mark 3 touched 4 cm from where it was measured: the registration names it.
+  rest_at(s, rejections, t, kMarks[2], CommandKind::MarkMeasured, 2, 34, A2, b2);
+  rest_at(s, rejections, t, kMarks[3] + Vec3(0.04, 0, 0), CommandKind::MarkMeasured, 3, 35, A2, b2);
+  run(s, rejections, {register_command(t, 36)});
+  REQUIRE(rejections.size() == 4);
+  CHECK(rejections[3].reason.find("mark 3 fits worst, 40.00 mm from where the other 3 put it") != std::string::npos);
+  CHECK(s.done.size() == 1);
+  rest_at(s, rejections, t, kMarks[3], CommandKind::MarkMeasured, 3, 37, A2, b2);  // touched again: it registers
+  run(s, rejections, {register_command(t, 38)});
+  CHECK(rejections.size() == 4);
+  CHECK(s.done.size() == 2);
+}
+
+TEST_CASE("measured marks and table touches survive a snapshot, and a snapshot written before them still loads") {
+  RegistrationState s;
+  std::vector<Rejection> rejections;
+  int64_t t = 0;
+  measure_all(s, rejections, t);
+  rest_at(s, rejections, t, Vec3(0.04, -0.02, 0.09), CommandKind::Measure, 7, 41);
+  REQUIRE(s.measured.size() == 5);
+  SnapshotWriter out;
+  s.save(out);
+  const std::string file = out.finish();
+  Result<SnapshotReader> in = SnapshotReader::open(file, "test");
+  REQUIRE(in.ok());
+  RegistrationState back;
+  REQUIRE(back.load(*in));
+  CHECK(in->at_end());
+  CHECK(back.table == s.table);
+  REQUIRE(back.measured.size() == 5);
+  CHECK(back.measured[4].mark == 7);
+  CHECK(back.measured[4].p == s.measured[4].p);
+  CHECK(back.measured[4].line == 41);
+  REQUIRE(back.done.size() == 1);
+  CHECK(back.done[0].measured_frame);
+
+  // The same state as a snapshot ended before the measured marks: its record, the table (a count and 3 points),
+  // the marks (a count and 5 of mark, point, line) and one registration's flag.
+  const size_t trailer = 1 + (8 + 3 * 24) + (8 + 5 * (4 + 24 + 4)) + 1;
+  const std::string payload = file.substr(kSnapshotHeaderBytes);
+  SnapshotWriter old;
+  for (size_t k = 0; k + trailer < payload.size(); ++k) old.put(uint8_t(payload[k]));
+  const std::string old_file = old.finish();
+  Result<SnapshotReader> old_in = SnapshotReader::open(old_file, "old");
+  REQUIRE(old_in.ok());
+  RegistrationState old_back;
+  REQUIRE(old_back.load(*old_in));
+  CHECK(old_in->at_end());
+  CHECK(old_back.transform->t == s.transform->t);
+  CHECK(old_back.measured.empty());
+  CHECK(old_back.table.empty());
+  CHECK(!old_back.done[0].measured_frame);
 }
