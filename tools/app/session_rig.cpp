@@ -61,35 +61,56 @@ bool has_device_reports(const InputLog& log) {
   return std::any_of(log.events.begin(), log.events.end(), [](const InputEvent& e) { return e.kind == EventKind::Hid; });
 }
 
-std::string marks_to_json(const std::vector<Vec3>& marks) {
-  nlohmann::ordered_json out = {{"format", "fire-marks"}, {"version", 1}, {"units", "metres"}, {"frame", "object"},
+std::string identified_marks_to_json(const std::vector<IdentifiedMark>& marks, std::string_view frame) {
+  nlohmann::ordered_json out = {{"format", "fire-marks"}, {"version", 1}, {"units", "metres"}, {"frame", frame},
                                 {"marks", nlohmann::ordered_json::array()}};
-  for (size_t k = 0; k < marks.size(); ++k)
-    out["marks"].push_back({{"id", k}, {"x", marks[k].x()}, {"y", marks[k].y()}, {"z", marks[k].z()}});
+  for (const IdentifiedMark& m : marks) out["marks"].push_back({{"id", m.id}, {"x", m.p.x()}, {"y", m.p.y()}, {"z", m.p.z()}});
   return out.dump(2) + "\n";
 }
 
-Result<std::vector<Vec3>> marks_from_json(std::string_view text, const std::string& source) {
-  using R = Result<std::vector<Vec3>>;
+std::string marks_to_json(const std::vector<Vec3>& marks) {
+  std::vector<IdentifiedMark> identified;
+  for (size_t k = 0; k < marks.size(); ++k) identified.push_back({uint32_t(k), marks[k]});
+  return identified_marks_to_json(identified, "object");
+}
+
+Result<std::vector<IdentifiedMark>> identified_marks_from_json(std::string_view text, const std::string& source) {
+  using R = Result<std::vector<IdentifiedMark>>;
   const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
   if (j.is_discarded()) return R::failure(source + ": not JSON");
   if (!j.is_object() || j.value("format", "") != "fire-marks")
     return R::failure(source + ": not a marks file (\"format\": \"fire-marks\")");
   if (!j.contains("marks") || !j["marks"].is_array() || j["marks"].empty())
     return R::failure(source + ": no \"marks\" array, or an empty one");
-  std::vector<Vec3> marks;
+  std::vector<IdentifiedMark> marks;
   for (const nlohmann::json& m : j["marks"]) {
-    const std::string which = source + ": mark " + std::to_string(marks.size());
-    if (!m.is_object() || !m.contains("id") || !m["id"].is_number_unsigned() || m["id"].get<size_t>() != marks.size())
-      return R::failure(which + ": its \"id\" must be " + std::to_string(marks.size()) + " (ids run 0, 1, ... in order)");
-    Vec3 p;
+    const std::string which = source + ": mark " + std::to_string(marks.size()) + " of the array";
+    if (!m.is_object() || !m.contains("id") || !m["id"].is_number_unsigned() || m["id"].get<uint64_t>() > UINT32_MAX)
+      return R::failure(which + ": its \"id\" must be a whole number from 0 to " + std::to_string(UINT32_MAX));
+    IdentifiedMark& out = marks.emplace_back();
+    out.id = m["id"].get<uint32_t>();
+    for (size_t k = 0; k + 1 < marks.size(); ++k)
+      if (marks[k].id == out.id) return R::failure(which + ": id " + std::to_string(out.id) + " is given twice");
     for (int k = 0; k < 3; ++k) {
       const char* axis = k == 0 ? "x" : k == 1 ? "y" : "z";
       if (!m.contains(axis) || !m[axis].is_number() || !std::isfinite(m[axis].get<double>()))
         return R::failure(which + ": \"" + axis + "\" must be a finite number of metres");
-      p[k] = m[axis].get<double>();
+      out.p[k] = m[axis].get<double>();
     }
-    marks.push_back(p);
+  }
+  return marks;
+}
+
+Result<std::vector<Vec3>> marks_from_json(std::string_view text, const std::string& source) {
+  using R = Result<std::vector<Vec3>>;
+  auto identified = identified_marks_from_json(text, source);
+  if (!identified) return R::failure(identified.error());
+  std::vector<Vec3> marks;
+  for (const IdentifiedMark& m : *identified) {
+    if (m.id != marks.size())
+      return R::failure(source + ": mark " + std::to_string(marks.size()) + ": its \"id\" must be " + std::to_string(marks.size()) +
+                        " (ids run 0, 1, ... in order)");
+    marks.push_back(m.p);
   }
   return marks;
 }

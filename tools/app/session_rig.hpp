@@ -20,6 +20,14 @@ Result<TrackingRig> tracking_rig_from_json(const std::string& rig_text, const st
 // position in the object's frame, metres. Ids run 0, 1, ... in order; errors name `source` and the mark.
 std::string marks_to_json(const std::vector<Vec3>& marks);
 Result<std::vector<Vec3>> marks_from_json(std::string_view text, const std::string& source);
+// The same format where the ids are any distinct numbers, in any order: the marks measured by touch
+// (`fire replay --measured-marks-out`), a subset of the object's, matched with its marks file by id.
+struct IdentifiedMark {
+  uint32_t id = 0;
+  Vec3 p = Vec3::Zero();
+};
+std::string identified_marks_to_json(const std::vector<IdentifiedMark>& marks, std::string_view frame);
+Result<std::vector<IdentifiedMark>> identified_marks_from_json(std::string_view text, const std::string& source);
 // Whether a log holds device reports (and so needs a rig to be replayed).
 bool has_device_reports(const InputLog& log);
 

@@ -13,6 +13,8 @@
 #include "platform/obj.hpp"
 #include "platform/surface_io.hpp"
 #include "systems/evaluate/evaluate.hpp"
+#include "systems/tracking/registration.hpp"
+#include "tools/app/session_rig.hpp"
 #include "tools/fire/commands.hpp"
 
 namespace fire::cli {
@@ -21,6 +23,7 @@ namespace {
 
 struct EvalArgs {
   std::string surface_path, reference_path, network_path;
+  std::vector<std::string> align_paths;  // TRUE.json MEASURED.json, or none
   int reference_levels = 5;
   double spacing = 0.002;  // sample spacing, a fraction of the reference diagonal
   double crease_radius = 0.01;  // where the bend across a sharp curve is read, a fraction of the reference diagonal
@@ -81,10 +84,45 @@ Creases measure_creases(const Mesh& network, const evaluate::TriangleBvh& surfac
   return out;
 }
 
+// The rigid motion from the frame the marks were measured in to the object's (marks matched by id).
+Result<tracking::RigidTransform> alignment(const std::string& true_path, const std::string& measured_path, size_t& matched) {
+  using R = Result<tracking::RigidTransform>;
+  std::vector<IdentifiedMark> files[2];
+  for (int k = 0; k < 2; ++k) {
+    const std::string& path = k == 0 ? true_path : measured_path;
+    auto text = read_text_file(path);
+    if (!text) return R::failure(text.error());
+    auto marks = identified_marks_from_json(*text, path);
+    if (!marks) return R::failure(marks.error());
+    files[k] = std::move(*marks);
+  }
+  std::vector<Vec3> measured, object;
+  for (const IdentifiedMark& m : files[1])
+    for (const IdentifiedMark& t : files[0])
+      if (t.id == m.id) {
+        measured.push_back(m.p);
+        object.push_back(t.p);
+      }
+  matched = measured.size();
+  if (matched < 3)
+    return R::failure("--align: " + std::to_string(matched) + " mark id(s) of " + measured_path + " are in " + true_path +
+                      ", at least 3 are needed");
+  auto T = tracking::register_rigid(measured, object);
+  if (!T) return R::failure("--align: the marks matched cannot be aligned: " + T.error());
+  return T;
+}
+
 int run_eval(const EvalArgs& a) {
   const Stages stages;
   auto surface = read_surface(a.surface_path);
   if (!surface) return fail(surface.error());
+  std::optional<tracking::RigidTransform> aligned;
+  size_t align_marks = 0;
+  if (!a.align_paths.empty()) {
+    auto T = alignment(a.align_paths[0], a.align_paths[1], align_marks);
+    if (!T) return fail(T.error());
+    aligned = *T;
+  }
   auto out_mesh = evaluate::triangulate(surface->positions, surface->face_offsets, surface->face_vertices);
   if (!out_mesh) return fail(a.surface_path + ": " + out_mesh.error());
 
@@ -92,6 +130,10 @@ int run_eval(const EvalArgs& a) {
   if (!control_text) return fail(control_text.error());
   auto control = parse_obj(*control_text, a.reference_path);
   if (!control) return fail(control.error());
+  // The reference into SURFACE's frame, by the inverse motion: the same distances, and the positions printed
+  // are where they are in SURFACE and the network.
+  if (aligned)
+    for (Vec3& p : control->positions) p = aligned->R.transpose() * (p - aligned->t);
   // A cage from fire reconstruct --cage, or one of OpenSubdiv's shapes, says which edges are creases.
   auto tags = parse_obj_tags(*control_text, a.reference_path, *control);
   if (!tags) return fail(tags.error());
@@ -169,6 +211,10 @@ int run_eval(const EvalArgs& a) {
   out["border_loops"] = topology.border_loops;
   out["reference_euler_characteristic"] = expected.euler_characteristic;
   out["reference_border_loops"] = expected.border_loops;
+  if (aligned) {
+    out["align_marks"] = align_marks;
+    out["align_residual"] = aligned->rms_residual;
+  }
   out["diagonal"] = diagonal;
   out["samples"] = d.a_to_b.samples + d.b_to_a.samples;
   std::cout << out.dump() << "\n";
@@ -195,7 +241,7 @@ void add_eval_commands(CLI::App& app, Registry& registry) {
       "curves marked sharp) and, where the bend across them could be read, crease_points and crease_error_max_deg, the "
       "largest difference between how far SURFACE and the reference bend across a sharp curve (180 degrees less the "
       "angle between the surface's two sides, read --crease-radius from the curve; 90 across a box's edge), with "
-      "crease_error_at (edge, point, surface_deg, reference_deg).");
+      "crease_error_at (edge, point, surface_deg, reference_deg); with --align, align_marks and align_residual (metres).");
   cmd->add_option("SURFACE", a->surface_path, "surface to measure: .obj, .ply, .stl or .glb as `fire reconstruct` writes")
       ->required();
   cmd->add_option("--reference", a->reference_path,
@@ -204,6 +250,12 @@ void add_eval_commands(CLI::App& app, Registry& registry) {
                   "reconstruct --cage` writes them")
       ->required();
   cmd->add_option("--network", a->network_path, "curve network whose polyline points are measured to SURFACE");
+  cmd->add_option("--align", a->align_paths,
+                  "TRUE.json MEASURED.json: marks files (fire-marks JSON) of the object's frame (fire simulate drawing "
+                  "--marks-out) and of the frame its marks were measured in (fire replay --measured-marks-out); SURFACE "
+                  "and --network are measured after the rigid motion (Umeyama, no scale) between the marks of the same id "
+                  "(done by moving the reference the other way: positions printed stay in SURFACE's frame)")
+      ->expected(2);
   cmd->add_option("--reference-levels", a->reference_levels,
                   "Catmull-Clark levels before projecting the reference to its limit")
       ->check(CLI::Range(5, 7))

@@ -58,7 +58,7 @@ ReplayHooks progress_hooks(bool asked) {
 }
 
 struct ReplayOptions {
-  std::string log_path, out_path, obj_path, session_dir, rig_path;
+  std::string log_path, out_path, obj_path, session_dir, rig_path, measured_marks_path;
   std::vector<std::string> surface_paths;
   uint64_t snapshot_every = 0;
   uint64_t until_stroke = 0;  // 0: the whole log
@@ -297,6 +297,20 @@ int run_replay(const ReplayOptions& o) {
       return 1;
     }
   }
+  if (!o.measured_marks_path.empty()) {
+    const RegistrationState& r = world->registration;
+    if (r.measured.empty() || !r.transform) {
+      std::cerr << "fire replay: " << o.log_path << (r.measured.empty() ? " measures no mark (cmd measure N)" : " measures marks but never registers: they have no frame")
+                << ", nothing to write to " << o.measured_marks_path << "\n";
+      return 1;
+    }
+    std::vector<IdentifiedMark> marks;
+    for (const MeasuredMark& mark : r.measured) marks.push_back({mark.mark, mark.p});
+    if (auto s = write_file_atomic(o.measured_marks_path, identified_marks_to_json(marks, "measured")); !s) {
+      std::cerr << "fire replay: " << s.error << "\n";
+      return 1;
+    }
+  }
   return 0;
 }
 
@@ -326,6 +340,9 @@ void add_network_commands(CLI::App& app, Registry& registry) {
                      "written from the log keeps a copy (rig.json), so reopening it needs no --rig");
   replay->add_option("-o,--output", o->out_path, "write the final curve network here (format: engine/NETWORK_FORMAT.md)");
   replay->add_option("--export-obj", o->obj_path, "also write the network's polylines as OBJ lines");
+  replay->add_option("--measured-marks-out", o->measured_marks_path,
+                     "write the marks the log measured by touch (cmd measure N) with their ids and positions in the "
+                     "object's frame they made (fire-marks JSON, metres), for fire eval --align");
   replay->add_option("--surface", o->surface_paths,
                      "write the final surface here (.obj, .ply, .stl or .glb), as the frame's subdivide system left it; "
                      "repeat it for more than one file")

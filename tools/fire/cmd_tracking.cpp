@@ -575,6 +575,12 @@ void add_tracking_commands(CLI::App& app, Registry& registry) {
   dr->add_option("--turns", drawing->drawing.turns, "poses the object may be turned to, evenly about its up axis (twice as many where these show too little of it)")->capture_default_str();
   dr->add_option("--undo-after", drawing->drawing.undo_after, "the split stroke (1-based) undone with cmd undo and drawn again (0: none)")
       ->capture_default_str();
+  dr->add_flag("--measure-marks", drawing->drawing.measure_marks,
+              "the person measures the marks by touch, as on an object nobody modelled: in the first pose three touches "
+              "on the table around the object (cmd table) and each mark seen (cmd measure N), then cmd register, which "
+              "makes the object's frame from them; after each later registration, on the measured marks it sees (cmd "
+              "mark N, no coordinates), the marks it sees for the first time are measured. --marks-out still writes the "
+              "true marks, for fire eval --align with fire replay --measured-marks-out");
   dr->add_option("--max-strokes", drawing->drawing.max_strokes, "stop after this many strokes, the border always whole (0: the whole network)")
       ->capture_default_str();
   dr->footer(

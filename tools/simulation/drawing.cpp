@@ -116,6 +116,91 @@ Status check_drawing(const DrawingOptions& d, const PolygonMeshView& object, con
   return Status::success();
 }
 
+// How far p lies from the line through `points` (their principal axis; infinitely far from fewer than 2).
+double off_line(const std::vector<Vec3>& points, const Vec3& p) {
+  if (points.size() < 2) return std::numeric_limits<double>::infinity();
+  Vec3 centre = Vec3::Zero();
+  for (const Vec3& q : points) centre += q;
+  centre /= static_cast<double>(points.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const Vec3& q : points) scatter += (q - centre) * (q - centre).transpose();
+  const Vec3 axis = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(2);
+  const Vec3 d = p - centre;
+  return (d - d.dot(axis) * axis).norm();
+}
+
+// Marks on the network's curves, away from where the object rests either way up, until poses a and b both
+// show 3 of them off one line: the object is registered in b on marks measured in a.
+void add_shared_marks(const SimulatedRig& rig, const Pose& a, const Pose& b, const DrawingNetwork& net, double top,
+                      std::vector<Vec3>& marks) {
+  auto shared = [&] {
+    std::vector<Vec3> out;
+    for (const Vec3& m : marks)
+      if (seen_by_both(rig, a, m) && seen_by_both(rig, b, m)) out.push_back(m);
+    return out;
+  };
+  auto enough = [&](const std::vector<Vec3>& on) {
+    if (on.size() < 3) return false;
+    for (const Vec3& m : on)
+      if (off_line(on, m) >= kMarkSpacing / 2) return true;
+    return false;
+  };
+  for (std::vector<Vec3> now = shared(); !enough(now); now = shared()) {
+    double best = kMarkSpacing;
+    std::optional<Vec3> pick;
+    for (const DrawingCurve& c : net.curves)
+      for (const Vec3& p : c.points) {
+        if (p.z() < 0.1 * top || p.z() > 0.9 * top) continue;
+        double spread = off_line(now, p);
+        for (const Vec3& m : marks) spread = std::min(spread, (p - m).norm());
+        if (spread > best && seen_by_both(rig, a, p) && seen_by_both(rig, b, p)) best = spread, pick = p;
+      }
+    if (!pick) return;  // the registration in b then says so
+    marks.push_back(*pick);
+  }
+}
+
+// The object's farthest point from its up axis.
+double object_radius(std::span<const Vec3> positions) {
+  double r = 0;
+  for (const Vec3& p : positions) r = std::max(r, std::hypot(p.x(), p.y()));
+  return r;
+}
+
+// Three points of the table the object stands on (its base plane, z = 0, or z = its top upside down) around
+// it, that both cameras see in the pose: the person touches them to give the object's +z (cmd table).
+Result<std::vector<Vec3>> table_touches(const SimulatedRig& rig, const Pose& pose, double radius) {
+  const bool upright = (pose.R * Vec3::UnitZ()).y() < 0;  // the world's up is -y
+  double top = 0;
+  for (const auto& tri : pose.triangles)
+    for (const Vec3& p : tri) top = std::max(top, (pose.R.transpose() * (p - pose.t)).z());
+  const double base = upright ? 0 : top;
+  constexpr int kAround = 24;
+  std::vector<Vec3> seen;
+  for (int k = 0; k < kAround; ++k) {
+    const double a = 2 * std::numbers::pi * k / kAround, r = 1.25 * radius + 0.02;
+    const Vec3 p(r * std::cos(a), r * std::sin(a), base);
+    if (seen_by_both(rig, pose, p)) seen.push_back(p);
+  }
+  if (seen.size() < 3)
+    return Result<std::vector<Vec3>>::failure("--measure-marks: both cameras see the table around the object at " +
+                                              std::to_string(seen.size()) + " of " + std::to_string(kAround) +
+                                              " points in the first pose, its frame needs 3");
+  // The two farthest apart, then the one farthest from their line.
+  std::array<size_t, 3> pick{0, 1, 2};
+  double best = -1;
+  for (size_t i = 0; i < seen.size(); ++i)
+    for (size_t j = i + 1; j < seen.size(); ++j)
+      if ((seen[i] - seen[j]).norm() > best) best = (seen[i] - seen[j]).norm(), pick[0] = i, pick[1] = j;
+  const Vec3 along = (seen[pick[1]] - seen[pick[0]]).normalized();
+  best = -1;
+  for (size_t k = 0; k < seen.size(); ++k) {
+    const Vec3 d = seen[k] - seen[pick[0]];
+    if (const double off = (d - d.dot(along) * along).norm(); off > best) best = off, pick[2] = k;
+  }
+  return std::vector<Vec3>{seen[pick[0]], seen[pick[2]], seen[pick[1]]};
+}
+
 }  // namespace
 
 Result<std::vector<Vec3>> object_frame(std::span<const Vec3> positions, double height_m) {
@@ -291,6 +376,21 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
   if (!planned && 2 * d.turns <= kMaxTurns) planned = attempt(2, tilts, 2 * d.turns);
   if (!planned) return R::failure(planned.error());
   const std::vector<PlanStep>& plan = planned->steps;
+  if (d.measure_marks) {
+    // Marks measured in one pose are all the next registers on: where two poses the object is turned between
+    // share fewer than 3 marks off one line, the person sticks more on where both show them.
+    int from = -1;
+    for (const PlanStep& step : plan) {
+      if (step.kind != PlanStep::Register) continue;
+      if (from >= 0 && from != step.pose) add_shared_marks(*rig, poses[size_t(from)], poses[size_t(step.pose)], net, top, marks);
+      from = step.pose;
+    }
+    for (size_t j = 0; j < poses.size(); ++j) {
+      marks_seen[j].clear();
+      for (uint32_t m = 0; m < marks.size(); ++m)
+        if (seen_by_both(*rig, poses[j], marks[m])) marks_seen[j].push_back(m);
+    }
+  }
 
   // The timeline: where the pen is, lit or not, and when each command is logged.
   constexpr double kAccel = 2.0;     // m/s^2, a hand drawing with care
@@ -324,27 +424,75 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
     timeline.push_back({Phase::Hold, t, t + seconds, -1, pen, pen});
     t += seconds;
   };
+  // The pen rests on a point of the object's frame (a mark, the table), and the command is logged.
+  auto rest_on = [&](const Pose& placed, const Vec3& object_point, CommandKind kind, uint32_t mark, const Vec3& p) {
+    travel_to(placed(object_point), kTravel_s);
+    hold(d.mark_hold_s);
+    command(t - 0.2, kind, mark, p);
+  };
+  std::vector<uint32_t> measured;
   bool first = true;
   for (const PlanStep& step : plan) {
     const Pose& placed = poses[static_cast<size_t>(step.pose)];
     switch (step.kind) {
-      case PlanStep::Register:
+      case PlanStep::Register: {
+        const std::vector<uint32_t>& seen_here = marks_seen[static_cast<size_t>(step.pose)];
+        auto is_measured = [&](uint32_t m) { return std::find(measured.begin(), measured.end(), m) != measured.end(); };
+        if (!first && d.measure_marks) {
+          // Before turning the object, the marks the next pose shows that are not measured yet are, where the
+          // present pose shows them too.
+          const int from = std::prev(pose_from.end())->second;
+          const std::vector<uint32_t>& seen_now = marks_seen[static_cast<size_t>(from)];
+          for (uint32_t m : seen_here)
+            if (!is_measured(m) && std::find(seen_now.begin(), seen_now.end(), m) != seen_now.end()) {
+              rest_on(poses[static_cast<size_t>(from)], marks[m], CommandKind::Measure, m, Vec3::Zero());
+              measured.push_back(m);
+              ++stats.mark_touches;
+            }
+        }
         if (!first) {
           pose_from.emplace_back(t + 0.5 * kTurn_s, step.pose);
           travel_to(pen, kTurn_s);
         }
-        first = false;
-        for (uint32_t m : marks_seen[static_cast<size_t>(step.pose)]) {
-          const Vec3& mark = marks[m];
-          travel_to(placed(mark), kTravel_s);
-          hold(d.mark_hold_s);
-          command(t - 0.2, CommandKind::Mark, m, mark);
-          ++stats.mark_touches;
+        std::vector<uint32_t> to_measure;
+        if (!d.measure_marks) {
+          for (uint32_t m : seen_here) rest_on(placed, marks[m], CommandKind::Mark, m, marks[m]);
+          stats.mark_touches += static_cast<int>(seen_here.size());
+        } else if (first) {
+          // The first round makes the object's frame: the table, then every mark seen, measured.
+          Result<std::vector<Vec3>> table = table_touches(*rig, placed, object_radius(object.positions));
+          if (!table) return R::failure(table.error());
+          for (const Vec3& p : *table) rest_on(placed, p, CommandKind::Table, 0, Vec3::Zero());
+          for (uint32_t m : seen_here) rest_on(placed, marks[m], CommandKind::Measure, m, Vec3::Zero());
+          stats.mark_touches += static_cast<int>(seen_here.size());
+          measured = seen_here;
+        } else {
+          // Registered on the marks measured that it sees; then the others it sees are measured for later turns.
+          size_t known = 0;
+          for (uint32_t m : seen_here)
+            if (is_measured(m)) {
+              rest_on(placed, marks[m], CommandKind::MarkMeasured, m, Vec3::Zero());
+              ++known;
+            } else {
+              to_measure.push_back(m);
+            }
+          if (known < 3)
+            return R::failure("--measure-marks: pose " + std::to_string(step.pose) + " shows both cameras " + std::to_string(known) +
+                              " mark(s) measured in the poses before it, a registration needs 3");
+          stats.mark_touches += static_cast<int>(known);
         }
+        first = false;
         travel_to(pen, 0.3);  // the pen lifted off the last mark
         command(t, CommandKind::Register);
         ++stats.registrations;
+        for (uint32_t m : to_measure) {
+          rest_on(placed, marks[m], CommandKind::Measure, m, Vec3::Zero());
+          measured.push_back(m);
+          ++stats.mark_touches;
+        }
+        if (!to_measure.empty()) travel_to(pen, 0.3);
         break;
+      }
       case PlanStep::Stroke: {
         std::vector<Vec3> world;
         for (const Vec3& p : step.points) world.push_back(placed(p));

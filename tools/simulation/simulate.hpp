@@ -96,6 +96,9 @@ struct DrawingOptions {
   int turns = 6;              // poses the object can be turned to, evenly about its up axis
   int undo_after = 3;         // the split stroke (1-based) undone by `cmd undo` and drawn again; 0: none
   int max_strokes = 0;        // stop after this many strokes (0: the whole network)
+  // The marks are measured by touch (cmd table, cmd measure N, then cmd mark N without coordinates), as on an
+  // object nobody modelled, instead of touched at the coordinates of the marks file.
+  bool measure_marks = false;
   std::string mesh_name = "pawn.obj";  // recorded in the log's meta
 };
 
