@@ -14,6 +14,20 @@ namespace {
 
 constexpr uint8_t kMeasuredMarksRecord = 2;
 
+void put_transform(SnapshotWriter& out, const tracking::RigidTransform& T) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out.put(T.R(r, c));
+  out.put(T.t);
+  out.put(T.rms_residual);
+}
+
+void get_transform(SnapshotReader& in, tracking::RigidTransform& T) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) in.get(T.R(r, c));
+  in.get(T.t);
+  in.get(T.rms_residual);
+}
+
 Vec3 mapped(const RegistrationState& s, const Vec3& p) { return s.transform ? Vec3(s.transform->R * p + s.transform->t) : p; }
 
 // Where the pen rests at the command `e`: the mean of its samples over the last kRestWindowUs, or none
@@ -108,6 +122,7 @@ void measure_mark(const InputEvent& e, RegistrationState& s, std::vector<Rejecti
     return;
   }
   s.measured.push_back({e.mark, p, e.line});
+  if (!s.rounds.empty()) s.rounds.back().push_back({e.mark, *rest});
 }
 
 void touch_table(const InputEvent& e, RegistrationState& s, std::vector<Rejection>& rejections) {
@@ -202,8 +217,46 @@ void make_frame(const InputEvent& e, RegistrationState& s, std::vector<Rejection
   T.t = -R * origin;
   T.rms_residual = table.off_plane_rms;
   s.transform = T;
-  for (MeasuredMark& m : s.measured) m.p = mapped(s, m.p);
+  s.frame_transform = T;
+  s.rounds.assign(1, {});
+  for (MeasuredMark& m : s.measured) {
+    s.rounds[0].push_back({m.mark, m.p});
+    m.p = mapped(s, m.p);
+  }
   s.done.push_back({e.line, uint32_t(s.measured.size()), T.rms_residual, true});
+}
+
+// The measured marks and every round's motion (the frame's held), alternated to a least-squares fit of all
+// the rests: each round's motion on the marks (Umeyama), each mark at the mean of where the rounds put it.
+// Returns the latest round's motion.
+tracking::RigidTransform refine_measured(RegistrationState& s, const tracking::RigidTransform& latest) {
+  std::vector<tracking::RigidTransform> motions(s.rounds.size(), *s.frame_transform);
+  motions.back() = latest;
+  // Each rest's mark in `measured` (a round holds rests on measured marks only).
+  std::vector<std::vector<size_t>> at(s.rounds.size());
+  for (size_t r = 0; r < s.rounds.size(); ++r)
+    for (const MarkRest& rest : s.rounds[r])
+      at[r].push_back(size_t(s.measured_mark(rest.mark) - s.measured.data()));
+  for (int sweep = 0; sweep < kRefineSweeps; ++sweep) {
+    for (size_t r = 1; r < s.rounds.size(); ++r) {
+      std::vector<Vec3> rests, marks;
+      for (size_t k = 0; k < s.rounds[r].size(); ++k) {
+        rests.push_back(s.rounds[r][k].rest);
+        marks.push_back(s.measured[at[r][k]].p);
+      }
+      if (Result<tracking::RigidTransform> T = tracking::register_rigid(rests, marks)) motions[r] = *T;
+    }
+    std::vector<Vec3> sum(s.measured.size(), Vec3::Zero());
+    std::vector<int> count(s.measured.size(), 0);
+    for (size_t r = 0; r < s.rounds.size(); ++r)
+      for (size_t k = 0; k < s.rounds[r].size(); ++k) {
+        sum[at[r][k]] += motions[r].R * s.rounds[r][k].rest + motions[r].t;
+        ++count[at[r][k]];
+      }
+    for (size_t m = 0; m < s.measured.size(); ++m)
+      if (count[m] > 0) s.measured[m].p = sum[m] / double(count[m]);
+  }
+  return motions.back();
 }
 
 // The rigid motion of the marks touched, but the one at `left_out` (none left out by default).
@@ -274,6 +327,15 @@ void register_marks(const InputEvent& e, RegistrationState& s, std::vector<Rejec
     return;
   }
   const bool first = !s.transform;
+  const bool all_measured = std::all_of(s.touched.begin(), s.touched.end(), [&](const MarkTouch& m) {
+    const MeasuredMark* measured = s.measured_mark(m.mark);
+    return measured && measured->p == m.model;
+  });
+  if (s.frame_transform && all_measured) {
+    std::vector<MarkRest>& round = s.rounds.emplace_back();
+    for (const MarkTouch& m : s.touched) round.push_back({m.mark, m.measured});
+    T = refine_measured(s, *T);
+  }
   s.transform = *T;
   if (first)  // marks measured before it wait for it
     for (MeasuredMark& m : s.measured) m.p = mapped(s, m.p);
@@ -387,12 +449,7 @@ std::vector<std::string> describe_registration(const RegistrationState& s) {
 
 void RegistrationState::save(SnapshotWriter& out) const {
   out.put(uint8_t(transform.has_value()));
-  if (transform) {
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) out.put(transform->R(r, c));
-    out.put(transform->t);
-    out.put(transform->rms_residual);
-  }
+  if (transform) put_transform(out, *transform);
   out.put(uint64_t(touched.size()));
   for (const MarkTouch& m : touched) {
     out.put(m.mark);
@@ -427,19 +484,23 @@ void RegistrationState::save(SnapshotWriter& out) const {
     out.put(m.line);
   }
   for (const Registration& r : done) out.put(uint8_t(r.measured_frame));
+  out.put(uint8_t(frame_transform.has_value()));
+  if (frame_transform) put_transform(out, *frame_transform);
+  out.put(uint64_t(rounds.size()));
+  for (const std::vector<MarkRest>& round : rounds) {
+    out.put(uint64_t(round.size()));
+    for (const MarkRest& m : round) {
+      out.put(m.mark);
+      out.put(m.rest);
+    }
+  }
 }
 
 bool RegistrationState::load(SnapshotReader& in) {
   *this = {};
   uint8_t has = 0, open = 0, released = 0;
   in.get(has);
-  if (has) {
-    transform.emplace();
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) in.get(transform->R(r, c));
-    in.get(transform->t);
-    in.get(transform->rms_residual);
-  }
+  if (has) get_transform(in, transform.emplace());
   uint64_t n = 0;
   in.get(n);
   for (uint64_t k = 0; k < n && in.ok(); ++k) {
@@ -490,6 +551,22 @@ bool RegistrationState::load(SnapshotReader& in) {
       in.get(flag);
       if (flag > 1) in.fail();
       r.measured_frame = flag != 0;
+    }
+    uint8_t has_frame = 0;
+    in.get(has_frame);
+    if (has_frame > 1) in.fail();
+    if (has_frame) get_transform(in, frame_transform.emplace());
+    in.get(n);
+    for (uint64_t k = 0; k < n && in.ok(); ++k) {
+      std::vector<MarkRest>& round = rounds.emplace_back();
+      uint64_t count = 0;
+      in.get(count);
+      for (uint64_t j = 0; j < count && in.ok(); ++j) {
+        MarkRest& m = round.emplace_back();
+        in.get(m.mark);
+        in.get(m.rest);
+        if (in.ok() && !measured_mark(m.mark)) in.fail();
+      }
     }
   }
   if (has > 1 || open > 1 || released > 1) in.fail();

@@ -15,6 +15,9 @@
 // table's normal toward the cameras, the origin the measured marks' centroid dropped onto the table, +x
 // camera 0's x axis laid on the table. A mark measured twice, marks closer than kMarkSpacing or on one line,
 // a table whose touches lie on a line, or a mark touched but never measured are rejected in words.
+// Each later registration on measured marks measures them again: the marks and every round's rigid motion
+// are then refined together over all the rounds (the first, which made the frame, held), so that a mark
+// measured through a chain of 3-mark registrations does not carry their errors into every later round.
 // A registration that cannot be made (fewer than 3 marks, collinear marks, a residual over kMaxResidual) is
 // rejected in words, naming the mark that fits worst where the others fit, and keeps the marks touched; a
 // later registration (the object turned) replaces the transform, and curves already drawn stay where they
@@ -41,6 +44,7 @@ inline constexpr double kMaxResidual = 0.005;      // metres: more means a mark 
 inline constexpr double kTouchRadius = 0.003;      // metres: a stroke that stays this close to its start is a touch
 inline constexpr double kMarkSpacing = 0.01;       // metres: measured marks (and table touches) at least this far apart and off a line
 inline constexpr size_t kTableTouches = 3;         // touches on the table that give the object's +z
+inline constexpr int kRefineSweeps = 20;          // alternations of the rounds' motions and the marks' positions
 
 struct MarkTouch {
   uint32_t mark = 0;
@@ -52,6 +56,12 @@ struct MeasuredMark {
   uint32_t mark = 0;
   Vec3 p = Vec3::Zero();  // object frame; rig frame while `RegistrationState::transform` is none
   uint32_t line = 0;      // of its cmd measure
+};
+
+// A rest of the pen on a measured mark, rig frame: where it was measured, or touched for a registration.
+struct MarkRest {
+  uint32_t mark = 0;
+  Vec3 rest = Vec3::Zero();
 };
 
 struct Registration {
@@ -73,6 +83,10 @@ struct RegistrationState {
   uint32_t touches_dropped = 0;
   std::vector<Vec3> table;            // the table touches (rig frame) before the first registration
   std::vector<MeasuredMark> measured;  // every mark measured, in the order measured
+  // Where the frame was made from the table and measured marks: the rests on measured marks of each pose
+  // registered, from the frame's own (whose motion, `frame_transform`, is held) to the latest.
+  std::vector<std::vector<MarkRest>> rounds;
+  std::optional<tracking::RigidTransform> frame_transform;
 
   const MeasuredMark* measured_mark(uint32_t mark) const;
   void save(SnapshotWriter& out) const;

@@ -517,11 +517,24 @@ TEST_CASE("measured marks and table touches survive a snapshot, and a snapshot w
   CHECK(back.measured[4].line == 41);
   REQUIRE(back.done.size() == 1);
   CHECK(back.done[0].measured_frame);
+  REQUIRE(back.rounds.size() == 1);
+  CHECK(back.rounds[0].size() == 5);
+  CHECK(back.rounds[0][4].rest == s.rounds[0][4].rest);
+  REQUIRE(back.frame_transform);
+  CHECK(back.frame_transform->R == s.frame_transform->R);
 
-  // The same state as a snapshot ended before the measured marks: its record, the table (a count and 3 points),
-  // the marks (a count and 5 of mark, point, line) and one registration's flag.
-  const size_t trailer = 1 + (8 + 3 * 24) + (8 + 5 * (4 + 24 + 4)) + 1;
-  const std::string payload = file.substr(kSnapshotHeaderBytes);
+  // A snapshot written before marks were measured: the same state without them, less the record that holds
+  // them, which is then its record byte, three empty counts (table, marks, rounds), a flag per registration
+  // and the frame's flag.
+  RegistrationState before = s;
+  before.table.clear();
+  before.measured.clear();
+  before.rounds.clear();
+  before.frame_transform.reset();
+  SnapshotWriter without;
+  before.save(without);
+  const size_t trailer = 1 + 3 * 8 + before.done.size() + 1;
+  const std::string payload = without.finish().substr(kSnapshotHeaderBytes);
   SnapshotWriter old;
   for (size_t k = 0; k + trailer < payload.size(); ++k) old.put(uint8_t(payload[k]));
   const std::string old_file = old.finish();
@@ -534,4 +547,48 @@ TEST_CASE("measured marks and table touches survive a snapshot, and a snapshot w
   CHECK(old_back.measured.empty());
   CHECK(old_back.table.empty());
   CHECK(!old_back.done[0].measured_frame);
+}
+
+TEST_CASE("a mark measured through a registration with a bad touch is mended by the next registration that touches it") {
+  RegistrationState s;
+  std::vector<Rejection> rejections;
+  int64_t t = 0;
+  measure_all(s, rejections, t);  // marks 0-3 exactly, in the first pose
+  REQUIRE(s.transform);
+  // The measured frame is the object's moved rigidly: that motion, from the exact first round.
+  std::vector<Vec3> object_points, measured_points;
+  for (uint32_t n = 0; n < 4; ++n) {
+    object_points.push_back(kMarks[n]);
+    measured_points.push_back(s.measured[n].p);
+  }
+  const Result<tracking::RigidTransform> M = tracking::register_rigid(object_points, measured_points);
+  REQUIRE(M.ok());
+  const Vec3 mark4(0.035, 0.03, 0.15);
+  auto error_of_mark4 = [&] { return (s.measured_mark(4)->p - (M->R * mark4 + M->t)).norm(); };
+
+  // Turned: registered on 0, 1 and 2, mark 2 touched 1 mm off; then mark 4 measured, which inherits the tilt.
+  const Eigen::Matrix3d A2 = Eigen::AngleAxisd(0.9, Vec3(0.1, 0.2, 1).normalized()).toRotationMatrix();
+  const Vec3 b2(0.02, -0.04, 0.43);
+  rest_at(s, rejections, t, kMarks[0], CommandKind::MarkMeasured, 0, 30, A2, b2);
+  rest_at(s, rejections, t, kMarks[1], CommandKind::MarkMeasured, 1, 31, A2, b2);
+  rest_at(s, rejections, t, kMarks[2] + Vec3(0.001, 0, 0), CommandKind::MarkMeasured, 2, 32, A2, b2);
+  run(s, rejections, {register_command(t, 33)});
+  rest_at(s, rejections, t, mark4, CommandKind::Measure, 4, 34, A2, b2);
+  REQUIRE(s.measured_mark(4));
+  const double before = error_of_mark4();
+  CHECK(before > 5e-4);
+
+  // Turned again: every mark touched exactly. The rounds refit together put mark 4 nearer where it is.
+  const Eigen::Matrix3d A3 = Eigen::AngleAxisd(-0.6, Vec3(0.2, 0.1, 1).normalized()).toRotationMatrix();
+  const Vec3 b3(-0.03, 0.02, 0.41);
+  for (uint32_t n = 0; n < 4; ++n) rest_at(s, rejections, t, kMarks[n], CommandKind::MarkMeasured, n, 40 + n, A3, b3);
+  rest_at(s, rejections, t, mark4, CommandKind::MarkMeasured, 4, 44, A3, b3);
+  run(s, rejections, {register_command(t, 45)});
+  CHECK(rejections.empty());
+  REQUIRE(s.rounds.size() == 3);
+  CHECK(s.rounds[1].size() == 4);  // the three touched and mark 4 measured
+  CHECK(error_of_mark4() < 0.5 * before);
+  // The latest motion maps a point of the object where the first round's frame has it.
+  const Vec3 point(0.01, -0.02, 0.1);
+  CHECK((s.transform->R * (A3.transpose() * (point - b3)) + s.transform->t - (M->R * point + M->t)).norm() < 2e-4);
 }
