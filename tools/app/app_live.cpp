@@ -29,7 +29,7 @@ Result<std::unique_ptr<AppLive>> AppLive::open(const AppLiveOptions& o) {
   wiimote::Clock clock;
   std::string rig_source = o.rig_path;
   if (o.fake_rig_seed) {
-    auto fake = FakeDrawingRig::create(*o.fake_rig_seed, o.fake_strokes);
+    auto fake = FakeDrawingRig::create(*o.fake_rig_seed, o.fake_strokes, o.fake_measure_marks);
     if (!fake) return R::failure(fake.error());
     app->fake_ = std::move(*fake);
     rig_json = app->fake_->rig_json();
@@ -120,6 +120,8 @@ std::vector<std::string> AppLive::step() {
   } else {
     live_->step();
   }
+  measured_in_view_.clear();
+  for (const MeasuredMark& m : world_.registration.measured) measured_in_view_.push_back(m.p);
   std::vector<std::string> messages;
   std::vector<PadAction> actions;
   actions.swap(pad_actions_);
@@ -154,8 +156,24 @@ std::string AppLive::act(PadAction action) {
       // The pen is lit only while it touches: where it last touched is where the person pointed.
       command(CommandKind::Hole, world_.pen_feedback.pen);
       return "a hole at the face the pen last touched";
+    case PadAction::TouchTable:
+      if (!marks_.empty()) return "the table is touched only to measure marks, and the marks file gives them";
+      command(CommandKind::Table);
+      return "the table touched (" + std::to_string(world_.registration.table.size() + 1) + " of " + std::to_string(kTableTouches) + ")";
     case PadAction::TouchMark: {
-      if (marks_.empty()) return "no marks to touch: give --marks FILE";
+      if (marks_.empty()) {
+        // No marks file: the mark shown is measured, or once measured (and the object has a frame) touched.
+        const RegistrationState& r = world_.registration;
+        const uint32_t mark = uint32_t(shown_mark_);
+        const bool measured = r.transform && r.measured_mark(mark);
+        InputEvent e;
+        e.kind = EventKind::Command;
+        e.command = measured ? CommandKind::MarkMeasured : CommandKind::Measure;
+        e.mark = mark;
+        log_->command(std::move(e));
+        shown_mark_ = (shown_mark_ + 1) % kMeasuredMarkIds;
+        return "mark " + std::to_string(mark) + (measured ? " touched" : " measured");
+      }
       InputEvent e;
       e.kind = EventKind::Command;
       e.command = CommandKind::Mark;
@@ -176,10 +194,11 @@ std::string AppLive::act(PadAction action) {
       return "registering on " + std::to_string(world_.registration.touched.size()) + " mark(s)";
     }
     case PadAction::PreviousMark:
-    case PadAction::NextMark:
-      if (marks_.empty()) return "no marks: give --marks FILE";
-      shown_mark_ = (shown_mark_ + (action == PadAction::NextMark ? 1 : marks_.size() - 1)) % marks_.size();
+    case PadAction::NextMark: {
+      const size_t ids = marks_.empty() ? kMeasuredMarkIds : marks_.size();
+      shown_mark_ = (shown_mark_ + (action == PadAction::NextMark ? 1 : ids - 1)) % ids;
       return "touch mark " + std::to_string(shown_mark_) + " next";
+    }
   }
   return {};
 }
@@ -191,13 +210,37 @@ void AppLive::fill_hud(window::HudData& hud) const {
     hud.live.push_back("next mark: " + std::to_string(shown_mark_) + " of " + std::to_string(marks_.size()) + " at " +
                        millimetres(marks_[shown_mark_]));
     hud.live.push_back("rest the pen on it, press 2 (or M); Home (or R) registers");
+  } else {
+    const RegistrationState& r = world_.registration;
+    std::string ids;
+    for (const MeasuredMark& m : r.measured) ids += (ids.empty() ? "" : ", ") + std::to_string(m.mark);
+    hud.live.push_back("marks measured by touch: " + (ids.empty() ? std::string("none yet") : ids));
+    if (!r.transform) {
+      hud.live.push_back("table: " + std::to_string(r.table.size()) + " of " + std::to_string(kTableTouches) +
+                         " touches (rest the pen on it around the object, press up or T)");
+      hud.live.push_back("mark " + std::to_string(shown_mark_) + ": rest the pen on it, press 2 (or M) to measure; " +
+                         "Home (or R) makes the object's frame");
+    } else if (r.measured_mark(uint32_t(shown_mark_))) {
+      hud.live.push_back("mark " + std::to_string(shown_mark_) + ", measured: press 2 (or M) on it to register on it; Home (or R) registers");
+    } else {
+      hud.live.push_back("mark " + std::to_string(shown_mark_) + ", new: rest the pen on it, press 2 (or M) to measure it");
+    }
   }
   hud.cameras = cameras_;
 }
 
 const std::vector<Vec3>& AppLive::marks_in_view() const {
   static const std::vector<Vec3> none;
-  return world_.registration.transform ? marks_ : none;
+  if (!world_.registration.transform) return none;
+  return marks_.empty() ? measured_in_view_ : marks_;
+}
+
+size_t AppLive::shown_mark() const {
+  if (!marks_.empty()) return shown_mark_;
+  const std::vector<MeasuredMark>& measured = world_.registration.measured;
+  for (size_t k = 0; k < measured.size(); ++k)
+    if (measured[k].mark == shown_mark_) return k;
+  return measured.size();  // not measured yet: none highlighted
 }
 
 Status AppLive::finish() {

@@ -31,6 +31,7 @@ struct AppLiveOptions {
   std::optional<uint64_t> fake_rig_seed;
   int fake_strokes = 0;
   double fake_speed = 1;
+  bool fake_measure_marks = false;  // the fake rig's person measures the marks by touch: no marks file
 };
 
 class AppLive {
@@ -54,7 +55,7 @@ class AppLive {
   // The marks to draw, in the network's frame, and the one to touch next: none before the object is
   // registered, when the network's frame is still the rig's.
   const std::vector<Vec3>& marks_in_view() const;
-  size_t shown_mark() const { return shown_mark_; }
+  size_t shown_mark() const;
   // Whether the fake rig has shown its whole drawing (never with real remotes).
   bool fake_finished() const { return fake_ && fake_->finished(); }
   // Stops the driver, runs every frame left and closes the session's log; the first failed write.
@@ -74,8 +75,9 @@ class AppLive {
   std::unique_ptr<wiimote::Driver> driver_;
   std::optional<SessionWriter> out_;
   std::optional<LiveSession> live_;
-  std::vector<Vec3> marks_;
+  std::vector<Vec3> marks_;  // from the marks file; empty: the marks are measured by touch
   size_t shown_mark_ = 0;
+  std::vector<Vec3> measured_in_view_;  // the marks measured, once the object has a frame
   PadPresses pad_;
   std::vector<PadAction> pad_actions_;  // taken from the log, acted on after the frames ran
   std::array<window::CameraView, 2> cameras_{};

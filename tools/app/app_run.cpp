@@ -50,7 +50,8 @@ const std::vector<std::string> kAppKeys = {
     "Esc             quit",
 };
 const std::vector<std::string> kAppLiveKeys = {
-    "M               the pen rests on the mark shown: touched (logged)",
+    "M               the pen rests on the mark shown: touched, or without a marks file measured (logged)",
+    "T               the pen rests on the table: touched, 3 times before marks are measured (logged)",
     "R               register the object on the marks touched (logged)",
     "N / P           show the next / previous mark",
 };
@@ -401,6 +402,7 @@ int run_app(const AppOptions& a) {
             report("exported " + std::to_string(w.surface.quad_count()) + " surface quads to " + export_path +
                    (w.surface.settled ? "" : " (provisional: the fit was still converging)"));
         } else if (live && e.key == GLFW_KEY_M) report(live->act(PadAction::TouchMark));
+        else if (live && e.key == GLFW_KEY_T) report(live->act(PadAction::TouchTable));
         else if (live && e.key == GLFW_KEY_R) report(live->act(PadAction::Register));
         else if (live && e.key == GLFW_KEY_N) report(live->act(PadAction::NextMark));
         else if (live && e.key == GLFW_KEY_P) report(live->act(PadAction::PreviousMark));

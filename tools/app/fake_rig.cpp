@@ -74,19 +74,20 @@ std::vector<PadPress> pad_presses_for(const std::vector<InputEvent>& commands, s
       case CommandKind::Sharp: action = PadAction::SharpLastCurve; break;
       case CommandKind::Register: action = PadAction::Register; break;
       case CommandKind::Hole: action = PadAction::HoleLastTouched; break;
-      case CommandKind::Table:
+      case CommandKind::Table: action = PadAction::TouchTable; break;
+      case CommandKind::Mark:
       case CommandKind::Measure:
-      case CommandKind::MarkMeasured: continue;  // the pad measures no marks: the app registers on a marks file
-      case CommandKind::Mark: {
-        if (mark_count == 0 || c.mark >= mark_count) continue;
+      case CommandKind::MarkMeasured: {
+        const size_t ids = c.command == CommandKind::Mark ? mark_count : kMeasuredMarkIds;
+        if (ids == 0 || c.mark >= ids) continue;
         // The shorter way round to the mark, the presses ending just before the touch.
-        const size_t forward = (c.mark + mark_count - shown) % mark_count, backward = mark_count - forward;
+        const size_t forward = (c.mark + ids - shown) % ids, backward = ids - forward;
         const bool right = forward <= backward;
         const size_t steps = forward == 0 ? 0 : right ? forward : backward;
         for (size_t k = 0; k < steps; ++k)
           presses.push_back({t - int64_t(steps - k) * kBetweenPressesNs,
                              button_of(right ? PadAction::NextMark : PadAction::PreviousMark)});
-        shown = (c.mark + 1) % mark_count;
+        shown = (c.mark + 1) % ids;
         action = PadAction::TouchMark;
         break;
       }
@@ -96,7 +97,7 @@ std::vector<PadPress> pad_presses_for(const std::vector<InputEvent>& commands, s
   return presses;
 }
 
-Result<std::unique_ptr<FakeDrawingRig>> FakeDrawingRig::create(uint64_t seed, int max_strokes) {
+Result<std::unique_ptr<FakeDrawingRig>> FakeDrawingRig::create(uint64_t seed, int max_strokes, bool measure_marks) {
   using R = Result<std::unique_ptr<FakeDrawingRig>>;
   auto pawn_path = bundled_data_file(kDefaultMesh);
   if (!pawn_path) return R::failure("--fake-rig: " + pawn_path.error());
@@ -104,6 +105,7 @@ Result<std::unique_ptr<FakeDrawingRig>> FakeDrawingRig::create(uint64_t seed, in
   if (!pawn) return R::failure("--fake-rig: " + pawn.error());
   simulation::DrawingOptions options;
   options.max_strokes = max_strokes;
+  options.measure_marks = measure_marks;
   auto placed = simulation::object_frame(pawn->positions, options.height_m);
   if (!placed) return R::failure("--fake-rig: " + placed.error());
   auto network = network_from_mesh({*placed, pawn->face_offsets, pawn->face_vertices, *pawn_path},
@@ -125,7 +127,7 @@ Result<std::unique_ptr<FakeDrawingRig>> FakeDrawingRig::create(uint64_t seed, in
                              {{"address", addresses[1]}, {"role", "camera1"}},
                              {{"address", addresses[2]}, {"role", "pad"}}};
   out->rig_json_ = with_remotes.dump(2) + "\n";
-  out->marks_json_ = marks_to_json(drawing->marks);
+  if (!measure_marks) out->marks_json_ = marks_to_json(drawing->marks);
   out->duration_s_ = drawing->session.stats.duration_s;
   out->remotes_ = std::make_unique<FakeRig>(simulated_blobs_of(drawing->session.events), true,
                                             pad_presses_for(drawing->session.events, drawing->marks.size()));

@@ -34,7 +34,8 @@ struct PadPress {
 inline constexpr int64_t kPadHoldNs = 50'000'000;
 // The presses that give the simulated person's commands (`cmd mark`, `cmd register`, `cmd undo`, ...) on
 // the pad as pad.hpp maps it: a mark is chosen with left / right from the app's shown mark (mark 0 at first,
-// the next one after each touch; `mark_count` marks), then touched with 2 at the command's instant.
+// the next one after each touch; `mark_count` marks), then touched with 2 at the command's instant. Marks
+// measured by touch are chosen so among kMeasuredMarkIds ids; the table is touched with up.
 std::vector<PadPress> pad_presses_for(const std::vector<InputEvent>& commands, size_t mark_count);
 
 // Fake remotes on a fake clock: two cameras showing `blobs` from the instant both run (the simulation's
@@ -73,7 +74,9 @@ class FakeRig {
 class FakeDrawingRig {
  public:
   // `max_strokes`: the drawing stops after this many strokes (0: the whole network).
-  static Result<std::unique_ptr<FakeDrawingRig>> create(uint64_t seed, int max_strokes);
+  // `measure_marks`: the person measures the marks by touch (fire simulate drawing --measure-marks), and
+  // there is no marks file.
+  static Result<std::unique_ptr<FakeDrawingRig>> create(uint64_t seed, int max_strokes, bool measure_marks = false);
 
   FakeRig& remotes() { return *remotes_; }
   // The true cameras as a rig file, with the three remotes' roles; the marks file of the object.

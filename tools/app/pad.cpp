@@ -4,19 +4,20 @@
 
 namespace fire::app {
 
-const std::array<PadBinding, 10>& pad_bindings() {
+const std::array<PadBinding, 11>& pad_bindings() {
   using namespace wiimote;
-  static const std::array<PadBinding, 10> bindings = {{
+  static const std::array<PadBinding, 11> bindings = {{
       {kButtonA, "A", PadAction::CloseBorder, "close the border to its first vertex"},
       {kButtonB, "B", PadAction::Undo, "undo"},
       {kButtonPlus, "+", PadAction::Redo, "redo"},
       {kButtonMinus, "-", PadAction::DeleteLastCurve, "delete the curve drawn last"},
       {kButtonOne, "1", PadAction::SharpLastCurve, "the curve drawn last sharp / smooth"},
-      {kButtonTwo, "2", PadAction::TouchMark, "the pen rests on the mark shown: touched"},
+      {kButtonTwo, "2", PadAction::TouchMark, "the pen rests on the mark shown: touched (without a marks file: measured, or touched once measured)"},
       {kButtonHome, "Home", PadAction::Register, "register the object on the marks touched (3 or more)"},
       {kButtonLeft, "left", PadAction::PreviousMark, "show the previous mark"},
       {kButtonRight, "right", PadAction::NextMark, "show the next mark"},
       {kButtonDown, "down", PadAction::HoleLastTouched, "the face the pen last touched becomes a hole (no surface)"},
+      {kButtonUp, "up", PadAction::TouchTable, "the pen rests on the table: touched (3 times, to measure the marks)"},
   }};
   return bindings;
 }

@@ -16,7 +16,10 @@
 
 namespace fire::app {
 
-enum class PadAction : uint8_t { CloseBorder, Undo, Redo, DeleteLastCurve, SharpLastCurve, TouchMark, Register, PreviousMark, NextMark, HoleLastTouched };
+enum class PadAction : uint8_t { CloseBorder, Undo, Redo, DeleteLastCurve, SharpLastCurve, TouchMark, Register, PreviousMark, NextMark, HoleLastTouched, TouchTable };
+
+// Without a marks file the marks are measured by touch, and the pad shows their ids from 0 to this less one.
+inline constexpr size_t kMeasuredMarkIds = 16;
 
 struct PadBinding {
   uint16_t button = 0;  // a wiimote::kButton* bit
@@ -26,7 +29,7 @@ struct PadBinding {
 };
 
 // The mapping, in the order the help lists it.
-const std::array<PadBinding, 10>& pad_bindings();
+const std::array<PadBinding, 11>& pad_bindings();
 // One help line a binding: "pad A           close the border to its first vertex".
 std::vector<std::string> pad_help_lines();
 

@@ -90,13 +90,17 @@ void add_app_commands(CLI::App& app, Registry& registry) {
                   "--live: the rig file from fire calibrate (the cameras, and the remotes' roles by address)");
   cmd->add_option("--marks", o.live_options.marks_path,
                   "--live: the object's marks (fire-marks JSON, object frame, metres), to register it: the HUD shows "
-                  "the mark to touch next");
+                  "the mark to touch next; without it the marks are measured by touch (the table with pad up or T, "
+                  "then each mark with 2 or M; Home or R makes the object's frame)");
   cmd->add_option("--ir-sensitivity", o.live_options.ir_sensitivity,
                   "--live: the cameras' IR sensitivity, 1 to 5 (the Wii's levels), 6 the high-sensitivity block")
       ->capture_default_str();
   cmd->add_option("--fake-rig", o.live_options.fake_rig_seed,
                   "--live without hardware: three fake remotes (two cameras and the pad) show `fire simulate drawing` "
                   "with this seed, the person pressing the pad for each command; its rig and marks are the simulation's");
+  cmd->add_flag("--fake-measure-marks", o.live_options.fake_measure_marks,
+               "--fake-rig: the simulated person measures the marks by touch (the table, then each mark), as on an object "
+               "nobody modelled: no marks file");
   cmd->add_option("--fake-strokes", o.live_options.fake_strokes,
                   "--fake-rig: the simulated person stops after this many strokes (0: the whole network)")
       ->capture_default_str();

@@ -666,24 +666,43 @@ TEST_CASE("fire app: a script that does not parse is refused before a window ope
   fs::remove_all(dir);
 }
 
+// `fire app --live --fake-rig 7 --fake-strokes 8` with `extra` options under Xvfb, writing a session and a
+// screenshot at the end of live.script into a scratch folder; checked to exit 0 with the validation layers on.
+struct LiveRun {
+  fs::path dir;
+  std::string session, shot;
+  Run app;
+  nlohmann::json json;
+};
+LiveRun run_live(int display, const std::string& name, const std::string& extra) {
+  REQUIRE(has_xvfb());
+  LiveRun r;
+  r.dir = scratch(name);
+  r.session = (r.dir / "live").string();
+  r.shot = (r.dir / "shot.png").string();
+  r.app = run_app(display,
+                  "--live --fake-rig 7 --fake-strokes 8 " + extra + " --size 1200x760 --session " + quote(r.session) +
+                      " --script " + quote(FIRE_WINDOW_TEST_DIR "/live.script") + " --screenshot " + quote(r.shot),
+                  r.dir);
+  INFO("xvfb-run exit: " << r.app.runner_exit << "\nstdout: " << r.app.out << "\nstderr: " << r.app.err);
+  REQUIRE(r.app.exit_code == 0);
+  r.json = nlohmann::json::parse(r.app.out);
+  CHECK(r.json["validation"] == true);
+  return r;
+}
+
 // Issue 12: `fire app --live` on three fake remotes (two cameras showing `fire simulate drawing`, the command
 // pad pressed for each of the simulated person's commands) through the real driver: the pen draws, the pad's
 // presses are the logged commands, the HUD shows the remotes and each camera's view, and the session folder
 // replays to the live world's hash.
 TEST_CASE("fire app --live: fake remotes draw through the driver, the pad gives the commands, the session replays",
           "[app][window][live]") {
-  REQUIRE(has_xvfb());
-  const fs::path dir = scratch("live");
-  const std::string session = (dir / "live").string(), shot = (dir / "shot.png").string();
-  const Run app = run_app(230,
-                          "--live --fake-rig 7 --fake-strokes 8 --fake-speed 6 --snapshot-every 500 --size 1200x760 "
-                          "--session " + quote(session) + " --script " + quote(FIRE_WINDOW_TEST_DIR "/live.script") +
-                              " --screenshot " + quote(shot),
-                          dir);
-  INFO("xvfb-run exit: " << app.runner_exit << "\nstdout: " << app.out << "\nstderr: " << app.err);
-  REQUIRE(app.exit_code == 0);
-  const auto json = nlohmann::json::parse(app.out);
-  CHECK(json["validation"] == true);
+  const LiveRun live = run_live(230, "live", "--fake-speed 6 --snapshot-every 500");
+  const fs::path& dir = live.dir;
+  const std::string &session = live.session, &shot = live.shot;
+  const Run& app = live.app;
+  const nlohmann::json& json = live.json;
+  INFO("stdout: " << app.out << "\nstderr: " << app.err);
   CHECK(json["display_frames"] == 201);
   CHECK(json["session"] == session);
   CHECK(json["registrations"].get<int>() == 2);  // the object registered, turned and registered again
@@ -748,6 +767,61 @@ TEST_CASE("fire app --live: fake remotes draw through the driver, the pad gives 
     CHECK(marks > 40);
     CHECK(next_mark > 40);
   }
+  fs::remove_all(dir);
+}
+
+// Issue 42: without a marks file the fake rig's person measures the marks by touch, with the pad: up on the
+// table three times, 2 on each mark shown (measured at first, touched once measured), Home to register.
+TEST_CASE("fire app --live with no marks file: the pad measures the marks by touch and the object is registered on them",
+          "[app][window][live]") {
+  const LiveRun live = run_live(231, "live_measured", "--fake-measure-marks --fake-speed 12");
+  const fs::path& dir = live.dir;
+  const std::string &session = live.session, &shot = live.shot;
+  const Run& app = live.app;
+  const nlohmann::json& json = live.json;
+  INFO("stdout: " << app.out << "\nstderr: " << app.err);
+  CHECK(json["registrations"].get<int>() >= 2);  // the frame made, then the object turned and registered on measured marks
+  CHECK(json["edges"].get<int>() >= 3);
+  CHECK(app.err.find("pad: the table touched (3 of 3)") != std::string::npos);
+  CHECK(app.err.find("pad: mark 2 measured") != std::string::npos);
+  CHECK(app.err.find("pad: mark 3 touched") != std::string::npos);
+  CHECK(app.err.find("rejected") == std::string::npos);
+
+  const auto log = fire::read_text_file(session + "/input.log");
+  REQUIRE(log);
+  auto count = [&](const std::string& what) {
+    size_t n = 0;
+    for (size_t at = log->find(what); at != std::string::npos; at = log->find(what, at + 1)) ++n;
+    return n;
+  };
+  CHECK(count(" cmd table\n") == 3);
+  CHECK(count(" cmd measure ") >= 5);
+  CHECK(count(" cmd mark ") >= 3);
+  CHECK(log->find(" cmd mark 3\n") != std::string::npos);  // no coordinates: the measured mark
+  CHECK(!fs::exists(session + "/marks.json"));
+  const Run replay = run(quote(FIRE_BINARY) + " replay " + quote(session) + " --hash --measured-marks-out " +
+                             quote((dir / "measured.json").string()),
+                         dir);
+  REQUIRE(replay.exit_code == 0);
+  CHECK(replay.out == json["hash"].get<std::string>() + "\n");
+  CHECK(replay.err.find("registration 1 (line ") != std::string::npos);
+  CHECK(replay.err.find("the object's frame from the table") != std::string::npos);
+  CHECK(fs::exists(dir / "measured.json"));
+
+  // The marks measured are drawn once the object has its frame, the one shown next larger and red (here
+  // under the HUD's translucent panel, so darker: any strong red).
+  auto image = fire::render::read_png(shot);
+  REQUIRE(image);
+  size_t marks = 0, next_mark = 0;
+  for (uint32_t y = 0; y < image->height; ++y)
+    for (uint32_t x = 0; x < image->width; ++x) {
+      const uint8_t* p = image->pixel(x, y);
+      marks += near(p, Palette::mark, 10);
+      next_mark += p[0] > 100 && p[1] * 3 < p[0] && p[2] * 3 < p[0];
+    }
+  INFO("mark pixels " << marks << ", next mark " << next_mark);
+  CHECK(marks > 40);
+  CHECK(next_mark > 40);
   fs::remove_all(dir);
 }
 
