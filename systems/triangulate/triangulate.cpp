@@ -35,6 +35,7 @@ constexpr double kStartAgree_m = 0.004;
 constexpr double kMaxPenSpeed_m_s = 5.0;  // a hand moves the pen no faster
 constexpr double kBridgeSpeed_m_s = 1.0;  // a drawing hand, while both cameras lose the pen, moves it no faster
 constexpr double kSpeedUp_m_s = 1.0;      // a hand speeds the pen up by no more than this from one frame to the next
+constexpr double kRestingSpeed_m_s = 0.05;  // a pen slower than this (filtered) is resting, not drawing
 constexpr double kFollowStep_px = 40;     // the pen's blob moves less than this between two frames of a camera
 // Of the pairs that fit where the pen could be, the nearer wins unless it is worse off its epipolar line
 // than the pen's own pixel noise explains. A light that shone merged with the pen's blob and split from it
@@ -236,6 +237,9 @@ void track_frame(size_t k, const TrackingRig& rig, TriangulateState& s, std::vec
     // evidence of it: a reflection near where the pen vanished fits one ray as well, and would hold a
     // lifted pen down until it is put down elsewhere, joining two strokes. Both cameras take it up again.
     if (!s.down || (s.lost_now && t - s.last_seen_t > static_cast<double>(options.short_gap_us))) return;
+    // Nor, sooner, where the pen was resting when both lost it: it went out at a stroke's end, and a lamp its
+    // blob had merged with in one camera shines on there as a new light.
+    if (s.lost_now && s.filter.derivative.norm() < kRestingSpeed_m_s) return;
     const double gate = reach_m(t - s.last_seen_t, options.short_gap_us, s.filter.derivative.norm());
     const Candidates c0 = maybe_pen(s.cameras[0], k, s.last_seen_t, s.pen_px[0]);
     std::optional<Followed> x =

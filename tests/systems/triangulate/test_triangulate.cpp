@@ -240,6 +240,42 @@ TEST_CASE("a light that shone merged with the pen's blob and split from it is no
   CHECK(off <= merged + 1);
 }
 
+TEST_CASE("a lamp merged with a resting pen's blob, shining on after the pen goes out, does not hold it down") {
+  // As on the pawn's seed 2 measured by touch: the pen rests at a stroke's end where camera 1 sees it beside a
+  // still lamp, one blob with it; it goes out at 1.0 s; camera 1 shows nothing for 40 ms, then the lamp alone,
+  // a few pixels off, whose ray passes within millimetres of the pen. The pen is put down 5 cm away at 1.5 s,
+  // 0.5 s later, within the time one camera may follow it alone: two strokes, as drawn, not one.
+  const Rig rig;
+  constexpr double kRests = 0.6, kOut = 1.0, kDark = 1.04, kDownAgain = 1.5;
+  auto where = [&](double t) -> Vec3 {
+    const Vec3 line(-0.05 + 0.2 * std::min(t, kRests), 0.02, 0.8);
+    return t < kDownAgain ? line : line + Vec3(0, 0.05, 0);
+  };
+  const Vec2 lamp = rig.c1.project(where(kRests)) + Vec2(3, 2);
+  auto lifted = [&](double t) { return t >= kOut && t < kDownAgain; };
+  DeviceStreams s;
+  for (double t = 0.0; t < 2.0; t += 0.010) {
+    if (lifted(t)) push_frame(s.cameras[0], t * 1e6, {});
+    else push_frame(s.cameras[0], t * 1e6, {rig.c0.project(where(t))});
+  }
+  for (double t = 0.005; t < 2.0; t += 0.010) {
+    const Vec2 pen = rig.c1.project(where(t));
+    if (t < kRests - 0.1) push_frame(s.cameras[1], t * 1e6, {pen});
+    else if (t < kOut) push_frame(s.cameras[1], t * 1e6, {0.5 * (pen + lamp)});
+    else if (t < kDark) push_frame(s.cameras[1], t * 1e6, {});
+    else if (lifted(t)) push_frame(s.cameras[1], t * 1e6, {lamp});
+    else push_frame(s.cameras[1], t * 1e6, {pen, lamp});
+  }
+  const SystemRun run = run_system_full(s, rig, 0.0);
+  CHECK(run.track.strokes == 2);
+  // No sample while the pen is out; those of the merged blob lie off by its share of the lamp.
+  for (const PenSample& p : run.track.samples) {
+    const double t = static_cast<double>(p.t_us) * 1e-6;
+    CHECK(!lifted(t));
+    if (t < kRests - 0.1 || t >= kDownAgain) CHECK((p.raw - where(t)).norm() < 1e-4);
+  }
+}
+
 TEST_CASE("a reflection level with the pen in camera 1 is not paired with camera 0's pen as it lights or goes out") {
   const Rig rig;
   // A reflection on the pen's epipolar line in camera 1, 4 % farther along camera 0's ray (3 cm deeper,
