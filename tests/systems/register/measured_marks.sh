@@ -6,7 +6,8 @@
 # and measured marks; and a log that measures nothing, a marks file with too few shared ids and a malformed
 # measuring command are refused in words.
 #   measured_marks.sh FIRE_BINARY WORK_DIR [whole | first-strokes]
-# first-strokes (the sanitizer build): the first 40 strokes, without the surface's distance to the object.
+# first-strokes (the sanitizer build): the first 40 strokes, without fire eval's measures (a refused --align
+# still runs).
 set -euo pipefail
 fire="$1"
 dir="$2"
@@ -39,12 +40,13 @@ grep -q '"frame": "measured"' measured.json || fail "measured.json is not the me
 measured_ids=$(grep -c '"id"' measured.json)
 [ "$measured_ids" -ge 3 ] || fail "$measured_ids marks measured"
 
-aligned=$("$fire" eval d.obj --reference pawn20.obj --align marks.json measured.json)
-unaligned=$("$fire" eval d.obj --reference pawn20.obj)
-echo "aligned: $aligned"
-[ "$(field align_marks "$aligned")" = "$measured_ids" ] || fail "aligned on $(field align_marks "$aligned") marks, not $measured_ids"
-awk -v r="$(field align_residual "$aligned")" 'BEGIN {exit !(r >= 0 && r < 0.001)}' || fail "alignment residual over 1 mm: $aligned"
+# Under the sanitizers (first-strokes) fire eval's sampling takes minutes: the alignment is checked in Release.
 if [ "$extent" = whole ]; then
+  aligned=$("$fire" eval d.obj --reference pawn20.obj --align marks.json measured.json)
+  unaligned=$("$fire" eval d.obj --reference pawn20.obj)
+  echo "aligned: $aligned"
+  [ "$(field align_marks "$aligned")" = "$measured_ids" ] || fail "aligned on $(field align_marks "$aligned") marks, not $measured_ids"
+  awk -v r="$(field align_residual "$aligned")" 'BEGIN {exit !(r >= 0 && r < 0.001)}' || fail "alignment residual over 1 mm: $aligned"
   awk -v a="$(field rms "$aligned")" -v u="$(field rms "$unaligned")" 'BEGIN {exit !(a > 0 && a <= 0.002 && u > 10 * a)}' ||
     fail "aligned rms $(field rms "$aligned"), unaligned $(field rms "$unaligned"): not where the object is"
 fi
