@@ -189,7 +189,8 @@ void make_frame(const InputEvent& e, RegistrationState& s, std::vector<Rejection
   }
   std::vector<Vec3> marks;
   for (const MeasuredMark& m : s.measured) marks.push_back(m.p);
-  if (const Spread spread = spread_of(marks); spread.off_line < kMarkSpacing) {
+  const Spread spread = spread_of(marks);
+  if (spread.off_line < kMarkSpacing) {
     reject("the measured marks lie on a line (the farthest " + format_mm(spread.off_line) + " from it, at least " +
            format_mm(kMarkSpacing) + "): measure a mark off that line");
     return;
@@ -210,7 +211,7 @@ void make_frame(const InputEvent& e, RegistrationState& s, std::vector<Rejection
   R.row(0) = x.transpose();
   R.row(1) = up.cross(x).transpose();
   R.row(2) = up.transpose();
-  const Vec3 centroid = spread_of(marks).centre;
+  const Vec3& centroid = spread.centre;
   const Vec3 origin = centroid - up.dot(centroid - table.centre) * up;
   tracking::RigidTransform T;
   T.R = R;
