@@ -200,6 +200,36 @@ int fan_turn(const Mesh& m, const Fan& fan, uint32_t v) {
   return votes > 0 ? 1 : votes < 0 ? -1 : 0;
 }
 
+// How far around a stroke's end the network's curves say which plane the surface lies in.
+constexpr double kNormalReach = 3 * kSideReach;
+// A view, or a face's loop, at least this cosine off the surface's plane tells the surface's two sides apart.
+constexpr double kSideCosine = 0.1;
+
+// The unsigned normal of the plane the network's curves within kNormalReach of q lie in (the least direction of
+// their spread), if they spread over a patch of surface rather than along one curve. The direction to the camera
+// is the normal only where it looks straight at the surface: on a pawn's head seen from the side it lies within
+// a few degrees of the surface, and a stroke's own noise then decides its side.
+std::optional<Vec3> network_normal(const Mesh& m, const SnapIndex& index, const Vec3& q) {
+  std::vector<SnapHit> hits;
+  index.nearest_per_edge(q, kNormalReach, hits);
+  Vec3 mean = Vec3::Zero();
+  Eigen::Matrix3d moments = Eigen::Matrix3d::Zero();
+  size_t n = 0;
+  for (const SnapHit& h : hits)
+    for (const Vec3& p : m.polyline(h.edge))
+      if ((p - q).norm() <= kNormalReach) {
+        mean += p;
+        moments += p * p.transpose();
+        ++n;
+      }
+  if (n < 3) return std::nullopt;
+  mean /= double(n);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(moments / double(n) - mean * mean.transpose());
+  const Eigen::Vector3d spread = solver.eigenvalues();
+  if (!(spread(1) > 0) || std::sqrt(spread(1)) < kNormalReach / 8 || spread(0) > spread(1) / 4) return std::nullopt;
+  return Vec3(solver.eigenvectors().col(0));
+}
+
 // Whether a stroke leaving the boundary point `end` of face f along `path` (from that end on) goes into f. At a
 // vertex, f's sector lies counter-clockwise from its curve out to its curve in about the fan's normal when the
 // faces turn that way there (`turn`); elsewhere, f lies to the left of its walk about the normal. `normal`: the
@@ -716,15 +746,26 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
               if (v == kNone) return std::nullopt;
               return fan_at(mesh, v, direction_along(path, mesh.vertices.position[v]), *viewpoint);
             };
-            auto normal_at = [&](const CurveEnd& e, std::span<const Vec3> path) {
-              const std::optional<Fan> fan = fan_of(e, path);
-              return fan ? fan->normal : Vec3((*viewpoint - mesh.polyline(e.edge)[e.point]).normalized());
+            // The surface's normal at an end on face f's boundary, toward the camera. Where the camera looks along
+            // the surface, the faces' turn about the outside, where known (`turn` not 0), orients it instead: face f
+            // walks `turn` about it.
+            auto normal_at = [&](const CurveEnd& e, std::span<const Vec3> path, uint32_t f, int turn) {
+              if (const std::optional<Fan> fan = fan_of(e, path)) return fan->normal;
+              const Vec3 q = mesh.polyline(e.edge)[e.point];
+              const Vec3 view = (*viewpoint - q).normalized();
+              const std::optional<Vec3> plane = network_normal(mesh, snap, q);
+              if (!plane) return view;
+              const Vec3 walked = double(turn) * loop_plane(mesh.face_boundary(f)).normal;
+              const Vec3& toward = std::abs(plane->dot(view)) < kSideCosine && std::abs(plane->dot(walked)) >= kSideCosine ? walked : view;
+              return plane->dot(toward) < 0 ? Vec3(-*plane) : *plane;
             };
-            // How many judged ends go into face c, of how many, with the faces turning `turn` about the outside.
-            auto ends_into = [&](const Snap& c, int turn) {
+            // How many judged ends go into face c, of how many, with the faces turning `turn` about the outside (as
+            // supposed, not known, while the part's first split finds it).
+            auto ends_into = [&](const Snap& c, int turn, bool supposed = false) {
               const auto ends = judged_ends(c);
               size_t in = 0;
-              for (const auto& [e, path] : ends) in += goes_into(mesh, c.face, e, path, normal_at(e, path), turn);
+              for (const auto& [e, path] : ends)
+                in += goes_into(mesh, c.face, e, path, normal_at(e, path, c.face, supposed ? 0 : turn), turn);
               return std::pair{in, ends.size()};
             };
             // The way the faces turn: as the part's first split found it; else as the fans at the judged ends say.
@@ -743,7 +784,7 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
                 known != state.outside.end()) {
               turn = known->turn;
             } else if (faces_in(here) == 1) {
-              const auto [in, judged] = ends_into(s, 1);
+              const auto [in, judged] = ends_into(s, 1, true);
               if (in == judged || in == 0) state.outside.push_back({mesh.vertex_id(mesh.tail(mesh.face_loop(s.face)[0])), int8_t(in == 0 ? -1 : 1)});
             } else {
               for (const auto& [e, path] : judged_ends(s))

@@ -251,3 +251,33 @@ TEST_CASE("seen from the cameras, of two faces that hold both ends of a stroke, 
     }
   }
 }
+
+TEST_CASE("seen along the surface, a stroke between two border points splits its face, whatever its samples' millimetre of depth",
+          "[sketch][topology]") {
+  // The square split by an arch seen from above; then, from a camera 4 degrees above the square's plane (a pawn's
+  // head seen from the side), a stroke across the right half's corner, from the bottom curve to the right one. Its
+  // samples dip and rise by a millimetre, as a tracked pen's do: the direction to the camera lies within that of the
+  // surface's plane, so it cannot say which side of the border the stroke leaves on; the curves around its ends can.
+  Log log;
+  square(log);
+  arc(log, {0.05, 0, 0}, {0.05, 0.1, 0}, 0.03);
+  log.event("down");
+  for (int k = 0; k <= 10; ++k) {
+    const double t = k / 10.0;
+    log.pen(0.09 + 0.01 * t, 0.01 * t, -0.001 * std::sin(2 * std::numbers::pi * t));
+  }
+  log.event("up");
+  const Vec3 above(0.05, 0.05, 0.5), along = Vec3(0.095, 0.005, 0) + 10 * Vec3(-1, -1, 0.1);
+  const auto w = replay_seen_from(log, above, 5 * kEventsPerArc, along);
+  INFO(rejections(*w));
+  CHECK(w->rejections.empty());
+  CHECK(w->mesh.face_count() == 3);
+  CHECK(w->mesh.border_loop_count() == 1);
+  // The corner's curve has a face on both sides: it split the right half, not the hole beyond the border.
+  uint32_t corner = kNone;
+  for (uint32_t e = 0; e < w->mesh.edge_slots(); ++e)
+    if (w->mesh.edge_alive(e) && (w->mesh.polyline(e)[w->mesh.edges.point_count[e] / 2] - Vec3(0.095, 0.005, 0)).norm() < 0.003) corner = e;
+  REQUIRE(corner != kNone);
+  CHECK(w->mesh.edges.face[corner][0] != kNone);
+  CHECK(w->mesh.edges.face[corner][1] != kNone);
+}
