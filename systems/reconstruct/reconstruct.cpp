@@ -1,6 +1,7 @@
 #include "systems/reconstruct/reconstruct.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -42,6 +43,7 @@ struct ReconstructionCache {
   std::vector<EdgeSplits> edges;
   std::vector<uint8_t> edge_valid;
   std::vector<double> edge_scale;   // short_curve_scale each entry of `edges` was split with (1: none)
+  std::vector<std::array<double, 2>> edge_reach;  // how far from each end it was taken straight (straight_reach)
   std::vector<uint8_t> edge_redone;  // recomputed by the current update
   // The chain each valid entry of `edges` was split from (oriented members, Sides::members), and the
   // current sides, rebuilt by every update.
@@ -317,6 +319,40 @@ std::vector<Vec3> scaled_polyline(std::span<const Vec3> line, double scale) {
   return out;
 }
 
+// The side `line` with its stretch from its start within `reach` (at most `share` of its length) taken straight
+// (kEndStraightNoises): each sample moves toward the point as far along the stretch's mean direction from the
+// start as it is along the stretch, fully at the start, not at all at the stretch's end (a smoothstep).
+void straighten_start(std::vector<Vec3>& line, double reach, double share) {
+  if (!(reach > 0) || line.size() < 3) return;
+  double length = 0;
+  for (size_t i = 1; i < line.size(); ++i) length += (line[i] - line[i - 1]).norm();
+  reach = std::min(reach, share * length);
+  size_t end = 1;
+  while (end + 1 < line.size() && (line[end] - line[0]).norm() < reach) ++end;
+  if (end < 2) return;
+  std::vector<double> arc(end + 1, 0.0);
+  Eigen::Matrix3d moments = Eigen::Matrix3d::Zero();
+  for (size_t i = 1; i <= end; ++i) {
+    arc[i] = arc[i - 1] + (line[i] - line[i - 1]).norm();
+    moments += (line[i] - line[0]) * (line[i] - line[0]).transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(moments);
+  Vec3 direction = solver.eigenvectors().col(2);
+  if (direction.dot(line[end] - line[0]) < 0) direction = -direction;
+  const double along = direction.dot(line[end] - line[0]);
+  for (size_t i = 1; i < end; ++i) {
+    const double t = arc[i] / arc[end], weight = 1 - t * t * (3 - 2 * t);
+    line[i] += weight * (line[0] + direction * (along * t) - line[i]);
+  }
+}
+
+// How far from a vertex of that valence a noisy side is taken straight (kEndStraightNoises), and the most of
+// the side's length that may be.
+std::pair<double, double> straight_reach(uint32_t valence, double deviation) {
+  const double crowded = std::max(1.0, double(valence) / 4);
+  return {kEndStraightNoises * deviation * crowded, kEndStraightShare * std::min(2.0, crowded)};
+}
+
 // With noisy curves, an interior network vertex where just two curves meet is left out of the base mesh:
 // its two edges become one side of both its faces. Kept, it would be a base vertex of valence 2, and a
 // fit stiff enough for the noise pins that degenerate Catmull-Clark vertex to the turn the curve takes
@@ -530,6 +566,7 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
   c.edges.resize(net.edge_slots());
   c.edge_valid.resize(net.edge_slots(), 0);
   c.edge_scale.resize(net.edge_slots(), 1.0);
+  c.edge_reach.resize(net.edge_slots(), {0, 0});
   c.edge_members.resize(net.edge_slots());
   c.edge_redone.assign(net.edge_slots(), 0);
   c.faces.resize(net.face_slots());
@@ -541,13 +578,14 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
   std::vector<std::vector<FaceSide>> all_sides = face_sides(net, sides, c);
   plan_faces(net, options, sides, straight_turn, all_sides);
   const std::vector<uint32_t> depth = side_depths(net, options, all_sides);
-  std::vector<Vec3> line;
+  std::vector<Vec3> line, straight;
   for (uint32_t e = 0; e < net.edge_slots(); ++e) {
     const std::vector<uint32_t>& members = sides.members[e];
     if (members.empty()) {
       c.edges[e] = {};
       c.edge_valid[e] = 0;
       c.edge_scale[e] = 1;
+      c.edge_reach[e] = {0, 0};
       c.edge_members[e].clear();
       continue;
     }
@@ -565,12 +603,26 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
       }
       side = line;
     }
+    // A noisy interior side leaves its end vertices straight; how far depends on their valence, which the
+    // side's own stamps do not see change.
+    std::array<double, 2> reach{0, 0};
+    if (deviation > 0 && net.edges.face[e][0] != kNone && net.edges.face[e][1] != kNone) {
+      const uint32_t first = members.front(), last = members.back();
+      const uint32_t ends[2] = {net.edges.vertex[first >> 1][first & 1], net.edges.vertex[last >> 1][(last & 1) ^ 1]};
+      for (int k = 0; k < 2; ++k) reach[k] = straight_reach(net.valence(ends[k]), deviation).first;
+      straight.assign(side.begin(), side.end());
+      straighten_start(straight, reach[0], straight_reach(net.valence(ends[0]), deviation).second);
+      std::reverse(straight.begin(), straight.end());
+      straighten_start(straight, reach[1], straight_reach(net.valence(ends[1]), deviation).second);
+      std::reverse(straight.begin(), straight.end());
+      side = straight;
+    }
     const double scale = short_curve_scale(side, deviation);
     const bool fresh = everything || !c.edge_valid[e];
     const bool rejoined = !fresh && c.edge_members[e] != members;
     bool stamped = false;
     for (uint32_t m : members) stamped = stamped || net.edges.changes.changed_since(m >> 1, c.seen);
-    const bool rescaled = scale != c.edge_scale[e];
+    const bool rescaled = scale != c.edge_scale[e] || reach != c.edge_reach[e];
     const bool resplit = !fresh && depth[e] != c.edges[e].depth;
     if (!fresh && !stamped && !rejoined && !rescaled && !resplit) continue;
     if (!fresh && !stamped) ++(rejoined ? c.stats.edges_rejoined : rescaled ? c.stats.edges_rescaled : c.stats.edges_resplit);
@@ -578,6 +630,7 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
                            : split_network_edge(side, depth[e]);
     c.edge_valid[e] = 1;
     c.edge_scale[e] = scale;
+    c.edge_reach[e] = reach;
     c.edge_members[e] = members;
     for (uint32_t m : members) c.edge_redone[m >> 1] = 1;
     ++c.stats.edges_recomputed;

@@ -171,6 +171,17 @@ Sampling fit_targets(double noise);
 // curves stay as drawn: only the surface's polylines (the refine stage's edge splits) change.
 inline constexpr double kChordCurveNoises = 3;
 inline constexpr double kShortCurveNoises = 6;
+// Where a noisy curve leaves a vertex, its first samples point any way within the noise: a tracked pen's start
+// is a millimetre off the vertex it snaps to, and curves that leave a pole of 12 a few degrees apart cross one
+// another there, which folds the surface between them (the simulated pawn's pole and its head's ring). The
+// surface takes each interior side's stretch within kEndStraightNoises deviations of its ends, times the
+// vertex's valence over 4 where more than 4 curves meet, as straight: the samples move onto the line of their
+// mean direction from the vertex, fully at the vertex and blending back to the drawn curve at the stretch's
+// end. A stretch is at most kEndStraightShare of the side's length, twice that at a crowded vertex.
+// Border sides stay as drawn: their turns are the border's corners. perf/notes/quality.md, "A pole's curves
+// taken straight from it".
+inline constexpr double kEndStraightNoises = 6;
+inline constexpr double kEndStraightShare = 0.25;
 // The same measure for one base face, which must be a quad.
 double quad_aspect(const BaseMesh& base, uint32_t face);
 
