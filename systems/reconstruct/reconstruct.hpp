@@ -178,8 +178,8 @@ inline constexpr double kShortCurveNoises = 6;
 // vertex's valence over 4 where more than 4 curves meet, as straight: the samples move onto the line of their
 // mean direction from the vertex, fully at the vertex and blending back to the drawn curve at the stretch's
 // end. A stretch is at most kEndStraightShare of the side's length, twice that at a crowded vertex.
-// Border sides stay as drawn: their turns are the border's corners. perf/notes/quality.md, "A pole's curves
-// taken straight from it".
+// Border sides stay as drawn: their turns are the border's corners. perf/notes/quality.md, "The pawn's pole: a
+// curve dragged through it, and curves crossing where they leave it".
 inline constexpr double kEndStraightNoises = 6;
 inline constexpr double kEndStraightShare = 0.25;
 // The same measure for one base face, which must be a quad.
