@@ -609,12 +609,13 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
     if (deviation > 0 && net.edges.face[e][0] != kNone && net.edges.face[e][1] != kNone) {
       const uint32_t first = members.front(), last = members.back();
       const uint32_t ends[2] = {net.edges.vertex[first >> 1][first & 1], net.edges.vertex[last >> 1][(last & 1) ^ 1]};
-      for (int k = 0; k < 2; ++k) reach[k] = straight_reach(net.valence(ends[k]), deviation).first;
       straight.assign(side.begin(), side.end());
-      straighten_start(straight, reach[0], straight_reach(net.valence(ends[0]), deviation).second);
-      std::reverse(straight.begin(), straight.end());
-      straighten_start(straight, reach[1], straight_reach(net.valence(ends[1]), deviation).second);
-      std::reverse(straight.begin(), straight.end());
+      for (int k = 0; k < 2; ++k) {
+        const auto [distance, share] = straight_reach(net.valence(ends[k]), deviation);
+        reach[k] = distance;
+        straighten_start(straight, distance, share);
+        std::reverse(straight.begin(), straight.end());  // the other end next, then back in order
+      }
       side = straight;
     }
     const double scale = short_curve_scale(side, deviation);

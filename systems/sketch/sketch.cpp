@@ -755,8 +755,10 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
               const Vec3 view = (*viewpoint - q).normalized();
               const std::optional<Vec3> plane = network_normal(mesh, snap, q);
               if (!plane) return view;
-              const Vec3 walked = double(turn) * loop_plane(mesh.face_boundary(f)).normal;
-              const Vec3& toward = std::abs(plane->dot(view)) < kSideCosine && std::abs(plane->dot(walked)) >= kSideCosine ? walked : view;
+              Vec3 toward = view;
+              if (std::abs(plane->dot(view)) < kSideCosine && turn != 0)
+                if (const Vec3 walked = double(turn) * loop_plane(mesh.face_boundary(f)).normal; std::abs(plane->dot(walked)) >= kSideCosine)
+                  toward = walked;
               return plane->dot(toward) < 0 ? Vec3(-*plane) : *plane;
             };
             // How many judged ends go into face c, of how many, with the faces turning `turn` about the outside (as
