@@ -120,12 +120,23 @@ double mean_curve_length(const Mesh& net) {
 
 // The unit direction in which edge e leaves its end v, from v to the polyline's point a fraction
 // kTangentReach of its length along: far enough that a hand's jitter does not turn it, near enough to
-// be the curve's own direction.
-Vec3 leaving_direction(const Mesh& net, uint32_t e, uint32_t v) {
+// be the curve's own direction. A noisy curve (`deviation` > 0, a length) is read from where it leaves the
+// pen's rest at v, and at least kCornerReachNoises deviations from there (kPauseNoises).
+Vec3 leaving_direction(const Mesh& net, uint32_t e, uint32_t v, double deviation = 0) {
   std::vector<Vec3> line(net.polyline(e).begin(), net.polyline(e).end());
   if (net.edges.vertex[e][0] != v) std::reverse(line.begin(), line.end());
+  if (deviation > 0) {
+    const std::vector<double> arc = arc_parameters(line);
+    size_t rest_end = 0;
+    for (size_t i = 1; i < line.size() && arc[i] <= 0.5; ++i)
+      if ((line[i] - line.front()).norm() <= kPauseNoises * deviation) rest_end = i;
+    line.erase(line.begin(), line.begin() + static_cast<std::ptrdiff_t>(rest_end));
+  }
   const std::vector<double> params = arc_parameters(line);
-  const Vec3 d = sample_polyline(line, params, kTangentReach, Sampling::linear) - line.front();
+  Vec3 d = sample_polyline(line, params, kTangentReach, Sampling::linear) - line.front();
+  const double reach = kCornerReachNoises * deviation;
+  for (size_t i = 1; d.norm() < reach && i < line.size() && params[i] <= 0.5; ++i)
+    if ((line[i] - line.front()).norm() >= reach) d = line[i] - line.front();
   return d.normalized();
 }
 
@@ -135,8 +146,10 @@ double turn_degrees(const Vec3& leaving, const Vec3& other_leaving) {
 }
 
 // A border network vertex is a corner of the surface where the border turns by more than
-// `threshold_deg`; where it goes straight on it is a smooth point of the border.
-bool border_corner(const Mesh& net, uint32_t v, double threshold_deg) {
+// `threshold_deg`; where it goes straight on it is a smooth point of the border. Noisy curves are read at the
+// vertex and past the pen's rest there (kPauseNoises), and the smaller turn counts: noise turns a straight
+// border, it does not straighten a corner, and a curve only a few deviations long has no rest to read past.
+bool border_corner(const Mesh& net, uint32_t v, double threshold_deg, double deviation) {
   uint32_t border[2], count = 0;
   for (uint32_t e : net.vertex_edges(v))
     if (used_by_face(net, e) && net.is_border_edge(e)) {
@@ -144,7 +157,11 @@ bool border_corner(const Mesh& net, uint32_t v, double threshold_deg) {
       border[count++] = e;
     }
   if (count != 2) return true;
-  return !(turn_degrees(leaving_direction(net, border[0], v), leaving_direction(net, border[1], v)) <= threshold_deg);
+  auto turn = [&](double rest_deviation) {
+    return turn_degrees(leaving_direction(net, border[0], v, rest_deviation),
+                        leaving_direction(net, border[1], v, rest_deviation));
+  };
+  return !(std::min(turn(0), deviation > 0 ? turn(deviation) : 180.0) <= threshold_deg);
 }
 
 
@@ -603,10 +620,10 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
       }
       side = line;
     }
-    // A noisy interior side leaves its end vertices straight; how far depends on their valence, which the
-    // side's own stamps do not see change.
+    // A noisy side leaves its end vertices straight; how far depends on their valence, which the side's own
+    // stamps do not see change.
     std::array<double, 2> reach{0, 0};
-    if (deviation > 0 && net.edges.face[e][0] != kNone && net.edges.face[e][1] != kNone) {
+    if (deviation > 0) {
       const uint32_t first = members.front(), last = members.back();
       const uint32_t ends[2] = {net.edges.vertex[first >> 1][first & 1], net.edges.vertex[last >> 1][(last & 1) ^ 1]};
       straight.assign(side.begin(), side.end());
@@ -658,8 +675,9 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
 
 // Global numbering, in slot order: network vertices used by faces, then the split points of each edge,
 // then the vertices made inside each face. fire: border vertices turning by more than `corner_turn`
-// degrees are corners.
-BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionCache& c, double corner_turn) {
+// degrees are corners, read on noisy curves of noise `deviation` (a length) past the pen's rests.
+BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionCache& c, double corner_turn,
+                  double deviation) {
   BaseMesh base;
   std::vector<uint32_t> vertex_id(net.vertex_slots(), kNone), edge_first(net.edge_slots(), kNone),
       face_first(net.face_slots(), kNone);
@@ -673,7 +691,8 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
       vertex_id[v] = base.vertex_count();
       base.positions.push_back(net.vertices.position[v]);
       base.vertex_drawn.push_back(1);
-      if (options.method == Method::fire) base.border_corners.push_back(border_corner(net, v, corner_turn) ? 1 : 0);
+      if (options.method == Method::fire)
+        base.border_corners.push_back(border_corner(net, v, corner_turn, deviation) ? 1 : 0);
     }
   for (uint32_t e = 0; e < net.edge_slots(); ++e) {
     if (!c.edge_valid[e]) continue;
@@ -839,7 +858,7 @@ Result<Refined> run_refine(const Mesh& net, const Options& options, Reconstructi
     deviation = curve_noise_deviation(options, c.noise, spread, mean_length);
   }
   update_elements(net, options, c, everything, deviation, kStraightCornerTurn - spread);
-  c.base = assemble(net, options, c, kBorderCornerTurnDegrees + spread);
+  c.base = assemble(net, options, c, kBorderCornerTurnDegrees + spread, deviation);
   c.rebuild_topology = c.rebuild_topology || everything || !same_topology(c, c.base);
   if (options.method == Method::fire && c.fit_built &&
       (weights.fairness != c.fit_fairness || weights.targets != c.fit_targets ||

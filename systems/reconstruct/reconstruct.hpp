@@ -44,6 +44,14 @@ inline constexpr uint32_t kMaxCoonsSteps = 5;
 // (thesis: a vertex where a curve merely goes on is no corner).
 inline constexpr double kBorderCornerTurnDegrees = 30.0;
 inline constexpr double kTangentReach = 0.15;
+// A noisy curve's border turn is read past the pen's rest at the vertex. Where two border strokes meet, the pen
+// rests between them, and a tracked pen drifts a millimetre while it rests: the curve's first dozens of samples
+// jitter within that, and the vertex sits where the rest began, off the line both curves then run along (the
+// simulated pawn's base). So the direction starts at the curve's last sample within kPauseNoises noise
+// deviations of the vertex (in its first half), and reaches at least kCornerReachNoises deviations from there.
+// perf/notes/quality.md, "The pawn's base: the pen's rest at a border corner".
+inline constexpr double kPauseNoises = 3;
+inline constexpr double kCornerReachNoises = 6;
 // fire: a side more than this many times as long as the mean side of a face it borders is split into
 // twice the pieces, again while it is still so much longer, at most kMaxSideDoublings times: the face's
 // quads along it are then not stretched along the curve, and the fit has the base points to follow it
@@ -174,12 +182,13 @@ inline constexpr double kShortCurveNoises = 6;
 // Where a noisy curve leaves a vertex, its first samples point any way within the noise: a tracked pen's start
 // is a millimetre off the vertex it snaps to, and curves that leave a pole of 12 a few degrees apart cross one
 // another there, which folds the surface between them (the simulated pawn's pole and its head's ring). The
-// surface takes each interior side's stretch within kEndStraightNoises deviations of its ends, times the
+// surface takes each side's stretch within kEndStraightNoises deviations of its ends, times the
 // vertex's valence over 4 where more than 4 curves meet, as straight: the samples move onto the line of their
 // mean direction from the vertex, fully at the vertex and blending back to the drawn curve at the stretch's
 // end. A stretch is at most kEndStraightShare of the side's length, twice that at a crowded vertex.
-// Border sides stay as drawn: their turns are the border's corners. perf/notes/quality.md, "The pawn's pole: a
-// curve dragged through it, and curves crossing where they leave it".
+// Border sides too: their corners are read on the drawn curves (kPauseNoises), and a stretch taken straight keeps
+// its side's direction there. perf/notes/quality.md, "The pawn's pole: a curve dragged through it, and curves
+// crossing where they leave it", and "The pawn's base: the pen's rest at a border corner".
 inline constexpr double kEndStraightNoises = 6;
 inline constexpr double kEndStraightShare = 0.25;
 // The same measure for one base face, which must be a quad.

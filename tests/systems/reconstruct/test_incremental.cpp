@@ -213,38 +213,38 @@ TEST_CASE("a noisy curve as short as its noise is taken nearer its chord, and a 
   update(net, options, state, surface);
   check_equals_full_rebuild(net, options, surface);
   CHECK(state.short_curves() == 2);
-  // The surface's polylines lie no farther from their chords than the drawn ones. Interior curves are all taken
-  // straight near their ends (kEndStraightNoises); of the border curves, which stay as drawn, only the short
-  // one (the column's bottom curve; the other short one is interior) lies nearer its chord. The base's drawn
-  // curves come in edge order; every edge of the grid is drawn.
+  // The surface's polylines lie no farther from their chords than the drawn ones. Every curve is taken straight
+  // near its ends (kEndStraightNoises), border curves too, so most border curves lie nearer their chords (only
+  // the short one would, if border curves stayed as drawn). The base's drawn curves come in edge order; every
+  // edge of the grid is drawn.
   const std::vector<double> before = departures(state.base());
   REQUIRE(before.size() == net.edge_count());
   auto border = [&](uint32_t e) { return net.edges.face[e][0] == kNone || net.edges.face[e][1] == kNone; };
-  uint32_t nearer_border = 0, partly = 0;
+  uint32_t border_curves = 0, nearer_border = 0, partly = 0;
   for (uint32_t e = 0; e < net.edge_count(); ++e) {
     const auto line = net.polyline(e);
     const double drawn = farthest_from_chord(line, line.front(), line.back());
     CHECK(before[e] <= drawn);
+    border_curves += border(e);
     if (border(e) && before[e] < drawn) ++nearer_border;
     if (before[e] > 0 && before[e] < drawn) ++partly;
   }
-  CHECK(nearer_border == 1);
+  CHECK(nearer_border > border_curves / 2);
   REQUIRE(partly >= 1);  // a short curve keeps part of its shape, so the move below changes it
 
   // A vertex far from them raised: the curves' mean length, and with it how much of the short curves'
-  // shape the surface takes and how far every interior curve is taken straight, change; so their faces are
-  // redone too: the short border curve's and every interior curve's but the raised vertex's own (redone as
-  // moved).
+  // shape the surface takes and how far every curve is taken straight, change; so their faces are redone too:
+  // every curve's but the raised vertex's own (redone as moved). The border's corners stay where they were.
   const uint32_t far = 3 * 7 + 5;
   const std::vector<uint32_t> at_far = net.vertex_edges(far);
-  uint32_t interior_elsewhere = 0;
+  uint32_t elsewhere = 0;
   for (uint32_t e = 0; e < net.edge_count(); ++e)
-    interior_elsewhere += !border(e) && std::find(at_far.begin(), at_far.end(), e) == at_far.end();
+    elsewhere += std::find(at_far.begin(), at_far.end(), e) == at_far.end();
   net.move_vertex(far, net.vertices.position[far] + Vec3(0, 0, 0.3));
   update(net, options, state, surface);
   CHECK_FALSE(state.last_update().topology_rebuilt);
   CHECK(state.last_update().edges_recomputed > at_far.size());
-  CHECK(state.last_update().edges_rescaled == interior_elsewhere + 1);
+  CHECK(state.last_update().edges_rescaled == elsewhere);
   CHECK(departures(state.base()) != before);
   check_equals_full_rebuild(net, options, surface);
 }

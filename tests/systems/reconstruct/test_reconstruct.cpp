@@ -278,6 +278,48 @@ TEST_CASE("FIRE: a border turn no larger than the noise's own turning is no corn
   CHECK_FALSE(kink_is_corner(net));
 }
 
+TEST_CASE("FIRE: a noisy border's turn is read past the pen's rest at a vertex", "[reconstruct][fire][noise]") {
+  // A 4 x 2 grid of noisy curves. Where two border strokes meet, the pen rests, and the curves' samples there
+  // jitter within a noise deviation of the vertex over a long stretch of their arc (the simulated pawn's base):
+  // read inside that rest, the border would turn any way. The straight bottom's middle (2, 0) stays smooth, and
+  // the grid's corner (0, 0) a corner, with such rests at both.
+  const uint32_t samples = 41, rest = 14;
+  Mesh net = grid_network(4, 2, samples,
+                          [](double x, double y) { return 0.05 * x * y + 0.004 * std::sin(97 * x + 53 * y); });
+  REQUIRE(fit_noise(net) > kExactCurveNoise);
+  // About the deviation the surface reads the noise as (curve_noise_deviation; the curves are 1 long).
+  const double deviation =
+      std::max(fit_noise(net), std::sin(tangent_spread_deg(net) * std::numbers::pi / 180) * kTangentReach);
+  auto is_corner = [&](const Vec3& at) {
+    const BaseMesh b = base_of(net, {Method::fire, 1, 2, Planarity::least_squares});
+    for (uint32_t v = 0; v < b.vertex_count(); ++v)
+      if ((b.positions[v] - at).norm() < 1e-9) return b.border_corners[v] != 0;
+    FAIL("no base vertex at " << at.transpose());
+    return false;
+  };
+  const Vec3 middle = net.vertices.position[2], corner = net.vertices.position[0];
+  REQUIRE(!is_corner(middle));
+  REQUIRE(is_corner(corner));
+  // The rest: the curve's samples nearest the vertex, each a deviation from it, turning a quarter round from one
+  // to the next, in and out of the surface as a hand's tremor would.
+  auto rest_at = [&](uint32_t e, bool at_start) {
+    const uint32_t first = net.edges.point_offset[e];
+    const Vec3 vertex = net.points[at_start ? first : first + samples - 1];
+    for (uint32_t k = 1; k <= rest; ++k) {
+      const double angle = std::numbers::pi / 2 * k;
+      const Vec3 off = deviation * Vec3(0.3 * std::cos(angle), std::sin(angle), 0.5 * std::cos(angle));
+      net.points.set(at_start ? first + k : first + samples - 1 - k, vertex + off);
+    }
+  };
+  rest_at(1, false);  // the bottom's second curve ends at (2, 0)
+  rest_at(2, true);   // its third begins there
+  rest_at(0, true);   // the bottom's first curve begins at (0, 0)
+  rest_at(4 * 3, true);  // and the left border's first curve
+  REQUIRE(net.validate() == "");
+  CHECK_FALSE(is_corner(middle));
+  CHECK(is_corner(corner));
+}
+
 TEST_CASE("FIRE: a straight corner joins its sides only beyond the noise's own turning", "[reconstruct][fire][noise]") {
   // A 4 x 4 grid whose first two bottom faces are one: its bottom runs straight on through (1, 0), a border
   // vertex of valence 2, which the face joins (five base faces for its six corners); (1, 1) is a corner of
