@@ -7,8 +7,8 @@
 #include <functional>
 #include <span>
 
+#include "engine/camera.hpp"
 #include "engine/common.hpp"
-#include "systems/tracking/camera.hpp"
 
 namespace fire::tracking {
 

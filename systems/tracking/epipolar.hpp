@@ -4,8 +4,8 @@
 #include <Eigen/Core>
 #include <span>
 
+#include "engine/camera.hpp"
 #include "engine/common.hpp"
-#include "systems/tracking/camera.hpp"
 
 namespace fire::tracking {
 

@@ -17,12 +17,12 @@
 #include <span>
 #include <vector>
 
+#include "engine/camera.hpp"
 #include "engine/common.hpp"
 #include "engine/input_log.hpp"
 #include "engine/ir_report.hpp"
 #include "engine/session_dir.hpp"
 #include "systems/tracking/calibration.hpp"
-#include "systems/tracking/camera.hpp"
 #include "systems/tracking/signal.hpp"
 #include "systems/tracking/triangulation.hpp"
 

@@ -1,6 +1,6 @@
 #pragma once
 // A 3D point from its two images (thesis 4.3.5 and its successors).
-#include "systems/tracking/camera.hpp"
+#include "engine/camera.hpp"
 
 namespace fire::tracking {
 

@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
+#include "engine/camera.hpp"
 #include "engine/ir_report.hpp"
 #include "platform/render/image.hpp"
-#include "systems/tracking/camera.hpp"
 
 namespace fire::app {
 

@@ -14,7 +14,7 @@
 #include "platform/wiimote/driver.hpp"
 #include "platform/wiimote/fake_remote.hpp"
 #include "platform/wiimote/hidapi_backend.hpp"
-#include "systems/tracking/camera.hpp"
+#include "engine/camera.hpp"
 #include "engine/ir_report.hpp"
 #include "tools/simulation/simulate.hpp"
 #include "tools/app/fake_rig.hpp"

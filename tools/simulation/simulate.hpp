@@ -25,12 +25,12 @@
 #include <string>
 #include <vector>
 
+#include "engine/camera.hpp"
 #include "engine/common.hpp"
 #include "engine/input_log.hpp"
 #include "engine/mesh.hpp"
 #include "engine/polygon_mesh.hpp"
 #include "systems/tracking/calibration.hpp"
-#include "systems/tracking/camera.hpp"
 #include "systems/tracking/track.hpp"
 
 namespace fire::simulation {

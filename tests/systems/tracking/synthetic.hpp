@@ -8,8 +8,8 @@
 #include <random>
 #include <vector>
 
+#include "engine/camera.hpp"
 #include "systems/tracking/calibration.hpp"
-#include "systems/tracking/camera.hpp"
 
 namespace fire::tracking::test {
 

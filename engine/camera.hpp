@@ -1,6 +1,8 @@
 #pragma once
 // Pinhole camera with two-term radial distortion, the model of a Wii Remote IR camera.
 // Pixels follow the device: x right in 0..1023, y down in 0..767.
+// Engine data, so that the simulated rig in platform/ projects with it as the tracking systems do; its
+// types keep the namespace fire::tracking they had in systems/tracking/.
 #include <Eigen/Core>
 
 #include "engine/common.hpp"

@@ -1,4 +1,4 @@
-#include "systems/tracking/camera.hpp"
+#include "engine/camera.hpp"
 
 #include <Eigen/Dense>
 #include <cmath>
