@@ -7,9 +7,9 @@
 #include <numbers>
 #include <numeric>
 
+#include "platform/simulated_rig/simulated_rig_detail.hpp"
 #include "systems/tracking/registration.hpp"
 #include "tools/simulation/drawing_plan.hpp"
-#include "tools/simulation/simulate_detail.hpp"
 
 namespace fire::simulation {
 using namespace tracking;  // the cameras, calibration and tracking this simulation feeds and checks

@@ -1,10 +1,12 @@
-// The truth a simulated session logs, read back, and the tracker's and the calibration's errors against it.
+// The truth a simulated session logs, read back, and the tracker's and the calibration's errors against it; the
+// simulated rig's true cameras as a rig file.
 #include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <numbers>
 
 #include "systems/tracking/registration.hpp"
+#include "systems/tracking/rig_io.hpp"
 #include "tools/simulation/simulate.hpp"
 
 namespace fire::simulation {
@@ -216,6 +218,16 @@ Result<RigErrors> compare_rig(const CalibrationResult& rig, const SessionTruth& 
     e.k1_error[d] = k.k1 - t.k1;
   }
   return e;
+}
+
+Result<std::string> true_rig_json(const RigOptions& o) {
+  Result<SimulatedRig> rig = make_simulated_rig(o);
+  if (!rig) return Result<std::string>::failure(rig.error());
+  CalibrationResult calibrated;
+  calibrated.cam0 = rig->cameras[0];
+  calibrated.cam1 = rig->cameras[1];
+  calibrated.time_offset_us = o.clock_offset_ms * 1e3;
+  return rig_to_json(calibrated);
 }
 
 }  // namespace fire::simulation

@@ -1,12 +1,12 @@
-// The simulated rig end to end on short sessions: deterministic logs, bytes that match the truth,
-// a wand session that calibrates, a sketch session that tracks, and a damaged log that still does.
+// The simulated rig end to end on short sessions: bytes that match the truth, a wand session that calibrates,
+// a sketch session that tracks, and a damaged log that still does (the rig alone: tests/platform/simulated_rig/).
 #include <catch2/catch.hpp>
 #include <algorithm>
 #include <sstream>
 #include <string>
 
 #include "engine/input_log.hpp"
-#include "platform/obj.hpp"
+#include "tests/platform/simulated_rig/sessions.hpp"
 #include "tools/simulation/simulate.hpp"
 #include "systems/tracking/track.hpp"
 #include "systems/triangulate/triangulate.hpp"
@@ -14,25 +14,9 @@
 using namespace fire;
 using namespace fire::tracking;
 using namespace fire::simulation;
+using namespace fire::simulation::test;
 
 namespace {
-
-const PolygonMesh& pawn() {
-  static const PolygonMesh mesh = [] {
-    Result<PolygonMesh> m = read_obj(std::string(FIRE_DATA_DIR) + "/meshes/pawn.obj");
-    REQUIRE(m.ok());
-    return *m;
-  }();
-  return mesh;
-}
-
-
-SketchOptions short_sketch() {
-  SketchOptions s;
-  s.strokes = 3;
-  s.hold_s = 0.6;
-  return s;
-}
 
 // The log as text and read back, as `fire track` sees it.
 InputLog through_text(const std::vector<InputEvent>& events) {
@@ -72,23 +56,6 @@ const Calibrated& calibrated() {
 
 }  // namespace
 
-TEST_CASE("a simulated session is byte-identical for the same seed and options") {
-  RigOptions rig;
-  rig.seed = 3;
-  const WandOptions wand{.duration_s = 2, .length_m = 0.3};
-  const std::string a = format_input_log(simulate_wand(rig, wand)->events);
-  const std::string b = format_input_log(simulate_wand(rig, wand)->events);
-  CHECK(a == b);
-  const std::string s1 = format_input_log(simulate_sketch(rig, short_sketch(), pawn().view())->events);
-  const std::string s2 = format_input_log(simulate_sketch(rig, short_sketch(), pawn().view())->events);
-  CHECK(s1 == s2);
-  RigOptions other = rig;
-  other.seed = 4;
-  CHECK(format_input_log(simulate_wand(other, wand)->events) != a);
-  // The rig follows rig_seed alone: a different noise seed keeps the cameras.
-  CHECK(make_simulated_rig(other)->cameras[1].t == make_simulated_rig(rig)->cameras[1].t);
-}
-
 TEST_CASE("every report holds exactly the rounded images of the true LEDs") {
   RigOptions rig;
   rig.noise_px = 0;
@@ -125,21 +92,6 @@ TEST_CASE("every report holds exactly the rounded images of the true LEDs") {
     ++checked;
   }
   CHECK(checked > 190);
-}
-
-TEST_CASE("options no rig can have are refused with a reason") {
-  RigOptions bad;
-  bad.noise_px = -1;
-  CHECK_FALSE(simulate_wand(bad, WandOptions{}).ok());
-  RigOptions nan_focal;
-  nan_focal.focal_px = std::nan("");
-  CHECK_FALSE(make_simulated_rig(nan_focal).ok());
-  CHECK_FALSE(simulate_wand(RigOptions{}, WandOptions{.duration_s = 0, .length_m = 0.3}).ok());
-  const std::vector<Vec3> flat{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-  const std::vector<uint32_t> offsets{0, 3}, faces{0, 1, 2};
-  const Result<SimulatedSession> s = simulate_sketch(RigOptions{}, short_sketch(), PolygonMeshView{flat, offsets, faces});
-  REQUIRE_FALSE(s.ok());
-  CHECK(s.error().find("flat") != std::string::npos);
 }
 
 TEST_CASE("a 12 s wand session with a 2 % focal error and a 5 ms clock offset calibrates") {

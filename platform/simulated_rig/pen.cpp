@@ -2,7 +2,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "tools/simulation/simulate_detail.hpp"
+#include "platform/simulated_rig/simulated_rig_detail.hpp"
 
 namespace fire::simulation::detail {
 

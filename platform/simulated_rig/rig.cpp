@@ -1,5 +1,5 @@
 // The simulated rig: two Wii Remotes' true cameras and clocks, and both run over a scene into a session of
-// report bytes in host arrival order with the truth beside them (simulate.hpp's time model).
+// report bytes in host arrival order with the truth beside them (simulated_rig.hpp's time model).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -7,11 +7,10 @@
 #include <numbers>
 
 #include "engine/ir_report.hpp"
-#include "systems/tracking/rig_io.hpp"
-#include "tools/simulation/simulate_detail.hpp"
+#include "platform/simulated_rig/simulated_rig_detail.hpp"
 
 namespace fire::simulation {
-using namespace tracking;  // the cameras, calibration and tracking this simulation feeds and checks
+using namespace tracking;  // the camera model (engine/camera.hpp) the rig projects with
 using namespace detail;
 
 namespace {
@@ -329,16 +328,6 @@ Result<SimulatedRig> make_simulated_rig(const RigOptions& o) {
                                 .cx = 512, .cy = 384, .k1 = 0, .k2 = 0};
   }
   return rig;
-}
-
-Result<std::string> true_rig_json(const RigOptions& o) {
-  Result<SimulatedRig> rig = make_simulated_rig(o);
-  if (!rig) return Result<std::string>::failure(rig.error());
-  CalibrationResult calibrated;
-  calibrated.cam0 = rig->cameras[0];
-  calibrated.cam1 = rig->cameras[1];
-  calibrated.time_offset_us = o.clock_offset_ms * 1e3;
-  return rig_to_json(calibrated);
 }
 
 }  // namespace fire::simulation

@@ -1,5 +1,5 @@
 // The wand scene: two LEDs on a bar waved in front of the rig, for calibration.
-#include "tools/simulation/simulate_detail.hpp"
+#include "platform/simulated_rig/simulated_rig_detail.hpp"
 
 namespace fire::simulation {
 using namespace detail;

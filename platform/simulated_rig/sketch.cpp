@@ -3,10 +3,9 @@
 #include <cmath>
 #include <limits>
 
-#include "tools/simulation/simulate_detail.hpp"
+#include "platform/simulated_rig/simulated_rig_detail.hpp"
 
 namespace fire::simulation {
-using namespace tracking;  // the cameras, calibration and tracking this simulation feeds and checks
 using namespace detail;
 
 namespace {

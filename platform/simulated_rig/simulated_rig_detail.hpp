@@ -1,6 +1,7 @@
 #pragma once
-// What the simulator's parts share (internal to tools/simulation): seeded random streams, both cameras run
-// over a scene into a session, the object's triangles, and the pen moving along its strokes.
+// What the simulator's parts share (internal to the simulated rig here and the simulated person of
+// tools/simulation/drawing.cpp): seeded random streams, both cameras run over a scene into a session, the
+// object's triangles, and the pen moving along its strokes.
 #include <Eigen/Geometry>
 #include <array>
 #include <cmath>
@@ -11,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "tools/simulation/simulate.hpp"
+#include "platform/simulated_rig/simulated_rig.hpp"
 
 namespace fire::simulation::detail {
 
