@@ -37,7 +37,7 @@ void SystemTiming::add(int64_t ns) {
   max_ns = std::max(max_ns, ns);
 }
 
-Result<Scheduler> Scheduler::build(std::vector<SystemSpec> systems, Clock clock) {
+Result<Scheduler> Scheduler::build(std::vector<SystemSpec> systems, Clock clock, Clock cpu_clock) {
   for (size_t i = 0; i < systems.size(); ++i) {
     const SystemSpec& s = systems[i];
     for (size_t j = 0; j < i; ++j)
@@ -57,23 +57,28 @@ Result<Scheduler> Scheduler::build(std::vector<SystemSpec> systems, Clock clock)
                                           "', but no later system writes it");
     }
   }
-  return Scheduler(std::move(systems), clock);
+  return Scheduler(std::move(systems), clock, cpu_clock);
 }
 
-Scheduler::Scheduler(std::vector<SystemSpec> systems, Clock clock) : systems_(std::move(systems)), clock_(clock) {
+Scheduler::Scheduler(std::vector<SystemSpec> systems, Clock clock, Clock cpu_clock)
+    : systems_(std::move(systems)), clock_(clock), cpu_clock_(cpu_clock) {
   for (const SystemSpec& s : systems_) {
-    SystemTiming& t = timings_.emplace_back();
-    t.name = s.name();
+    timings_.emplace_back().name = s.name();
+    if (cpu_clock_) cpu_timings_.emplace_back().name = s.name();
   }
 }
 
 void Scheduler::run_frame() {
   const int64_t frame_start = clock_();
+  const int64_t frame_cpu_start = cpu_clock_ ? cpu_clock_() : 0;
   for (size_t i = 0; i < systems_.size(); ++i) {
     const int64_t t0 = clock_();
+    const int64_t cpu0 = cpu_clock_ ? cpu_clock_() : 0;
     systems_[i].run();
+    if (cpu_clock_) cpu_timings_[i].add(cpu_clock_() - cpu0);
     timings_[i].add(clock_() - t0);
   }
+  if (cpu_clock_) frame_cpu_timing_.add(cpu_clock_() - frame_cpu_start);
   frame_timing_.add(clock_() - frame_start);
   ++frames_;
 }

@@ -146,13 +146,17 @@ class Scheduler {
 
   // The systems in frame order; fails, naming the systems and the data, when a read comes after its write
   // without being declared as a read of the previous frame, or a previous-frame read names data that no
-  // later system writes.
-  static Result<Scheduler> build(std::vector<SystemSpec> systems, Clock clock);
+  // later system writes. `clock` times them by the wall; `cpu_clock`, when given, by the thread's CPU time
+  // too, which a busy machine's other work does not inflate.
+  static Result<Scheduler> build(std::vector<SystemSpec> systems, Clock clock, Clock cpu_clock = nullptr);
 
   void run_frame();
   const std::vector<SystemTiming>& timings() const { return timings_; }
   // Timings of the whole frame (all systems together), one sample per frame.
   const SystemTiming& frame_timing() const { return frame_timing_; }
+  // The same by the thread's CPU time; empty (no samples) without a cpu_clock.
+  const std::vector<SystemTiming>& cpu_timings() const { return cpu_timings_; }
+  const SystemTiming& frame_cpu_timing() const { return frame_cpu_timing_; }
   uint64_t frames() const { return frames_; }
   const std::vector<SystemSpec>& systems() const { return systems_; }
   // The frame: one line per system, in order, with what it reads (this frame's and the previous frame's)
@@ -160,11 +164,11 @@ class Scheduler {
   std::string describe() const;
 
  private:
-  Scheduler(std::vector<SystemSpec> systems, Clock clock);
+  Scheduler(std::vector<SystemSpec> systems, Clock clock, Clock cpu_clock);
   std::vector<SystemSpec> systems_;
-  Clock clock_;
-  std::vector<SystemTiming> timings_;
-  SystemTiming frame_timing_{"frame", {}, 0, 0};
+  Clock clock_, cpu_clock_;
+  std::vector<SystemTiming> timings_, cpu_timings_;
+  SystemTiming frame_timing_{"frame", {}, 0, 0}, frame_cpu_timing_{"frame", {}, 0, 0};
   uint64_t frames_ = 0;
 };
 

@@ -40,6 +40,8 @@ expect_error "replay --until-stroke 0 is refused" "until-stroke" "$fire" replay 
 check "replay writes the surface, to each --surface" "'$fire' replay '$src/tools/demo/sketch.log' -o '$tmp/s.fnet' --surface '$tmp/live.obj' --surface '$tmp/live.glb' 2>/dev/null && [ -s '$tmp/live.obj' ]"
 check "the live surface equals a full rebuild" "'$fire' reconstruct '$tmp/s.fnet' -o '$tmp/full.obj' && cmp -s '$tmp/live.obj' '$tmp/full.obj'"
 check "so does its second file" "'$fire' reconstruct '$tmp/s.fnet' -o '$tmp/full.glb' && cmp -s '$tmp/live.glb' '$tmp/full.glb'"
+check "--timings gives each system and the frame by the wall and by the thread's CPU time, and how much faster than drawn" \
+  "'$fire' replay '$src/tools/demo/sketch.log' --timings 2>/dev/null >'$tmp/timings.txt' && [ \$(grep -c '^system .* max .* cpu mean .* max ' '$tmp/timings.txt') -eq 9 ] && grep -q '^log .* s replayed in .* times faster' '$tmp/timings.txt'"
 check "--no-surface skips refine and subdivide" "'$fire' replay '$src/tools/demo/sketch.log' --no-surface --timings 2>/dev/null | grep -q 'surface: level 0, 0 quads'"
 expect_error "--surface with an unknown extension" "unknown surface format" "$fire" replay "$src/tools/demo/sketch.log" --surface "$tmp/x.xyz"
 check "export-network writes one l per edge" "'$fire' export-network '$tmp/demo.fnet' -o '$tmp/demo.obj' && [ \$(grep -c '^l ' '$tmp/demo.obj') -eq 32 ]"

@@ -317,6 +317,40 @@ TEST_CASE("the scheduler keeps per-system samples for mean, p99 and max", "[sche
   CHECK_THAT(s->describe(), Catch::Contains("count: reads -; writes requests"));
 }
 
+int64_t fake_cpu_clock() {
+  static int64_t t = 0;
+  return t += 300;
+}
+
+TEST_CASE("the scheduler times each system by the wall and, given a second clock, by the thread's CPU time", "[scheduler]") {
+  Toy t;
+  std::vector<SystemSpec> systems;
+  systems.push_back(declare_system<Write<&Toy::requests>>(t, "a", [](int&) {}));
+  systems.push_back(declare_system<Read<&Toy::requests>>(t, "b", [](const int&) {}));
+  auto wall_only = Scheduler::build(systems, fake_clock);
+  REQUIRE(wall_only.ok());
+  wall_only->run_frame();
+  CHECK(wall_only->cpu_timings().empty());
+  CHECK(wall_only->frame_cpu_timing().frames == 0);
+  auto both = Scheduler::build(std::move(systems), fake_clock, fake_cpu_clock);
+  REQUIRE(both.ok());
+  for (int i = 0; i < 3; ++i) both->run_frame();
+  REQUIRE(both->cpu_timings().size() == 2);
+  for (size_t i = 0; i < 2; ++i) {
+    const SystemTiming& wall = both->timings()[i];
+    const SystemTiming& cpu = both->cpu_timings()[i];
+    CHECK(cpu.name == wall.name);
+    CHECK(cpu.frames == 3);
+    // Each clock is read once before and once after a system: one step of each.
+    CHECK(wall.max_ns == 1000);
+    CHECK(cpu.max_ns == 300);
+  }
+  // The frame's own reads bracket both systems': five steps of the wall clock, five of the CPU clock.
+  CHECK(both->frame_timing().max_ns == 5000);
+  CHECK(both->frame_cpu_timing().max_ns == 1500);
+  CHECK(both->frame_cpu_timing().frames == 3);
+}
+
 TEST_CASE("the scheduler's samples stay bounded over a long session, mean and max cover every frame", "[scheduler]") {
   Toy t;
   std::vector<SystemSpec> systems;

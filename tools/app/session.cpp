@@ -68,8 +68,8 @@ std::vector<SystemSpec> session_systems(World& w) {
   return systems;
 }
 
-Scheduler make_scheduler(World& world, Scheduler::Clock clock) {
-  auto scheduler = Scheduler::build(session_systems(world), clock);
+Scheduler make_scheduler(World& world, Scheduler::Clock clock, Scheduler::Clock cpu_clock) {
+  auto scheduler = Scheduler::build(session_systems(world), clock, cpu_clock);
   // The order above is fixed in code: a refusal is a programming error, caught by every replay test.
   if (!scheduler) {
     std::fprintf(stderr, "internal error: %s\n", scheduler.error().c_str());

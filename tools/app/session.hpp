@@ -59,8 +59,8 @@ struct World {
 
 // The design card's systems over `world`, in frame order, with their declared reads and writes.
 std::vector<SystemSpec> session_systems(World& world);
-// Builds the scheduler over session_systems(world).
-Scheduler make_scheduler(World& world, Scheduler::Clock clock);
+// Builds the scheduler over session_systems(world), timed by `clock` (and by `cpu_clock` too, when given).
+Scheduler make_scheduler(World& world, Scheduler::Clock clock, Scheduler::Clock cpu_clock = nullptr);
 // Starts frame `index` covering [begin_us, begin_us + kFrameStepUs): the pools stamp what follows with it.
 void begin_frame(World& world, uint64_t index, int64_t begin_us);
 // Called before each frame runs (its events not delivered yet) and after it (before the next one begins,

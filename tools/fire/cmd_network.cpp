@@ -71,9 +71,14 @@ struct ReplayOptions {
   LengthUnit unit = kDefaultExportUnit;
 };
 
-void print_timing(const SystemTiming& t) {
-  std::printf("system %-10s mean %10.1f us  p99 %10.1f us  max %10.1f us  total %9.3f ms\n", t.name.c_str(),
-              t.mean_ns() / 1e3, double(t.percentile_ns(99)) / 1e3, double(t.max_ns) / 1e3, double(t.total_ns) / 1e6);
+// By the wall, then by the thread's CPU time (the same system's, when `cpu` has samples).
+void print_timing(const SystemTiming& t, const SystemTiming& cpu) {
+  std::printf("system %-10s mean %10.1f us  p99 %10.1f us  max %10.1f us  total %9.3f ms", t.name.c_str(), t.mean_ns() / 1e3,
+              double(t.percentile_ns(99)) / 1e3, double(t.max_ns) / 1e3, double(t.total_ns) / 1e6);
+  if (cpu.frames > 0)
+    std::printf("  cpu mean %10.1f us  p99 %10.1f us  max %10.1f us", cpu.mean_ns() / 1e3, double(cpu.percentile_ns(99)) / 1e3,
+                double(cpu.max_ns) / 1e3);
+  std::printf("\n");
 }
 
 // Reopens a session folder (engine/SESSION.md), saying on stderr what recovery dropped and passed over.
@@ -159,6 +164,7 @@ int run_replay(const ReplayOptions& o) {
     }
   std::unique_ptr<World> world;
   std::unique_ptr<Scheduler> scheduler_owner;
+  int64_t replay_started_ns = 0, replayed_ns = 0;  // the frames of a log replayed, by the wall (not a reopened session's)
   // Where rejections' lines are: the log read, or the log of the session written or reopened.
   std::string lines_of = o.log_path;
   if (session_in) {
@@ -207,7 +213,8 @@ int run_replay(const ReplayOptions& o) {
     world->sketch_settings.snap_distance = o.snap;
     world->build_surface = !o.no_surface;
     world->surface_options = o.surface;
-    scheduler_owner = std::make_unique<Scheduler>(make_scheduler(*world, monotonic_ns));
+    scheduler_owner = std::make_unique<Scheduler>(make_scheduler(*world, monotonic_ns, thread_cpu_ns));
+    replay_started_ns = monotonic_ns();
     if (o.session_dir.empty()) {
       replay_headless(*world, *scheduler_owner, progress_hooks(o.progress));
     } else {
@@ -224,6 +231,7 @@ int run_replay(const ReplayOptions& o) {
       }
       lines_of = writer->paths().log();
     }
+    replayed_ns = monotonic_ns() - replay_started_ns;
   }
   Scheduler& scheduler = *scheduler_owner;
   // A replay that showed its progress (--progress, or a terminal once it ran two seconds) ends with a summary line.
@@ -263,8 +271,15 @@ int run_replay(const ReplayOptions& o) {
     std::cerr << o.log_path << ": the surface does not follow the last edit: " << world->surface_build.problem << "\n";
   if (o.timings) {
     std::printf("frames %" PRIu64 " run (frames with no input skipped)\n", scheduler.frames());
-    for (const SystemTiming& t : scheduler.timings()) print_timing(t);
-    print_timing(scheduler.frame_timing());
+    for (size_t i = 0; i < scheduler.timings().size(); ++i)
+      print_timing(scheduler.timings()[i], i < scheduler.cpu_timings().size() ? scheduler.cpu_timings()[i] : SystemTiming{});
+    print_timing(scheduler.frame_timing(), scheduler.frame_cpu_timing());
+    // How much faster than the person drew it: the log's span of time against the replay's by the wall.
+    if (world->log.events.size() > 1 && replayed_ns > 0) {
+      const double drawn_s = double(world->log.events.back().t_us - world->log.events.front().t_us) * 1e-6;
+      std::printf("log %.1f s replayed in %.3f s: %.0f times faster\n", drawn_s, double(replayed_ns) * 1e-9,
+                  drawn_s / (double(replayed_ns) * 1e-9));
+    }
     std::printf("vertices %zu edges %zu faces %zu points %zu; edits %zu applied, %zu rejected\n", m.vertex_count(),
                 m.edge_count(), m.face_count(), m.live_point_count(), world->history.undo_depth(),
                 world->rejections.size());
@@ -360,7 +375,7 @@ void add_network_commands(CLI::App& app, Registry& registry) {
   add_surface_options(*replay, o->surface_args);
   replay->add_flag("--hash", o->hash,
                    "print a 64-bit hash of the final pools and surface (identical on every run and machine)");
-  replay->add_flag("--timings", o->timings, "print per-system timings (mean, p99, max per frame) and final counts");
+  replay->add_flag("--timings", o->timings, "print per-system timings (mean, p99, max per frame), by the wall and by the thread's CPU time, for each system and the whole frame; how many times faster than the log's own span it replayed; and final counts");
   replay->add_option("--snap", o->snap,
                      "snap distance for stroke ends, in model units (a stroke end whose pen sample carries its own "
                      "radius, as a mouse drawing from fire app does, uses that, and lands on a vertex within it)")
