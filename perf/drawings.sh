@@ -13,11 +13,8 @@
 # usage: perf/drawings.sh [FIRE_BINARY]      (default: build/fire)
 # env:   MESHES  space-separated subset (default "pawn rook torus lampshade mug egg box ridge"); SEEDS (default "1 2 3 4 5")
 set -euo pipefail
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-fire="${1:-$here/build/fire}"
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
 meshes_dir="$here/tests/data/meshes"
-tmp="$(mktemp -d)"
-trap 'rm -rf "$tmp"' EXIT
 field() { sed -n "s/.*\"$1\": *\([-+0-9.eE]*\).*/\1/p" "$2" | head -1; }
 crease_error() { local e; e=$(field crease_error_max_deg "$1"); [ -n "$e" ] && printf '%.1f' "$e" || echo -; }
 

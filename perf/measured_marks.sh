@@ -10,11 +10,8 @@
 # usage: perf/measured_marks.sh [FIRE_BINARY]   (default: build/fire)
 # env:   MESH (default pawn), SEEDS (default "1 2 3 4 5")
 set -euo pipefail
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-fire="${1:-$here/build/fire}"
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
 mesh="$here/tests/data/meshes/${MESH:-pawn}.obj"
-tmp="$(mktemp -d)"
-trap 'rm -rf "$tmp"' EXIT
 field() { sed -n "s/.*\"$1\": *\([-+0-9.eE]*\).*/\1/p" "$2" | head -1; }
 
 "$fire" simulate wand -o "$tmp/wand.log" >/dev/null

@@ -17,8 +17,7 @@
 #        CORRELATION=L    correlation length of the "c" noise, percent of the mean control edge (default 50)
 #        RECONSTRUCT_ARGS extra options for every `fire reconstruct` (e.g. "--levels 4")
 set -u
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-fire="${1:-$here/build/fire}"
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
 baseline="${BASELINE:-}"
 meshes_dir="$here/tests/data/meshes"
 repeat="${REPEAT:-3}"
@@ -34,7 +33,6 @@ notes=()  # failures, printed under the tables
 [ -z "$baseline" ] || [ -x "$baseline" ] || { echo "perf/quality.sh: BASELINE=$baseline is not an executable" >&2; exit 2; }
 command -v python3 >/dev/null || { echo "perf/quality.sh: needs python3 for perf/folds.py" >&2; exit 2; }
 
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 field() { sed -n "s/.*\"$1\":\([-+0-9.eEinf]*\).*/\1/p" "$2"; }
 folds() { sed -n "s/.*\"$1\": \([-0-9.]*\).*/\1/p" "$2"; }
 fmt() { [ -n "$1" ] && awk -v x="$1" 'BEGIN { printf "%.2e", x }' || printf 'n/a'; }

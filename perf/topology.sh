@@ -7,11 +7,8 @@
 # usage: perf/topology.sh [FIRE_BINARY]      (default: build/fire)
 # env:   MESHES   space-separated subset (default "lampshade mug egg torus")
 set -euo pipefail
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-fire="${1:-$here/build/fire}"
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
 meshes_dir="$here/tests/data/meshes"
-tmp="$(mktemp -d)"
-trap 'rm -rf "$tmp"' EXIT
 field() { sed -n "s/.*\"$1\":\([-+0-9.eE]*\).*/\1/p" "$tmp/eval.json"; }
 echo "| mesh | Euler characteristic / border loops, surface | the same, reference | rms | hausdorff |"
 echo "|---|---|---|---|---|"

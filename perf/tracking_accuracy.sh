@@ -12,12 +12,10 @@
 # usage: perf/tracking_accuracy.sh [FIRE_BINARY]      (default: build/fire)
 # env:   SEEDS   space-separated seeds (default "1 2 3 4 5"); each seed is both --seed and --rig-seed
 set -u
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-fire="${1:-$here/build/fire}"
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
 read -r -a seeds <<<"${SEEDS:-1 2 3 4 5}"
 [ -x "$fire" ] || { echo "perf/tracking_accuracy.sh: $fire not found; build it first (cmake --build build --target fire)" >&2; exit 2; }
 
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 field() { sed -n "s/.*\"$1\":\([-+0-9.eE]*\)[,}].*/\1/p" <<<"$2"; }
 fmt() { [ -n "$1" ] && awk -v x="$1" -v d="${2:-3}" 'BEGIN { printf "%.*f", d, x }' || printf 'n/a'; }
 # PASS or FAIL for value <= limit (a missing value fails).

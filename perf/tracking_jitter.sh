@@ -9,13 +9,11 @@
 # usage: perf/tracking_jitter.sh [FIRE_BINARY]      (default: build/fire)
 # env:   JITTERS (default "0.3 1 2.5 4 6"), BURSTS (default "0 0.1"), SEED (default 1)
 set -u
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-fire="${1:-$here/build/fire}"
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
 read -r -a jitters <<<"${JITTERS:-0.3 1 2.5 4 6}"
 read -r -a bursts <<<"${BURSTS:-0 0.1}"
 seed="${SEED:-1}"
 [ -x "$fire" ] || { echo "perf/tracking_jitter.sh: $fire not found; build it first (cmake --build build --target fire)" >&2; exit 2; }
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 field() { sed -n "s/.*\"$1\":\([-+0-9.eE]*\)[,}].*/\1/p" <<<"$2"; }
 fmt() { [ -n "$1" ] && awk -v x="$1" 'BEGIN { printf "%.2f", x }' || printf 'n/a'; }
 
