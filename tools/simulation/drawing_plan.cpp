@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "engine/input_log.hpp"
+#include "engine/text.hpp"
 
 namespace fire::simulation {
 using namespace tracking;  // the cameras, calibration and tracking this simulation feeds and checks
@@ -565,10 +566,18 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
           }
         }
     }
-    if (!best)
-      return Status::failure("part of the first border loop of " +
-                             (parts->size() > 1 ? "part " + std::to_string(index + 1) + " of the network" : std::string("the network")) +
-                             " is seen whole by both cameras in no pose (try another --tilt or --turns)");
+    const std::string loop_name = "the first border loop of " +
+                                  (parts->size() > 1 ? "part " + std::to_string(index + 1) + " of the network" : std::string("the network"));
+    if (!best) return Status::failure("part of " + loop_name + " is seen whole by both cameras in no pose (try another --tilt or --turns)");
+    // A stroke a tracked pen cannot draw is taken for a touch, and the border would never be drawn.
+    for (const Chain& c : best_strokes)
+      if (chain_length(net, c) < kShortestStroke) {
+        const Vec3& a = net.vertices[chain_start(net, c)];
+        return Status::failure(loop_name + " (through (" + format_double(a.x()) + ", " + format_double(a.y()) + ", " +
+                               format_double(a.z()) + "), " + format_mm(chain_length(net, part.first_loop)) +
+                               " round) has a stroke " + format_mm(chain_length(net, c)) + " long, under the " +
+                               format_mm(kShortestStroke) + " a tracked pen draws");
+      }
     for (size_t k = 0; k < best_strokes.size(); ++k) {
       if (steps.empty() || best->second[k] != steps.back().pose) steps.push_back({PlanStep::Register, best->second[k], {}});
       steps.push_back({PlanStep::Stroke, best->second[k], chain_points(net, best_strokes[k])});
