@@ -17,11 +17,12 @@
 #include <vector>
 
 #include "engine/common.hpp"
+#include "engine/ir_report.hpp"
 
 namespace fire {
 
-// The frame step: 100 Hz, the Wii Remote's report rate.
-inline constexpr int64_t kFrameStepUs = 10'000;
+// The frame step: one frame per report of a Wii Remote.
+inline constexpr int64_t kFrameStepUs = kReportPeriodUs;
 
 // The fixed step a frame covers on the input log's clock.
 struct FrameTime {
