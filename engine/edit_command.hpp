@@ -11,7 +11,7 @@ namespace fire {
 
 // Where a curve ends: a polyline point of an edge. Point 0 and the last point are the edge's vertices.
 struct CurveEnd {
-  uint32_t edge = kNone;
+  EdgeIndex edge;
   uint32_t point = 0;
 };
 
@@ -23,19 +23,19 @@ enum class EditKind : uint8_t { StartBorder, AppendBorder, CloseBorder, SplitFac
 struct Crossing {
   CurveEnd at;           // the crossed curve's polyline point (a vertex at its first or last point) where the stroke is cut
   uint32_t point = 0;    // the stroke's point there, an index into EditCommand::points: the pieces either side share it
-  uint32_t face = kNone; // the face the stroke runs into after the crossing
+  FaceIndex face;        // the face the stroke runs into after the crossing
 };
 
 struct EditCommand {
   EditKind kind = EditKind::StartBorder;
   std::vector<Vec3> points;  // the new curve's polyline (the border and split kinds)
-  uint32_t face = kNone;     // SplitFace: the face the curve crosses; MakeHole: the face that becomes a hole;
+  FaceIndex face;            // SplitFace: the face the curve crosses; MakeHole: the face that becomes a hole;
                              // CrossCurves: the face the stroke starts in
   CurveEnd start, end;       // SplitFace: where the curve starts and ends on that face's boundary; SplitHole: on
                              // one border loop, whose hole the curve crosses; JoinBorders: on two border loops;
                              // CrossCurves: on the boundaries of the first and the last face it runs through
   std::vector<Crossing> crossings;  // CrossCurves: in stroke order, at least one
-  uint32_t edge = kNone;     // DeleteCurve, ToggleSharp (sharp becomes smooth, smooth sharp); ExtendChain and the
+  EdgeIndex edge;            // DeleteCurve, ToggleSharp (sharp becomes smooth, smooth sharp); ExtendChain and the
                              // kinds that split (SplitFace, SplitHole, JoinBorders, CrossCurves): the last piece of
                              // the pending chain the stroke goes on from (kNone: none; points then hold the whole
                              // chain and the stroke, from where the chain began)

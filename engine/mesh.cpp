@@ -64,29 +64,29 @@ size_t Mesh::edge_count() const { return count_alive(edges.flags); }
 size_t Mesh::face_count() const { return count_alive(faces.flags); }
 size_t Mesh::live_point_count() const {
   size_t n = 0;
-  for (uint32_t e = 0; e < edge_slots(); ++e)
+  for (EdgeIndex e{0}; e < edge_slots(); ++e)
     if (edge_alive(e)) n += edges.point_count[e];
   return n;
 }
 
-std::vector<uint32_t> Mesh::vertex_edges(uint32_t v) const {
+std::vector<EdgeIndex> Mesh::vertex_edges(VertexIndex v) const {
   FIRE_ASSERT(vertex_alive(v), "a dead vertex's edge list is another vertex's");
-  std::vector<uint32_t> out;
-  for (uint32_t e = vertices.first_edge[v]; e != kNone;) {
+  std::vector<EdgeIndex> out;
+  for (EdgeIndex e{vertices.first_edge[v]}; e != kNone;) {
     out.push_back(e);
-    e = edges.next[e][edges.vertex[e][0] == v ? 0 : 1];
+    e = EdgeIndex{edges.next[e][edges.vertex[e][0] == v ? 0 : 1]};
   }
   return out;
 }
 
-uint32_t Mesh::valence(uint32_t v) const {
+uint32_t Mesh::valence(VertexIndex v) const {
   FIRE_ASSERT(vertex_alive(v), "a dead vertex has no valence");
   uint32_t n = 0;
   for (uint32_t e = vertices.first_edge[v]; e != kNone; e = edges.next[e][edges.vertex[e][0] == v ? 0 : 1]) ++n;
   return n;
 }
 
-uint32_t Mesh::loop_position(uint32_t f, uint32_t e) const {
+uint32_t Mesh::loop_position(FaceIndex f, EdgeIndex e) const {
   FIRE_ASSERT(face_alive(f), "a dead face's loop is stale");
   auto loop = face_loop(f);
   for (uint32_t k = 0; k < loop.size(); ++k)
@@ -94,14 +94,15 @@ uint32_t Mesh::loop_position(uint32_t f, uint32_t e) const {
   return kNone;
 }
 
-std::vector<uint32_t> Mesh::border_loop(uint32_t e) const {
-  auto one_face = [&](uint32_t g) { return edge_alive(g) && is_border_edge(g) && !is_loose_edge(g); };
+std::vector<OrientedEdge> Mesh::border_loop(EdgeIndex e) const {
+  auto one_face = [&](EdgeIndex g) { return edge_alive(g) && is_border_edge(g) && !is_loose_edge(g); };
   if (!one_face(e)) return {};
-  std::vector<uint32_t> loop{hole_side(e)};
+  std::vector<OrientedEdge> loop{hole_side(e)};
   for (;;) {
-    const uint32_t v = head(loop.back());
-    uint32_t next = kNone, border_curves = 0;
-    for (uint32_t g : vertex_edges(v)) {
+    const VertexIndex v = head(loop.back());
+    OrientedEdge next;
+    uint32_t border_curves = 0;
+    for (EdgeIndex g : vertex_edges(v)) {
       if (!one_face(g)) continue;
       ++border_curves;
       if (g != edge_of(loop.back())) next = hole_side(g);
@@ -114,25 +115,25 @@ std::vector<uint32_t> Mesh::border_loop(uint32_t e) const {
 }
 
 bool Mesh::border_in_progress() const {
-  for (uint32_t e = 0; e < edge_slots(); ++e)
+  for (EdgeIndex e{0}; e < edge_slots(); ++e)
     if (edge_alive(e) && is_loose_edge(e) && !is_waiting_bridge(e) && !is_pending(e)) return true;
   return false;
 }
 
 size_t Mesh::pending_piece_count() const {
   size_t n = 0;
-  for (uint32_t e = 0; e < edge_slots(); ++e) n += edge_alive(e) && is_pending(e);
+  for (EdgeIndex e{0}; e < edge_slots(); ++e) n += edge_alive(e) && is_pending(e);
   return n;
 }
 
-std::vector<std::vector<uint32_t>> Mesh::pending_chains() const {
-  std::vector<std::vector<uint32_t>> chains;
-  for (uint32_t e = 0; e < edge_slots(); ++e) {
-    if (!edge_alive(e) || !is_pending(e) || valence(edges.vertex[e][0]) != 1) continue;  // a chain's first piece
-    std::vector<uint32_t> chain{e};
+std::vector<std::vector<EdgeIndex>> Mesh::pending_chains() const {
+  std::vector<std::vector<EdgeIndex>> chains;
+  for (EdgeIndex e{0}; e < edge_slots(); ++e) {
+    if (!edge_alive(e) || !is_pending(e) || valence(VertexIndex{edges.vertex[e][0]}) != 1) continue;  // a chain's first piece
+    std::vector<EdgeIndex> chain{e};
     for (bool more = true; more && chain.size() <= edge_slots();) {
       more = false;
-      for (uint32_t g : vertex_edges(edges.vertex[chain.back()][1]))
+      for (EdgeIndex g : vertex_edges(VertexIndex{edges.vertex[chain.back()][1]}))
         if (g != chain.back() && is_pending(g) && edges.vertex[g][0] == edges.vertex[chain.back()][1]) {
           chain.push_back(g);
           more = true;
@@ -146,17 +147,17 @@ std::vector<std::vector<uint32_t>> Mesh::pending_chains() const {
 
 size_t Mesh::pending_bridge_count() const {
   size_t n = 0;
-  for (uint32_t e = 0; e < edge_slots(); ++e) n += edge_alive(e) && is_waiting_bridge(e);
+  for (EdgeIndex e{0}; e < edge_slots(); ++e) n += edge_alive(e) && is_waiting_bridge(e);
   return n;
 }
 
 size_t Mesh::border_loop_count() const {
   std::vector<uint8_t> walked(edge_slots(), 0);
   size_t loops = 0;
-  for (uint32_t e = 0; e < edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < edge_slots(); ++e) {
     if (walked[e] || !edge_alive(e) || !is_border_edge(e) || is_loose_edge(e)) continue;
-    const std::vector<uint32_t> loop = border_loop(e);
-    for (uint32_t oe : loop) walked[edge_of(oe)] = 1;
+    const std::vector<OrientedEdge> loop = border_loop(e);
+    for (OrientedEdge oe : loop) walked[edge_of(oe)] = 1;
     loops += loop.empty() ? 0 : 1;
   }
   return loops;
@@ -173,10 +174,10 @@ LoopPlane loop_plane(std::span<const Vec3> loop) {
   return plane;
 }
 
-std::vector<Vec3> Mesh::face_boundary(uint32_t f) const {
+std::vector<Vec3> Mesh::face_boundary(FaceIndex f) const {
   FIRE_ASSERT(face_alive(f), "a dead face's loop is stale");
   std::vector<Vec3> out;
-  for (uint32_t oe : face_loop(f)) {
+  for (OrientedEdge oe : face_loop(f)) {
     auto line = polyline(edge_of(oe));
     if (is_reversed(oe)) out.insert(out.end(), line.rbegin(), line.rend() - 1);
     else out.insert(out.end(), line.begin(), line.end() - 1);
@@ -208,9 +209,9 @@ void Mesh::release(uint32_t slot, Column<uint32_t>& free_list, Column<uint32_t>&
   changes.touch(slot, frame_);
 }
 
-uint32_t Mesh::add_vertex(const Vec3& p, uint8_t extra_flags) {
+VertexIndex Mesh::add_vertex(const Vec3& p, uint8_t extra_flags) {
   bool fresh = vertices.free_list.empty();
-  uint32_t v = allocate(vertices.free_list, vertices.generation, vertices.flags, vertices.changes);
+  const VertexIndex v{allocate(vertices.free_list, vertices.generation, vertices.flags, vertices.changes)};
   if (fresh) {
     vertices.position.push_back(p);
     vertices.first_edge.push_back(kNone);
@@ -222,7 +223,7 @@ uint32_t Mesh::add_vertex(const Vec3& p, uint8_t extra_flags) {
   return v;
 }
 
-void Mesh::link_edge(uint32_t e) {
+void Mesh::link_edge(EdgeIndex e) {
   auto next = edges.next[e];
   for (int s = 0; s < 2; ++s) {
     uint32_t v = edges.vertex[e][s];
@@ -233,7 +234,7 @@ void Mesh::link_edge(uint32_t e) {
   edges.next.set(e, next);
 }
 
-void Mesh::unlink_edge(uint32_t e) {
+void Mesh::unlink_edge(EdgeIndex e) {
   for (int s = 0; s < 2; ++s) {
     uint32_t v = edges.vertex[e][s];
     vertices.changes.touch(v, frame_);
@@ -255,11 +256,11 @@ void Mesh::unlink_edge(uint32_t e) {
   }
 }
 
-uint32_t Mesh::add_edge(uint32_t v0, uint32_t v1, std::span<const Vec3> polyline) {
+EdgeIndex Mesh::add_edge(VertexIndex v0, VertexIndex v1, std::span<const Vec3> polyline) {
   FIRE_ASSERT(polyline.size() >= 2, "a polyline joins its two vertices: it has at least 2 points");
   FIRE_ASSERT(vertex_alive(v0) && vertex_alive(v1), "an edge joins live vertices");
   bool fresh = edges.free_list.empty();
-  uint32_t e = allocate(edges.free_list, edges.generation, edges.flags, edges.changes);
+  const EdgeIndex e{allocate(edges.free_list, edges.generation, edges.flags, edges.changes)};
   uint32_t offset = static_cast<uint32_t>(points.size());
   for (size_t i = 0; i < polyline.size(); ++i) {
     if (i == 0) points.push_back(vertices.position[v0]);
@@ -285,10 +286,11 @@ uint32_t Mesh::add_edge(uint32_t v0, uint32_t v1, std::span<const Vec3> polyline
   return e;
 }
 
-bool Mesh::loop_fits(std::span<const uint32_t> loop, uint32_t f) const {
+bool Mesh::loop_fits(std::span<const OrientedEdge> loop, FaceIndex f) const {
   if (loop.empty()) return false;
   for (size_t k = 0; k < loop.size(); ++k) {
-    const uint32_t oe = loop[k], e = edge_of(oe);
+    const OrientedEdge oe = loop[k];
+    const EdgeIndex e = edge_of(oe);
     if (!edge_alive(e)) return false;
     const uint32_t side = edges.face[e][is_reversed(oe)];
     if (side != kNone && side != f) return false;
@@ -299,8 +301,8 @@ bool Mesh::loop_fits(std::span<const uint32_t> loop, uint32_t f) const {
   return true;
 }
 
-void Mesh::set_loop_sides(std::span<const uint32_t> loop, uint32_t face) {
-  for (uint32_t oe : loop) {
+void Mesh::set_loop_sides(std::span<const OrientedEdge> loop, FaceIndex face) {
+  for (OrientedEdge oe : loop) {
     auto fs = edges.face[edge_of(oe)];
     fs[is_reversed(oe)] = face;
     edges.face.set(edge_of(oe), fs);
@@ -308,18 +310,18 @@ void Mesh::set_loop_sides(std::span<const uint32_t> loop, uint32_t face) {
   }
 }
 
-uint32_t Mesh::append_loop(std::span<const uint32_t> loop, uint32_t face) {
+uint32_t Mesh::append_loop(std::span<const OrientedEdge> loop, FaceIndex face) {
   const uint32_t offset = static_cast<uint32_t>(face_edges.size());
-  for (uint32_t oe : loop) face_edges.push_back(oe);
+  for (OrientedEdge oe : loop) face_edges.push_back(oe);
   face_edge_changes.note(offset, static_cast<uint32_t>(face_edges.size()), frame_);
   set_loop_sides(loop, face);
   return offset;
 }
 
-uint32_t Mesh::add_face(std::span<const uint32_t> loop) {
-  if (!loop_fits(loop, kNone)) return kNone;
+FaceIndex Mesh::add_face(std::span<const OrientedEdge> loop) {
+  if (!loop_fits(loop, FaceIndex{})) return FaceIndex{};
   const bool fresh = faces.free_list.empty();
-  const uint32_t f = allocate(faces.free_list, faces.generation, faces.flags, faces.changes);
+  const FaceIndex f{allocate(faces.free_list, faces.generation, faces.flags, faces.changes)};
   const uint32_t offset = append_loop(loop, f);
   if (fresh) {
     faces.edge_offset.push_back(offset);
@@ -331,36 +333,36 @@ uint32_t Mesh::add_face(std::span<const uint32_t> loop) {
   return f;
 }
 
-bool Mesh::set_face_loop(uint32_t f, std::span<const uint32_t> loop) {
+bool Mesh::set_face_loop(FaceIndex f, std::span<const OrientedEdge> loop) {
   FIRE_ASSERT(face_alive(f), "only a live face keeps its slot and handle");
   if (!loop_fits(loop, f)) return false;
-  set_loop_sides(face_loop(f), kNone);
+  set_loop_sides(face_loop(f), FaceIndex{});
   faces.edge_offset.set(f, append_loop(loop, f));
   faces.edge_count.set(f, static_cast<uint32_t>(loop.size()));
   faces.changes.touch(f, frame_);
   return true;
 }
 
-void Mesh::remove_face(uint32_t f) {
+void Mesh::remove_face(FaceIndex f) {
   FIRE_ASSERT(face_alive(f), "a face is removed once");
-  set_loop_sides(face_loop(f), kNone);
+  set_loop_sides(face_loop(f), FaceIndex{});
   release(f, faces.free_list, faces.generation, faces.flags, faces.changes);
 }
 
-void Mesh::remove_edge(uint32_t e) {
+void Mesh::remove_edge(EdgeIndex e) {
   FIRE_ASSERT(edge_alive(e), "an edge is removed once");
   FIRE_ASSERT(edges.face[e][0] == kNone && edges.face[e][1] == kNone, "the faces of an edge go before it");
   unlink_edge(e);
   release(e, edges.free_list, edges.generation, edges.flags, edges.changes);
 }
 
-void Mesh::remove_vertex(uint32_t v) {
+void Mesh::remove_vertex(VertexIndex v) {
   FIRE_ASSERT(vertex_alive(v), "a vertex is removed once");
   FIRE_ASSERT(vertices.first_edge[v] == kNone, "the edges of a vertex go before it");
   release(v, vertices.free_list, vertices.generation, vertices.flags, vertices.changes);
 }
 
-void Mesh::set_edge_flag(uint32_t e, uint8_t flag, bool on) {
+void Mesh::set_edge_flag(EdgeIndex e, uint8_t flag, bool on) {
   FIRE_ASSERT(edge_alive(e), "a dead edge's flags hold its liveness");
   FIRE_ASSERT(!(flag & kAlive), "liveness is the pools' to set");
   uint8_t f = edges.flags[e];
@@ -368,11 +370,11 @@ void Mesh::set_edge_flag(uint32_t e, uint8_t flag, bool on) {
   edges.changes.touch(e, frame_);
 }
 
-void Mesh::move_vertex(uint32_t v, const Vec3& p) {
+void Mesh::move_vertex(VertexIndex v, const Vec3& p) {
   FIRE_ASSERT(vertex_alive(v), "a dead vertex's slot may be reused");
   vertices.position.set(v, p);
   vertices.changes.touch(v, frame_);
-  for (uint32_t e : vertex_edges(v)) {
+  for (EdgeIndex e : vertex_edges(v)) {
     uint32_t at = edges.vertex[e][0] == v ? edges.point_offset[e] : edges.point_offset[e] + edges.point_count[e] - 1;
     points.set(at, p);
     point_changes.note(at, at + 1, frame_);
@@ -464,7 +466,7 @@ const CompactionMap& Mesh::compact() {
   std::vector<uint32_t> po(ne), pc(ne);
   std::vector<Vec3> pts;
   pts.reserve(live_point_count());
-  for (uint32_t e = 0; e < edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < edge_slots(); ++e) {
     uint32_t n = map.edge[e];
     if (n == kNone) continue;
     ev[n] = {map.vertex[edges.vertex[e][0]], map.vertex[edges.vertex[e][1]]};
@@ -490,13 +492,14 @@ const CompactionMap& Mesh::compact() {
   c.edges.point_count.assign(std::move(pc));
   c.points.assign(std::move(pts));
 
-  std::vector<uint32_t> fo(nf), fc(nf), fe;
-  for (uint32_t f = 0; f < face_slots(); ++f) {
+  std::vector<uint32_t> fo(nf), fc(nf);
+  std::vector<OrientedEdge> fe;
+  for (FaceIndex f{0}; f < face_slots(); ++f) {
     uint32_t n = map.face[f];
     if (n == kNone) continue;
     fo[n] = static_cast<uint32_t>(fe.size());
     fc[n] = faces.edge_count[f];
-    for (uint32_t oe : face_loop(f)) fe.push_back(make_oriented(map.edge[edge_of(oe)], is_reversed(oe)));
+    for (OrientedEdge oe : face_loop(f)) fe.push_back(make_oriented(EdgeIndex{map.edge[edge_of(oe)]}, is_reversed(oe)));
   }
   c.faces.edge_offset.assign(std::move(fo));
   c.faces.edge_count.assign(std::move(fc));

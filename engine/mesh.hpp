@@ -21,6 +21,7 @@
 #include "engine/change.hpp"
 #include "engine/column.hpp"
 #include "engine/common.hpp"
+#include "engine/mesh_index.hpp"
 
 namespace fire {
 
@@ -32,14 +33,14 @@ struct Handle {
   bool valid() const { return index != kNone; }
   friend bool operator==(const Handle&, const Handle&) = default;
 };
-using VertexId = Handle<struct VertexTag>;
-using EdgeId = Handle<struct EdgeTag>;
-using FaceId = Handle<struct FaceTag>;
+using VertexId = Handle<VertexTag>;
+using EdgeId = Handle<EdgeTag>;
+using FaceId = Handle<FaceTag>;
 
 // An edge as it appears in a face loop.
-inline uint32_t make_oriented(uint32_t edge, bool reversed) { return edge << 1 | (reversed ? 1u : 0u); }
-inline uint32_t edge_of(uint32_t oriented) { return oriented >> 1; }
-inline bool is_reversed(uint32_t oriented) { return oriented & 1u; }
+inline OrientedEdge make_oriented(EdgeIndex edge, bool reversed) { return OrientedEdge{edge << 1 | (reversed ? 1u : 0u)}; }
+inline EdgeIndex edge_of(OrientedEdge oriented) { return EdgeIndex{oriented >> 1}; }
+inline bool is_reversed(OrientedEdge oriented) { return oriented & 1u; }
 
 enum ElementFlag : uint8_t {
   kAlive = 1,
@@ -108,7 +109,7 @@ class Mesh {
   EdgePool edges;
   FacePool faces;
   Column<Vec3> points;
-  Column<uint32_t> face_edges;
+  Column<OrientedEdge> face_edges;
   ChangeStamps point_changes;      // ranges only: a point's element stamp is its edge's
   ChangeStamps face_edge_changes;  // ranges only: a loop's element stamp is its face's
 
@@ -116,54 +117,58 @@ class Mesh {
   size_t vertex_slots() const { return vertices.flags.size(); }
   size_t edge_slots() const { return edges.flags.size(); }
   size_t face_slots() const { return faces.flags.size(); }
-  bool vertex_alive(uint32_t v) const { return v < vertex_slots() && (vertices.flags[v] & kAlive); }
-  bool edge_alive(uint32_t e) const { return e < edge_slots() && (edges.flags[e] & kAlive); }
-  bool face_alive(uint32_t f) const { return f < face_slots() && (faces.flags[f] & kAlive); }
+  bool vertex_alive(VertexIndex v) const { return v < vertex_slots() && (vertices.flags[v] & kAlive); }
+  bool edge_alive(EdgeIndex e) const { return e < edge_slots() && (edges.flags[e] & kAlive); }
+  bool face_alive(FaceIndex f) const { return f < face_slots() && (faces.flags[f] & kAlive); }
   size_t vertex_count() const;
   size_t edge_count() const;
   size_t face_count() const;
   size_t live_point_count() const;  // points owned by live edges (shared ends counted per edge)
 
-  VertexId vertex_id(uint32_t v) const { return {v, vertices.generation[v]}; }
-  EdgeId edge_id(uint32_t e) const { return {e, edges.generation[e]}; }
-  FaceId face_id(uint32_t f) const { return {f, faces.generation[f]}; }
-  bool valid(VertexId h) const { return vertex_alive(h.index) && vertices.generation[h.index] == h.generation; }
-  bool valid(EdgeId h) const { return edge_alive(h.index) && edges.generation[h.index] == h.generation; }
-  bool valid(FaceId h) const { return face_alive(h.index) && faces.generation[h.index] == h.generation; }
+  VertexId vertex_id(VertexIndex v) const { return {v, vertices.generation[v]}; }
+  EdgeId edge_id(EdgeIndex e) const { return {e, edges.generation[e]}; }
+  FaceId face_id(FaceIndex f) const { return {f, faces.generation[f]}; }
+  bool valid(VertexId h) const { return vertex_alive(VertexIndex{h.index}) && vertices.generation[h.index] == h.generation; }
+  bool valid(EdgeId h) const { return edge_alive(EdgeIndex{h.index}) && edges.generation[h.index] == h.generation; }
+  bool valid(FaceId h) const { return face_alive(FaceIndex{h.index}) && faces.generation[h.index] == h.generation; }
 
-  std::span<const Vec3> polyline(uint32_t e) const {
+  std::span<const Vec3> polyline(EdgeIndex e) const {
     return points.span(edges.point_offset[e], edges.point_count[e]);
   }
-  std::span<const uint32_t> face_loop(uint32_t f) const {
+  std::span<const OrientedEdge> face_loop(FaceIndex f) const {
     return face_edges.span(faces.edge_offset[f], faces.edge_count[f]);
   }
   // The vertex an oriented edge starts from / arrives at when its face walks it.
-  uint32_t tail(uint32_t oriented) const { return edges.vertex[edge_of(oriented)][is_reversed(oriented) ? 1 : 0]; }
-  uint32_t head(uint32_t oriented) const { return edges.vertex[edge_of(oriented)][is_reversed(oriented) ? 0 : 1]; }
-  // Edges incident to v (unordered).
-  std::vector<uint32_t> vertex_edges(uint32_t v) const;
-  uint32_t valence(uint32_t v) const;
-  // The other face of an edge, or kNone.
-  uint32_t other_face(uint32_t e, uint32_t f) const {
-    const auto& fs = edges.face[e];
-    return fs[0] == f ? fs[1] : fs[0];
+  VertexIndex tail(OrientedEdge oriented) const {
+    return VertexIndex{edges.vertex[edge_of(oriented)][is_reversed(oriented) ? 1 : 0]};
   }
-  bool is_border_edge(uint32_t e) const { return edges.face[e][0] == kNone || edges.face[e][1] == kNone; }
+  VertexIndex head(OrientedEdge oriented) const {
+    return VertexIndex{edges.vertex[edge_of(oriented)][is_reversed(oriented) ? 0 : 1]};
+  }
+  // Edges incident to v (unordered).
+  std::vector<EdgeIndex> vertex_edges(VertexIndex v) const;
+  uint32_t valence(VertexIndex v) const;
+  // The other face of an edge, or kNone.
+  FaceIndex other_face(EdgeIndex e, FaceIndex f) const {
+    const auto& fs = edges.face[e];
+    return FaceIndex{fs[0] == f ? fs[1] : fs[0]};
+  }
+  bool is_border_edge(EdgeIndex e) const { return edges.face[e][0] == kNone || edges.face[e][1] == kNone; }
   // An edge with no face on either side: a curve of a border polygon still being drawn.
-  bool is_loose_edge(uint32_t e) const { return edges.face[e][0] == kNone && edges.face[e][1] == kNone; }
+  bool is_loose_edge(EdgeIndex e) const { return edges.face[e][0] == kNone && edges.face[e][1] == kNone; }
   // A bridge (kBridgeEdge) still waiting for the second curve between its two border loops.
-  bool is_waiting_bridge(uint32_t e) const { return is_loose_edge(e) && (edges.flags[e] & kBridgeEdge); }
-  bool is_pending(uint32_t e) const { return edges.flags[e] & kPendingEdge; }
+  bool is_waiting_bridge(EdgeIndex e) const { return is_loose_edge(e) && (edges.flags[e] & kBridgeEdge); }
+  bool is_pending(EdgeIndex e) const { return edges.flags[e] & kPendingEdge; }
   // The pending chains (kPendingEdge), each as its pieces in drawing order (edge i ends where i + 1 starts):
   // the first starts on the network where the chain began, the last ends at the chain's free end.
-  std::vector<std::vector<uint32_t>> pending_chains() const;
+  std::vector<std::vector<EdgeIndex>> pending_chains() const;
   // Pieces of pending chains (kPendingEdge), without walking them.
   size_t pending_piece_count() const;
   // The oriented edge that walks border edge e as the hole beside it would: against its one face.
-  uint32_t hole_side(uint32_t e) const { return make_oriented(e, edges.face[e][1] == kNone); }
+  OrientedEdge hole_side(EdgeIndex e) const { return make_oriented(e, edges.face[e][1] == kNone); }
   // The border loop through border edge e as the hole beside it walks it, starting with e; empty when e has
   // not exactly one face, or the loop passes a vertex with more than two border curves (it pinches there).
-  std::vector<uint32_t> border_loop(uint32_t e) const;
+  std::vector<OrientedEdge> border_loop(EdgeIndex e) const;
   // Whether a border polygon is being drawn: some live edge other than a bridge has no face yet.
   bool border_in_progress() const;
   // Bridges (kBridgeEdge) still waiting for the second curve between their two border loops.
@@ -171,9 +176,9 @@ class Mesh {
   // The border loops of the faces (what Mesh::border_loop walks; a loop through a pinched vertex is not counted).
   size_t border_loop_count() const;
   // Index of edge e in f's loop, or kNone.
-  uint32_t loop_position(uint32_t f, uint32_t e) const;
+  uint32_t loop_position(FaceIndex f, EdgeIndex e) const;
   // Face f's boundary as one closed polyline in loop order, each corner once (the last point is not the first).
-  std::vector<Vec3> face_boundary(uint32_t f) const;
+  std::vector<Vec3> face_boundary(FaceIndex f) const;
 
   // ---- frames and change stamps
   // Every write from now on is stamped `f`; frames never go back.
@@ -184,21 +189,21 @@ class Mesh {
   bool written_after(Frame f) const;
 
   // ---- primitive mutations (journaled inside a transaction, stamped always)
-  uint32_t add_vertex(const Vec3& p, uint8_t extra_flags = 0);
+  VertexIndex add_vertex(const Vec3& p, uint8_t extra_flags = 0);
   // The polyline must have at least 2 points; its ends are set to the vertices' positions exactly.
-  uint32_t add_edge(uint32_t v0, uint32_t v1, std::span<const Vec3> polyline);
+  EdgeIndex add_edge(VertexIndex v0, VertexIndex v1, std::span<const Vec3> polyline);
   // `loop` is a closed walk of oriented edges. Fails (returns kNone, changes nothing) when an edge's side
   // is already taken by another face or the walk is not closed.
-  uint32_t add_face(std::span<const uint32_t> loop);
+  FaceIndex add_face(std::span<const OrientedEdge> loop);
   // Gives face f a new loop, keeping its slot and handle (used when an edge of f is split or joined).
   // Returns false and changes nothing when the loop is not closed or an edge side is taken by another face.
-  bool set_face_loop(uint32_t f, std::span<const uint32_t> loop);
-  void remove_face(uint32_t f);
-  void remove_edge(uint32_t e);    // the edge must have no faces
-  void remove_vertex(uint32_t v);  // the vertex must have no edges
-  void set_edge_flag(uint32_t e, uint8_t flag, bool on);
+  bool set_face_loop(FaceIndex f, std::span<const OrientedEdge> loop);
+  void remove_face(FaceIndex f);
+  void remove_edge(EdgeIndex e);      // the edge must have no faces
+  void remove_vertex(VertexIndex v);  // the vertex must have no edges
+  void set_edge_flag(EdgeIndex e, uint8_t flag, bool on);
   // Moves a vertex and the matching end of every incident polyline.
-  void move_vertex(uint32_t v, const Vec3& p);
+  void move_vertex(VertexIndex v, const Vec3& p);
 
   // ---- transactions
   MeshMark begin_transaction();
@@ -243,14 +248,14 @@ class Mesh {
                ChangeStamps& changes);
   Frame frame_ = 0;
   CompactionRecord last_compaction_;
-  void link_edge(uint32_t e);
-  void unlink_edge(uint32_t e);
+  void link_edge(EdgeIndex e);
+  void unlink_edge(EdgeIndex e);
   // Whether `loop` is a closed walk of live edges, none twice, whose sides are free or already f's.
-  bool loop_fits(std::span<const uint32_t> loop, uint32_t f) const;
+  bool loop_fits(std::span<const OrientedEdge> loop, FaceIndex f) const;
   // Names `face` (or kNone) on the side of each edge that the loop walks.
-  void set_loop_sides(std::span<const uint32_t> loop, uint32_t face);
+  void set_loop_sides(std::span<const OrientedEdge> loop, FaceIndex face);
   // Appends the loop to face_edges for `face`, naming it on the edges; returns the loop's offset.
-  uint32_t append_loop(std::span<const uint32_t> loop, uint32_t face);
+  uint32_t append_loop(std::span<const OrientedEdge> loop, FaceIndex face);
 };
 
 struct MeshMark {

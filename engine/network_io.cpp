@@ -11,9 +11,9 @@ using nlohmann::json;
 std::string network_to_json(const Mesh& m) {
   json vertices = json::array(), edges = json::array(), faces = json::array();
   auto point = [](const Vec3& p) { return json::array({p.x(), p.y(), p.z()}); };
-  for (uint32_t v = 0; v < m.vertex_slots(); ++v)
+  for (VertexIndex v{0}; v < m.vertex_slots(); ++v)
     vertices.push_back({{"p", point(m.vertices.position[v])}, {"split", bool(m.vertices.flags[v] & kSplitVertex)}});
-  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e) {
     json pts = json::array();
     for (const Vec3& p : m.polyline(e)) pts.push_back(point(p));
     edges.push_back({{"v", {m.edges.vertex[e][0], m.edges.vertex[e][1]}},
@@ -22,10 +22,10 @@ std::string network_to_json(const Mesh& m) {
     if (m.edges.flags[e] & kBridgeEdge) edges.back()["bridge"] = true;  // only then: older networks read the same
     if (m.edges.flags[e] & kPendingEdge) edges.back()["pending"] = true;
   }
-  for (uint32_t f = 0; f < m.face_slots(); ++f) {
+  for (FaceIndex f{0}; f < m.face_slots(); ++f) {
     json es = json::array(), rs = json::array();
-    for (uint32_t oe : m.face_loop(f)) {
-      es.push_back(edge_of(oe));
+    for (OrientedEdge oe : m.face_loop(f)) {
+      es.push_back(edge_of(oe).value);
       rs.push_back(is_reversed(oe));
     }
     faces.push_back({{"edges", std::move(es)}, {"reversed", std::move(rs)}});
@@ -89,7 +89,7 @@ Result<Mesh> network_from_json(std::string_view text, const std::string& source)
       std::string where = "edge " + std::to_string(i);
       const json& ev = field(es[i], "v", where);
       if (!ev.is_array() || ev.size() != 2) throw Bad{where + ": \"v\" must be two vertex indices"};
-      uint32_t a = read_index(ev[0], vs.size(), where + " vertex"), b = read_index(ev[1], vs.size(), where + " vertex");
+      const VertexIndex a{read_index(ev[0], vs.size(), where + " vertex")}, b{read_index(ev[1], vs.size(), where + " vertex")};
       if (a == b) throw Bad{where + " joins vertex " + std::to_string(a) + " to itself"};
       const json& pts = field(es[i], "points", where);
       if (!pts.is_array() || pts.size() < 2) throw Bad{where + " needs a polyline of at least 2 points"};
@@ -99,7 +99,7 @@ Result<Mesh> network_from_json(std::string_view text, const std::string& source)
         throw Bad{where + "'s polyline does not start and end at its vertices"};
       const json& sharp = field(es[i], "sharp", where);
       if (!sharp.is_boolean()) throw Bad{where + ": \"sharp\" must be true or false"};
-      uint32_t e = m.add_edge(a, b, line);
+      const EdgeIndex e = m.add_edge(a, b, line);
       if (sharp.get<bool>()) m.set_edge_flag(e, kSharpEdge, true);
       for (const auto& [name, flag] : {std::pair{"bridge", kBridgeEdge}, std::pair{"pending", kPendingEdge}})
         if (const auto on = es[i].find(name); on != es[i].end()) {
@@ -107,7 +107,7 @@ Result<Mesh> network_from_json(std::string_view text, const std::string& source)
           if (on->get<bool>()) m.set_edge_flag(e, flag, true);
         }
     }
-    std::vector<uint32_t> loop;
+    std::vector<OrientedEdge> loop;
     for (size_t i = 0; i < fs.size(); ++i) {
       std::string where = "face " + std::to_string(i);
       const json& fe = field(fs[i], "edges", where);
@@ -117,7 +117,7 @@ Result<Mesh> network_from_json(std::string_view text, const std::string& source)
       loop.clear();
       for (size_t k = 0; k < fe.size(); ++k) {
         if (!fr[k].is_boolean()) throw Bad{where + ": \"reversed\" holds a non-boolean"};
-        loop.push_back(make_oriented(read_index(fe[k], es.size(), where + " edge"), fr[k].get<bool>()));
+        loop.push_back(make_oriented(EdgeIndex{read_index(fe[k], es.size(), where + " edge")}, fr[k].get<bool>()));
       }
       if (m.add_face(loop) == kNone)
         throw Bad{where + " is not a closed loop of edges, repeats an edge, or walks an edge in a direction another face already walks"};
@@ -140,9 +140,9 @@ std::string network_to_obj(const Mesh& m) {
     out += "v " + format_double(p.x()) + ' ' + format_double(p.y()) + ' ' + format_double(p.z()) + '\n';
     return next++;
   };
-  for (uint32_t v = 0; v < m.vertex_slots(); ++v)
+  for (VertexIndex v{0}; v < m.vertex_slots(); ++v)
     if (m.vertex_alive(v)) vertex_index[v] = v_line(m.vertices.position[v]);
-  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e) {
     if (!m.edge_alive(e)) continue;
     auto line = m.polyline(e);
     std::string l = "l " + std::to_string(vertex_index[m.edges.vertex[e][0]]);

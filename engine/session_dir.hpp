@@ -18,6 +18,7 @@
 #include "engine/common.hpp"
 #include "engine/hash.hpp"
 #include "engine/input_log.hpp"
+#include "engine/mesh_index.hpp"
 #include "engine/surface.hpp"
 
 namespace fire {
@@ -73,12 +74,20 @@ inline constexpr size_t kSnapshotSizeAt = kSnapshotMagic.size() + sizeof(uint32_
 inline constexpr size_t kSnapshotChecksumAt = kSnapshotSizeAt + sizeof(uint64_t);
 inline constexpr size_t kSnapshotHeaderBytes = kSnapshotChecksumAt + sizeof(uint64_t);
 
+// Values written as their bytes: numbers, and typed indices (engine/mesh_index.hpp), which are their number.
+template <class T>
+inline constexpr bool kSnapshotBytes = std::is_arithmetic_v<T> || kIsIndex<T>;
+
 class SnapshotWriter {
  public:
   template <class T>
     requires std::is_arithmetic_v<T>
   void put(T v) {
     bytes_.append(reinterpret_cast<const char*>(&v), sizeof v);
+  }
+  template <class Tag>
+  void put(Index<Tag> i) {
+    put(i.value);
   }
   void put(const Vec3& p) {
     put(p.x());
@@ -96,7 +105,7 @@ class SnapshotWriter {
   template <class T>
   void put(const std::vector<T>& v) {
     put(uint64_t(v.size()));
-    if constexpr (std::is_arithmetic_v<T>) {
+    if constexpr (kSnapshotBytes<T>) {
       if (!v.empty()) bytes_.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
     } else {
       for (const T& x : v) put(x);
@@ -128,6 +137,10 @@ class SnapshotReader {
     std::memcpy(&v, data_.data() + at_ - sizeof v, sizeof v);
     return true;
   }
+  template <class Tag>
+  bool get(Index<Tag>& i) {
+    return get(i.value);
+  }
   bool get(Vec3& p) { return get(p.x()) && get(p.y()) && get(p.z()); }
   template <class T, size_t N>
   bool get(std::array<T, N>& a) {
@@ -144,9 +157,9 @@ class SnapshotReader {
   template <class T>
   bool get(std::vector<T>& v) {
     uint64_t n = 0;
-    if (!get(n) || !fits(n, std::is_arithmetic_v<T> ? sizeof(T) : 1)) return false;
+    if (!get(n) || !fits(n, kSnapshotBytes<T> ? sizeof(T) : 1)) return false;
     v.resize(n);
-    if constexpr (std::is_arithmetic_v<T>) {
+    if constexpr (kSnapshotBytes<T>) {
       if (n == 0) return true;
       if (!take(n * sizeof(T))) return false;
       std::memcpy(v.data(), data_.data() + at_ - n * sizeof(T), n * sizeof(T));

@@ -220,7 +220,8 @@ void SnapIndex::update(const Mesh& mesh, std::span<const uint32_t> changed_edge_
   for (size_t e = mesh.edge_slots(); e < edge_leaves_.size(); ++e) remove_edge(static_cast<uint32_t>(e));
   if (edge_leaves_.size() > mesh.edge_slots()) edge_leaves_.resize(mesh.edge_slots());
   std::vector<uint32_t> fresh;
-  for (uint32_t e : changed_edge_slots) {
+  for (uint32_t slot : changed_edge_slots) {
+    const EdgeIndex e{slot};
     if (!mesh.edge_alive(e)) {
       remove_edge(e);
       continue;
@@ -649,7 +650,7 @@ SnapHit SnapIndex::nearest(const Vec3& p, double radius) const {
         if (!near[j]) continue;
         const double d = (Vec3(l.x[k + j], l.y[k + j], l.z[k + j]) - p).norm();
         if (d <= radius && before(d, l.edge, l.first + k + j, best)) {
-          best = {l.edge, l.first + k + j, d};
+          best = {EdgeIndex{l.edge}, l.first + k + j, d};
           bound = bound_of(d);
         }
       }
@@ -687,13 +688,13 @@ SnapHit SnapIndex::nearest(const Vec3& p, double radius) const {
   return best;
 }
 
-SnapHit SnapIndex::nearest_on_face(const Mesh& mesh, uint32_t f, const Vec3& p, double radius) const {
+SnapHit SnapIndex::nearest_on_face(const Mesh& mesh, FaceIndex f, const Vec3& p, double radius) const {
   SnapHit best;
   double bound = bound_of(radius);
   // The exhaustive search's own order (loop order, then point order) with a strict comparison, so the
   // first of equally near points wins as there; boxes only skip runs that cannot reach the best so far.
-  for (uint32_t oe : mesh.face_loop(f)) {
-    const uint32_t e = edge_of(oe);
+  for (OrientedEdge oe : mesh.face_loop(f)) {
+    const EdgeIndex e = edge_of(oe);
     if (e >= edge_leaves_.size()) continue;
     for (uint32_t r : edge_leaves_[e]) {
       const Leaf& l = leaves_[r];
@@ -733,7 +734,7 @@ void SnapIndex::nearest_per_edge(const Vec3& p, double radius, std::vector<SnapH
     for (uint32_t k = 0; k < l.count; ++k) {
       const Vec3 q(l.x[k], l.y[k], l.z[k]);
       const double d = (q - p).norm();
-      if (d <= radius) out.push_back({l.edge, l.first + k, d});
+      if (d <= radius) out.push_back({EdgeIndex{l.edge}, l.first + k, d});
     }
   }
   std::sort(out.begin(), out.end(), [](const SnapHit& a, const SnapHit& b) {
@@ -793,7 +794,7 @@ std::string SnapIndex::validate_ref(uint32_t ref, uint32_t parent, const Box& bo
 
 std::string SnapIndex::validate(const Mesh& mesh) const {
   size_t points = 0, edges = 0;
-  for (uint32_t e = 0; e < std::max<size_t>(mesh.edge_slots(), edge_leaves_.size()); ++e) {
+  for (EdgeIndex e{0}; e < std::max<size_t>(mesh.edge_slots(), edge_leaves_.size()); ++e) {
     const bool held = e < edge_leaves_.size() && !edge_leaves_[e].empty();
     if (held != mesh.edge_alive(e)) return "edge " + std::to_string(e) + (held ? " is held but dead" : " is live but missing");
     if (!held) continue;

@@ -26,7 +26,7 @@ namespace fire {
 
 // A polyline point: edge slot, index in the edge's polyline, distance to the query.
 struct SnapHit {
-  uint32_t edge = kNone;
+  EdgeIndex edge;
   uint32_t point = kNone;
   double distance = std::numeric_limits<double>::infinity();
   bool found() const { return edge != kNone; }
@@ -59,7 +59,7 @@ class SnapIndex {
   SnapHit nearest(const Vec3& p, double radius = kUnbounded) const;
   // Nearest point of face f's boundary within `radius`; ties go to the edge first in f's loop, then the
   // lowest point index (the order sketch's exhaustive search walks the boundary in).
-  SnapHit nearest_on_face(const Mesh& mesh, uint32_t f, const Vec3& p, double radius = kUnbounded) const;
+  SnapHit nearest_on_face(const Mesh& mesh, FaceIndex f, const Vec3& p, double radius = kUnbounded) const;
   // For every edge with a point within `radius`: its nearest point (lowest index on ties), by edge slot.
   void nearest_per_edge(const Vec3& p, double radius, std::vector<SnapHit>& out) const;
 

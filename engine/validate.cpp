@@ -38,13 +38,13 @@ std::string Mesh::validate() const {
   if (auto w = check_free(edges.free_list, edges.flags, "edge"); !w.empty()) return w;
   if (auto w = check_free(faces.free_list, faces.flags, "face"); !w.empty()) return w;
 
-  for (uint32_t v = 0; v < nv; ++v) {
+  for (VertexIndex v{0}; v < nv; ++v) {
     if (!vertex_alive(v)) continue;
     if (!is_finite(vertices.position[v])) return "vertex " + str(v) + " has a non-finite position";
   }
 
   // Face ranges before the edges: an edge's check walks the loops of the faces it names.
-  for (uint32_t f = 0; f < nf; ++f) {
+  for (FaceIndex f{0}; f < nf; ++f) {
     if (!face_alive(f)) continue;
     const uint32_t off = faces.edge_offset[f], cnt = faces.edge_count[f];
     if (cnt < 2) return "face " + str(f) + " has " + std::to_string(cnt) + " edge(s); a face needs at least 2";
@@ -52,11 +52,11 @@ std::string Mesh::validate() const {
   }
 
   size_t incidences = 0;
-  for (uint32_t e = 0; e < ne; ++e) {
+  for (EdgeIndex e{0}; e < ne; ++e) {
     if (!edge_alive(e)) continue;
     const auto ev = edges.vertex[e];
     const std::string name = "edge " + str(e);
-    if (!vertex_alive(ev[0]) || !vertex_alive(ev[1])) return name + " joins a dead or missing vertex (" + str(ev[0]) + ", " + str(ev[1]) + ")";
+    if (!vertex_alive(VertexIndex{ev[0]}) || !vertex_alive(VertexIndex{ev[1]})) return name + " joins a dead or missing vertex (" + str(ev[0]) + ", " + str(ev[1]) + ")";
     if (ev[0] == ev[1]) return name + " joins vertex " + str(ev[0]) + " to itself";
     const uint32_t off = edges.point_offset[e], cnt = edges.point_count[e];
     if (cnt < 2) return name + " has a polyline of " + std::to_string(cnt) + " point(s); at least 2 are needed";
@@ -68,11 +68,11 @@ std::string Mesh::validate() const {
     if (line.back() != vertices.position[ev[1]]) return name + "'s polyline does not end at its vertex " + str(ev[1]);
     const auto ef = edges.face[e];
     for (int side = 0; side < 2; ++side) {
-      uint32_t f = ef[side];
+      const FaceIndex f{ef[side]};
       if (f == kNone) continue;
       if (!face_alive(f)) return name + " refers to dead face " + str(f);
       uint32_t hits = 0;
-      for (uint32_t oe : face_loop(f))
+      for (OrientedEdge oe : face_loop(f))
         if (edge_of(oe) == e) {
           ++hits;
           if (is_reversed(oe) != (side == 1)) return name + " is walked by face " + str(f) + " in the direction its other side claims";
@@ -87,32 +87,32 @@ std::string Mesh::validate() const {
 
   // V -> E lists: every live edge exactly in the lists of its two vertices, nothing else.
   size_t listed = 0;
-  for (uint32_t v = 0; v < nv; ++v) {
+  for (VertexIndex v{0}; v < nv; ++v) {
     if (!vertex_alive(v)) continue;
     size_t steps = 0;
-    for (uint32_t e = vertices.first_edge[v]; e != kNone;) {
+    for (EdgeIndex e{vertices.first_edge[v]}; e != kNone;) {
       if (!edge_alive(e)) return "vertex " + str(v) + "'s edge list holds dead edge " + str(e);
       if (edges.vertex[e][0] != v && edges.vertex[e][1] != v) return "vertex " + str(v) + "'s edge list holds edge " + str(e) + " that does not touch it";
       if (++steps > ne) return "vertex " + str(v) + "'s edge list loops";
       ++listed;
-      e = edges.next[e][edges.vertex[e][0] == v ? 0 : 1];
+      e = EdgeIndex{edges.next[e][edges.vertex[e][0] == v ? 0 : 1]};
     }
   }
   if (listed != 2 * incidences) return "vertex edge lists hold " + std::to_string(listed) + " entries for " + std::to_string(incidences) + " edges";
   // A pending chain lies apart from the network until the stroke that finishes it.
-  for (uint32_t e = 0; e < ne; ++e)
+  for (EdgeIndex e{0}; e < ne; ++e)
     if (edge_alive(e) && (edges.flags[e] & kPendingEdge))
       for (uint32_t v : edges.vertex[e])
-        for (uint32_t g : vertex_edges(v))
+        for (EdgeIndex g : vertex_edges(VertexIndex{v}))
           if (!(edges.flags[g] & kPendingEdge)) return "edge " + str(e) + " is pending but touches curve " + str(g) + " of the network";
 
-  for (uint32_t f = 0; f < nf; ++f) {
+  for (FaceIndex f{0}; f < nf; ++f) {
     if (!face_alive(f)) continue;
     const std::string name = "face " + str(f);
     const uint32_t cnt = faces.edge_count[f];
     auto loop = face_loop(f);
     for (uint32_t k = 0; k < cnt; ++k) {
-      uint32_t e = edge_of(loop[k]);
+      const EdgeIndex e = edge_of(loop[k]);
       if (!edge_alive(e)) return name + " uses dead edge " + str(e);
       if (edges.face[e][is_reversed(loop[k])] != f) return name + " uses edge " + str(e) + " which does not name it back";
       if (head(loop[k]) != tail(loop[(k + 1) % cnt]))

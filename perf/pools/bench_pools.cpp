@@ -89,15 +89,15 @@ Mesh build_by_splitting(bool history, double& seconds) {
   // are interior points of the face's two longest polylines: no 2-gons or doubled edges, which OpenMesh
   // cannot hold.
   std::mt19937_64 rng(kSeed);
-  std::vector<uint32_t> alive;
+  std::vector<FaceIndex> alive;
   while (mesh.face_count() < kFaces) {
     alive.clear();
-    for (uint32_t f = 0; f < mesh.face_slots(); ++f)
+    for (FaceIndex f{0}; f < mesh.face_slots(); ++f)
       if (mesh.face_alive(f)) alive.push_back(f);
-    const uint32_t f = alive[rng() % alive.size()];
-    std::vector<uint32_t> edges;
-    for (uint32_t oe : mesh.face_loop(f)) edges.push_back(edge_of(oe));
-    std::sort(edges.begin(), edges.end(), [&](uint32_t a, uint32_t b) {
+    const FaceIndex f = alive[rng() % alive.size()];
+    std::vector<EdgeIndex> edges;
+    for (OrientedEdge oe : mesh.face_loop(f)) edges.push_back(edge_of(oe));
+    std::sort(edges.begin(), edges.end(), [&](EdgeIndex a, EdgeIndex b) {
       return mesh.edges.point_count[a] != mesh.edges.point_count[b] ? mesh.edges.point_count[a] > mesh.edges.point_count[b] : a < b;
     });
     if (edges.size() < 2 || mesh.edges.point_count[edges[1]] < 3) continue;
@@ -178,12 +178,12 @@ int main() {
     const Vec3& p = mesh.vertices.position[v];
     vh[v] = om.add_vertex(OMesh::Point(float(p.x()), float(p.y()), float(p.z())));
   }
-  for (uint32_t f = 0; f < nf; ++f) {
+  for (FaceIndex f{0}; f < nf; ++f) {
     corners.clear();
-    for (uint32_t oe : mesh.face_loop(f)) corners.push_back(vh[mesh.tail(oe)]);
+    for (OrientedEdge oe : mesh.face_loop(f)) corners.push_back(vh[mesh.tail(oe)]);
     if (!om.add_face(corners).is_valid()) die("OpenMesh refused face " + std::to_string(f));
   }
-  for (uint32_t e = 0; e < ne; ++e) {
+  for (EdgeIndex e{0}; e < ne; ++e) {
     auto h = om.find_halfedge(vh[mesh.edges.vertex[e][0]], vh[mesh.edges.vertex[e][1]]);
     if (!h.is_valid()) die("OpenMesh has no edge for edge " + std::to_string(e));
     eh[e] = om.edge_handle(h);
@@ -221,7 +221,7 @@ int main() {
   });
   const double t_edges = median_seconds([&] {
     Sum s;
-    for (uint32_t e = 0; e < mesh.edge_slots(); ++e)
+    for (EdgeIndex e{0}; e < mesh.edge_slots(); ++e)
       for (const Vec3& p : mesh.polyline(e)) s.x += p.x(), s.y += p.y(), s.z += p.z();
     sum_edges = s.total();
   });

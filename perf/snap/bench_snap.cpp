@@ -107,19 +107,19 @@ Mesh draw_network(size_t target, SnapIndex* index) {
   std::mt19937_64 rng(kSeed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   size_t points = 4 * side_points;
-  std::vector<uint32_t> edges;
+  std::vector<EdgeIndex> edges;
   while (points < target) {
-    const uint32_t f = uint32_t(rng() % mesh.face_slots());  // splits never remove faces
+    const FaceIndex f{uint32_t(rng() % mesh.face_slots())};  // splits never remove faces
     edges.clear();
-    for (uint32_t oe : mesh.face_loop(f)) edges.push_back(edge_of(oe));
-    std::sort(edges.begin(), edges.end(), [&](uint32_t a, uint32_t b) {
+    for (OrientedEdge oe : mesh.face_loop(f)) edges.push_back(edge_of(oe));
+    std::sort(edges.begin(), edges.end(), [&](EdgeIndex a, EdgeIndex b) {
       return mesh.edges.point_count[a] != mesh.edges.point_count[b] ? mesh.edges.point_count[a] > mesh.edges.point_count[b] : a < b;
     });
     if (edges.size() < 2 || mesh.edges.point_count[edges[1]] < 5) continue;
     EditCommand c;
     c.kind = EditKind::SplitFace;
     c.face = f;
-    auto inner = [&](uint32_t e) {
+    auto inner = [&](EdgeIndex e) {
       const uint32_t n = mesh.edges.point_count[e];
       return CurveEnd{e, 1 + uint32_t(rng() % (n - 2))};
     };
@@ -202,7 +202,7 @@ int main() {
     const double bulk_seconds = cpu_now() - t_bulk;
 
     Cloud cloud;
-    for (uint32_t e = 0; e < mesh.edge_slots(); ++e)
+    for (EdgeIndex e{0}; e < mesh.edge_slots(); ++e)
       if (mesh.edge_alive(e)) cloud.pts.insert(cloud.pts.end(), mesh.polyline(e).begin(), mesh.polyline(e).end());
     const double t_nano = cpu_now();
     Static tree(3, cloud);
@@ -260,11 +260,11 @@ int main() {
     }
     double ours_insert = 1e300, ours_delete = 1e300, nano_insert = 1e300, nano_delete = 1e300;
     for (int r = 0; r < kRepetitions; ++r) {
-      std::vector<uint32_t> added;
+      std::vector<EdgeIndex> added;
       double t = 0;
       for (const auto& c : curves) {
-        const uint32_t v0 = mesh.add_vertex(c.front()), v1 = mesh.add_vertex(c.back());
-        const uint32_t e = mesh.add_edge(v0, v1, c);
+        const VertexIndex v0 = mesh.add_vertex(c.front()), v1 = mesh.add_vertex(c.back());
+        const EdgeIndex e = mesh.add_edge(v0, v1, c);
         const uint32_t slot[1] = {e};
         const double t0 = cpu_now();
         bulk.update(mesh, slot);
@@ -273,8 +273,8 @@ int main() {
       }
       ours_insert = std::min(ours_insert, t / kEdits);
       t = 0;
-      for (uint32_t e : added) {
-        const uint32_t v0 = mesh.edges.vertex[e][0], v1 = mesh.edges.vertex[e][1];
+      for (EdgeIndex e : added) {
+        const VertexIndex v0{mesh.edges.vertex[e][0]}, v1{mesh.edges.vertex[e][1]};
         mesh.remove_edge(e);
         mesh.remove_vertex(v0);
         mesh.remove_vertex(v1);

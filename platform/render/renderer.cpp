@@ -344,7 +344,7 @@ Status Renderer::upload_points(const Mesh& network) {
   curve_draws_.clear();
   pending_draws_.clear();
   std::vector<glm::vec3> floats;
-  for (uint32_t e = 0; e < network.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < network.edge_slots(); ++e) {
     EdgeRecord& record = edge_records_[e];
     if (!network.edge_alive(e)) {
       record = {};
@@ -372,7 +372,7 @@ Status Renderer::upload_vertices(const Mesh& network) {
   vertex_copy_.resize(slots);
   vertex_live_.resize(slots, 0);
   marker_draws_.clear();
-  for (uint32_t v = 0; v < slots; ++v) {
+  for (VertexIndex v{0}; v < slots; ++v) {
     if (!network.vertex_alive(v)) {
       vertex_live_[v] = 0;
       continue;
@@ -589,7 +589,7 @@ Status Renderer::set_pen_feedback(const Mesh& network, const PenFeedback& feedba
   std::vector<glm::vec3> data;
   uint32_t fan = 0;
   if (network.valid(feedback.face)) {  // a fan around the boundary's centroid, lit by the boundary's normal
-    const std::vector<Vec3> loop = network.face_boundary(feedback.face.index);
+    const std::vector<Vec3> loop = network.face_boundary(FaceIndex{feedback.face.index});
     const LoopPlane plane = loop_plane(loop);
     const glm::vec3 n = plane.normal.norm() > 0 ? to_float(plane.normal) : glm::vec3(0.0f, 0.0f, 1.0f);
     for (size_t i = 0; i < loop.size(); ++i)

@@ -253,10 +253,10 @@ struct Refiner {
 
 FacePatch build_face_patch(const Mesh& net, uint32_t face, std::span<const EdgeSplits* const> splits,
                            const FaceSettings& settings) {
-  const auto network_loop = net.face_loop(face);
+  const auto network_loop = net.face_loop(FaceIndex{face});
   std::vector<FaceSide> sides(network_loop.size());
   for (size_t k = 0; k < sides.size(); ++k) {
-    const uint32_t e = edge_of(network_loop[k]);
+    const EdgeIndex e = edge_of(network_loop[k]);
     sides[k] = {splits[k], e, net.edges.vertex[e][0], net.edges.vertex[e][1], is_reversed(network_loop[k]),
                 polyline_length(net.polyline(e)), size_t(net.edges.point_count[e] - 1)};
   }

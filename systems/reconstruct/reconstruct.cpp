@@ -109,7 +109,7 @@ bool used_by_face(const Mesh& net, uint32_t e) {
 double mean_curve_length(const Mesh& net) {
   double length = 0;
   uint32_t lines = 0;
-  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < net.edge_slots(); ++e) {
     if (!net.edge_alive(e) || !used_by_face(net, e)) continue;
     const auto line = net.polyline(e);
     for (size_t i = 1; i < line.size(); ++i) length += (line[i] - line[i - 1]).norm();
@@ -123,7 +123,7 @@ double mean_curve_length(const Mesh& net) {
 // be the curve's own direction. A noisy curve (`deviation` > 0, a length) is read from where it leaves the
 // pen's rest at v, and at least kCornerReachNoises deviations from there (kPauseNoises).
 Vec3 leaving_direction(const Mesh& net, uint32_t e, uint32_t v, double deviation = 0) {
-  std::vector<Vec3> line(net.polyline(e).begin(), net.polyline(e).end());
+  std::vector<Vec3> line(net.polyline(EdgeIndex{e}).begin(), net.polyline(EdgeIndex{e}).end());
   if (net.edges.vertex[e][0] != v) std::reverse(line.begin(), line.end());
   if (deviation > 0) {
     const std::vector<double> arc = arc_parameters(line);
@@ -151,7 +151,7 @@ double turn_degrees(const Vec3& leaving, const Vec3& other_leaving) {
 // border, it does not straighten a corner, and a curve only a few deviations long has no rest to read past.
 bool border_corner(const Mesh& net, uint32_t v, double threshold_deg, double deviation) {
   uint32_t border[2], count = 0;
-  for (uint32_t e : net.vertex_edges(v))
+  for (EdgeIndex e : net.vertex_edges(VertexIndex{v}))
     if (used_by_face(net, e) && net.is_border_edge(e)) {
       if (count == 2) return true;  // the border touches itself here
       border[count++] = e;
@@ -182,7 +182,7 @@ namespace {
 // noise_estimate for a network whose mean_curve_length is known.
 double noise_estimate(const Mesh& net, double mean_length) {
   std::vector<double> cubed;  // squared third differences of the samples
-  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < net.edge_slots(); ++e) {
     if (!net.edge_alive(e) || !used_by_face(net, e)) continue;
     const auto line = net.polyline(e);
     // On a few samples the curve's own shape dominates the differences.
@@ -208,7 +208,7 @@ double tangent_spread_deg(const Mesh& net) {
   std::vector<Eigen::Matrix3d> moments(net.vertex_slots(), Eigen::Matrix3d::Zero());
   std::vector<uint32_t> counts(net.vertex_slots(), 0);
   std::vector<bool> crease(net.vertex_slots(), false);
-  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < net.edge_slots(); ++e) {
     if (!net.edge_alive(e) || !used_by_face(net, e)) continue;
     const auto line = net.polyline(e);
     for (int end = 0; end < 2; ++end) {
@@ -231,7 +231,7 @@ double tangent_spread_deg(const Mesh& net) {
     }
   }
   std::vector<double> spread;
-  for (uint32_t v = 0; v < net.vertex_slots(); ++v) {
+  for (VertexIndex v{0}; v < net.vertex_slots(); ++v) {
     if (!net.vertex_alive(v) || crease[v] || counts[v] < 3) continue;
     const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(moments[v], Eigen::EigenvaluesOnly).eigenvalues()(0);
     spread.push_back(std::asin(std::sqrt(std::clamp(smallest / counts[v], 0.0, 1.0))) * 180.0 / std::numbers::pi);
@@ -285,7 +285,7 @@ Status check_reconstruction_input(const Mesh& net, const Options& options) {
   if (Status s = check_options(options); !s) return s;
   if (std::string problem = net.validate(); !problem.empty()) return Status::failure("invalid network: " + problem);
   if (net.face_count() == 0) return Status::failure("the network has no faces");
-  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < net.edge_slots(); ++e) {
     if (!net.edge_alive(e) || !used_by_face(net, e)) continue;
     auto line = net.polyline(e);
     if (std::all_of(line.begin(), line.end(), [&](const Vec3& p) { return p == line.front(); }))
@@ -295,7 +295,7 @@ Status check_reconstruction_input(const Mesh& net, const Options& options) {
         return Status::failure("edge " + std::to_string(e) + "'s polyline has coincident consecutive points " +
                                std::to_string(i - 1) + " and " + std::to_string(i));
   }
-  for (uint32_t f = 0; f < net.face_slots(); ++f) {
+  for (FaceIndex f{0}; f < net.face_slots(); ++f) {
     if (!net.face_alive(f)) continue;
     auto loop = net.face_loop(f);
     if (options.method == Method::thesis && loop.size() < 3)
@@ -381,7 +381,7 @@ std::vector<uint8_t> joined_vertices(const Mesh& net, bool noisy) {
   if (!noisy) return joined;
   std::vector<uint32_t> used(net.vertex_slots(), 0), first(net.vertex_slots(), kNone);
   std::vector<uint8_t> candidate(net.vertex_slots(), 1);
-  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < net.edge_slots(); ++e) {
     if (!net.edge_alive(e) || !used_by_face(net, e)) continue;
     const uint32_t a = net.edges.vertex[e][0], b = net.edges.vertex[e][1];
     const bool interior = !net.is_border_edge(e) && net.edges.face[e][0] != net.edges.face[e][1] && a != b;
@@ -399,13 +399,13 @@ std::vector<uint8_t> joined_vertices(const Mesh& net, bool noisy) {
       }
     }
   }
-  for (uint32_t v = 0; v < net.vertex_slots(); ++v) joined[v] = net.vertex_alive(v) && used[v] == 2 && candidate[v];
-  for (uint32_t f = 0; f < net.face_slots(); ++f) {
+  for (VertexIndex v{0}; v < net.vertex_slots(); ++v) joined[v] = net.vertex_alive(v) && used[v] == 2 && candidate[v];
+  for (FaceIndex f{0}; f < net.face_slots(); ++f) {
     if (!net.face_alive(f)) continue;
     const auto loop = net.face_loop(f);
-    const auto kept = std::count_if(loop.begin(), loop.end(), [&](uint32_t oe) { return !joined[net.tail(oe)]; });
+    const auto kept = std::count_if(loop.begin(), loop.end(), [&](OrientedEdge oe) { return !joined[net.tail(oe)]; });
     if (kept < 2)
-      for (uint32_t oe : loop) joined[net.tail(oe)] = 0;
+      for (OrientedEdge oe : loop) joined[net.tail(oe)] = 0;
   }
   return joined;
 }
@@ -420,7 +420,7 @@ void build_sides(const Mesh& net, bool noisy, Sides& sides) {
   sides.to.assign(net.edge_slots(), kNone);
   // The other edge at a joined vertex.
   std::vector<uint32_t> pair(2 * size_t(net.vertex_slots()), kNone);
-  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < net.edge_slots(); ++e) {
     if (!net.edge_alive(e) || !used_by_face(net, e)) continue;
     for (uint32_t v : net.edges.vertex[e])
       if (sides.joined[v]) pair[2 * size_t(v) + (pair[2 * size_t(v)] == kNone ? 0 : 1)] = e;
@@ -428,7 +428,7 @@ void build_sides(const Mesh& net, bool noisy, Sides& sides) {
   auto across = [&](uint32_t v, uint32_t e) { return pair[2 * size_t(v)] == e ? pair[2 * size_t(v) + 1] : pair[2 * size_t(v)]; };
   auto far_end = [&](uint32_t e, uint32_t v) { return net.edges.vertex[e][0] == v ? net.edges.vertex[e][1] : net.edges.vertex[e][0]; };
   std::vector<uint32_t> back;
-  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < net.edge_slots(); ++e) {
     std::vector<uint32_t>& members = sides.members[e];
     members.clear();
     if (!net.edge_alive(e) || !used_by_face(net, e) || sides.lead[e] != kNone) continue;
@@ -463,20 +463,20 @@ std::vector<std::vector<FaceSide>> face_sides(const Mesh& net, const Sides& side
   // Each side's drawn length and segments, once for both its faces.
   std::vector<double> length(net.edge_slots(), 0.0);
   std::vector<size_t> segments(net.edge_slots(), 0);
-  for (uint32_t lead = 0; lead < net.edge_slots(); ++lead)
+  for (EdgeIndex lead{0}; lead < net.edge_slots(); ++lead)
     for (uint32_t m : sides.members[lead]) {
-      length[lead] += polyline_length(net.polyline(m >> 1));
+      length[lead] += polyline_length(net.polyline(EdgeIndex{m >> 1}));
       segments[lead] += net.edges.point_count[m >> 1] - 1;
     }
   std::vector<std::vector<FaceSide>> all(net.face_slots());
-  for (uint32_t f = 0; f < net.face_slots(); ++f) {
+  for (FaceIndex f{0}; f < net.face_slots(); ++f) {
     if (!net.face_alive(f)) continue;
     auto loop = net.face_loop(f);
     const size_t n = loop.size();
     size_t start = 0;
     while (sides.joined[net.tail(loop[start])]) ++start;
     for (size_t i = 0; i < n; ++i) {
-      const uint32_t oe = loop[(start + i) % n];
+      const OrientedEdge oe = loop[(start + i) % n];
       if (sides.joined[net.tail(oe)]) continue;
       const uint32_t lead = sides.lead[edge_of(oe)];
       const std::vector<uint32_t>& members = sides.members[lead];
@@ -596,7 +596,7 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
   plan_faces(net, options, sides, straight_turn, all_sides);
   const std::vector<uint32_t> depth = side_depths(net, options, all_sides);
   std::vector<Vec3> line, straight;
-  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < net.edge_slots(); ++e) {
     const std::vector<uint32_t>& members = sides.members[e];
     if (members.empty()) {
       c.edges[e] = {};
@@ -612,7 +612,7 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
     if (members.size() > 1) {
       line.clear();
       for (uint32_t m : members) {
-        const auto drawn = net.polyline(m >> 1);
+        const auto drawn = net.polyline(EdgeIndex{m >> 1});
         const size_t at = line.size();
         line.insert(line.end(), drawn.begin(), drawn.end());
         if (m & 1) std::reverse(line.begin() + std::ptrdiff_t(at), line.end());
@@ -628,7 +628,7 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
       const uint32_t ends[2] = {net.edges.vertex[first >> 1][first & 1], net.edges.vertex[last >> 1][(last & 1) ^ 1]};
       straight.assign(side.begin(), side.end());
       for (int k = 0; k < 2; ++k) {
-        const auto [distance, share] = straight_reach(net.valence(ends[k]), deviation);
+        const auto [distance, share] = straight_reach(net.valence(VertexIndex{ends[k]}), deviation);
         reach[k] = distance;
         straighten_start(straight, distance, share);
         std::reverse(straight.begin(), straight.end());  // the other end next, then back in order
@@ -655,7 +655,7 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
   }
   const FaceSettings settings{options.method, options.coons_steps, options.planarity};
   std::vector<uint8_t> joins;
-  for (uint32_t f = 0; f < net.face_slots(); ++f) {
+  for (FaceIndex f{0}; f < net.face_slots(); ++f) {
     if (!net.face_alive(f)) {
       c.faces[f] = {};
       c.face_valid[f] = 0;
@@ -664,7 +664,7 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
     joins.clear();
     for (const FaceSide& side : all_sides[f]) joins.push_back(side.joins_next ? 1 : 0);
     bool stale = everything || !c.face_valid[f] || net.faces.changes.changed_since(f, c.seen) || c.face_joins[f] != joins;
-    for (uint32_t oe : net.face_loop(f)) stale = stale || c.edge_redone[edge_of(oe)];
+    for (OrientedEdge oe : net.face_loop(f)) stale = stale || c.edge_redone[edge_of(oe)];
     if (!stale) continue;
     c.faces[f] = build_face_patch(all_sides[f], settings);
     c.face_valid[f] = 1;
@@ -682,11 +682,11 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
   std::vector<uint32_t> vertex_id(net.vertex_slots(), kNone), edge_first(net.edge_slots(), kNone),
       face_first(net.face_slots(), kNone);
   const Sides& sides = c.sides;
-  for (uint32_t f = 0; f < net.face_slots(); ++f)
+  for (FaceIndex f{0}; f < net.face_slots(); ++f)
     if (net.face_alive(f))
-      for (uint32_t oe : net.face_loop(f))
+      for (OrientedEdge oe : net.face_loop(f))
         if (!sides.joined[net.tail(oe)]) vertex_id[net.tail(oe)] = 0;
-  for (uint32_t v = 0; v < net.vertex_slots(); ++v)
+  for (VertexIndex v{0}; v < net.vertex_slots(); ++v)
     if (vertex_id[v] != kNone) {
       vertex_id[v] = base.vertex_count();
       base.positions.push_back(net.vertices.position[v]);
@@ -694,7 +694,7 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
       if (options.method == Method::fire)
         base.border_corners.push_back(border_corner(net, v, corner_turn, deviation) ? 1 : 0);
     }
-  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < net.edge_slots(); ++e) {
     if (!c.edge_valid[e]) continue;
     edge_first[e] = base.vertex_count();
     for (uint32_t i = 1; i < c.edges[e].leaf_count(); ++i) {
@@ -702,7 +702,7 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
       base.vertex_drawn.push_back(1);
     }
   }
-  for (uint32_t f = 0; f < net.face_slots(); ++f) {
+  for (FaceIndex f{0}; f < net.face_slots(); ++f) {
     if (!net.face_alive(f)) continue;
     face_first[f] = base.vertex_count();
     base.positions.insert(base.positions.end(), c.faces[f].interior.begin(), c.faces[f].interior.end());
@@ -716,7 +716,7 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
     }
     return kNone;
   };
-  for (uint32_t f = 0; f < net.face_slots(); ++f) {
+  for (FaceIndex f{0}; f < net.face_slots(); ++f) {
     if (!net.face_alive(f)) continue;
     const FacePatch& p = c.faces[f];
     for (uint32_t k = 0; k < p.face_count(); ++k) {
@@ -726,7 +726,7 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
     }
   }
   // Drawn curves: the pieces of each side, between its ends and split points.
-  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < net.edge_slots(); ++e) {
     if (!c.edge_valid[e]) continue;
     const bool sharp = (net.edges.flags[e] & kSharpEdge) != 0;
     const uint32_t pieces = c.edges[e].leaf_count();
@@ -746,7 +746,7 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
     }
     base.side_curve_offsets.push_back(base.curve_count());
   }
-  for (uint32_t f = 0; f < net.face_slots(); ++f) {
+  for (FaceIndex f{0}; f < net.face_slots(); ++f) {
     if (!net.face_alive(f)) continue;
     const FacePatch& p = c.faces[f];
     for (uint32_t k = 0; k < p.curve_count(); ++k) {

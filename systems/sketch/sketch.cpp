@@ -58,12 +58,12 @@ void drop_pauses(std::vector<Vec3>& stroke, const Vec3& start, double start_radi
 // The vertex of `face` nearest to p, or to the curve point p snapped to, if it lies within `radius`, as a
 // curve end; else `end` as it was. A curve point that close to a vertex is the vertex within the pen's error,
 // and a new vertex there would leave a curve piece shorter than the radius beside it.
-CurveEnd at_vertex(const Mesh& mesh, std::span<const uint32_t> loop, const CurveEnd& end, const Vec3& p, double radius) {
+CurveEnd at_vertex(const Mesh& mesh, std::span<const OrientedEdge> loop, const CurveEnd& end, const Vec3& p, double radius) {
   CurveEnd best = end;
   double nearest = radius;
   const Vec3 snapped = mesh.polyline(end.edge)[end.point];
-  for (uint32_t oriented : loop) {
-    const uint32_t e = edge_of(oriented);
+  for (OrientedEdge oriented : loop) {
+    const EdgeIndex e = edge_of(oriented);
     const std::span<const Vec3> line = mesh.polyline(e);
     for (uint32_t k : {uint32_t(0), uint32_t(line.size() - 1)})
       if (const double d = std::min((line[k] - p).norm(), (line[k] - snapped).norm()); d < nearest) {
@@ -78,15 +78,15 @@ CurveEnd at_vertex(const Mesh& mesh, std::span<const uint32_t> loop, const Curve
 // `limit`, the end's on the start's loop where there is one (a curve across that loop's hole), else on another
 // loop (a curve joining the two, `join`).
 struct HoleSnap {
-  std::vector<uint32_t> rim;  // the start's border loop, as Mesh::border_loop walks it; empty when there is none
-  std::vector<uint32_t> end_rim;  // the end's: `rim` unless `join`
+  std::vector<OrientedEdge> rim;  // the start's border loop, as Mesh::border_loop walks it; empty when there is none
+  std::vector<OrientedEdge> end_rim;  // the end's: `rim` unless `join`
   CurveEnd start, end;
   bool join = false;
 };
 
 HoleSnap snap_to_hole(const Mesh& m, const SnapIndex& index, const Vec3& start, const Vec3& end, double limit) {
   // The nearest of `hits` on a border curve with a face, and the nearest of those on `rim` (when given).
-  auto nearest_border = [&](const std::vector<SnapHit>& hits, const std::vector<uint32_t>* rim) {
+  auto nearest_border = [&](const std::vector<SnapHit>& hits, const std::vector<OrientedEdge>* rim) {
     SnapHit best, best_on_rim;
     auto better = [](const SnapHit& h, const SnapHit& than) {
       return !than.found() || h.distance < than.distance || (h.distance == than.distance && h.edge < than.edge);
@@ -94,7 +94,7 @@ HoleSnap snap_to_hole(const Mesh& m, const SnapIndex& index, const Vec3& start, 
     for (const SnapHit& h : hits) {
       if (!m.is_border_edge(h.edge) || m.is_loose_edge(h.edge)) continue;
       if (better(h, best)) best = h;
-      if (rim && std::any_of(rim->begin(), rim->end(), [&](uint32_t oe) { return edge_of(oe) == h.edge; }) && better(h, best_on_rim))
+      if (rim && std::any_of(rim->begin(), rim->end(), [&](OrientedEdge oe) { return edge_of(oe) == h.edge; }) && better(h, best_on_rim))
         best_on_rim = h;
     }
     return std::pair{best, best_on_rim};
@@ -104,7 +104,7 @@ HoleSnap snap_to_hole(const Mesh& m, const SnapIndex& index, const Vec3& start, 
   index.nearest_per_edge(start, limit, hits);
   const SnapHit a = nearest_border(hits, nullptr).first;
   if (!a.found()) return out;
-  std::vector<uint32_t> rim = m.border_loop(a.edge);
+  std::vector<OrientedEdge> rim = m.border_loop(a.edge);
   if (rim.empty()) return out;
   index.nearest_per_edge(end, limit, hits);
   const auto [any_rim, on_rim] = nearest_border(hits, &rim);
@@ -143,14 +143,14 @@ struct Fan {
 
 // At vertex v with three or more curves: the normal is the one their directions (and the stroke's, `d`) leave
 // least of, turned toward the camera. nullopt with fewer curves.
-std::optional<Fan> fan_at(const Mesh& m, uint32_t v, const Vec3& d, const Vec3& viewpoint) {
+std::optional<Fan> fan_at(const Mesh& m, VertexIndex v, const Vec3& d, const Vec3& viewpoint) {
   Fan fan;
   const Vec3& at = m.vertices.position[v];
-  std::vector<uint32_t> incident = m.vertex_edges(v);
+  std::vector<EdgeIndex> incident = m.vertex_edges(v);
   std::sort(incident.begin(), incident.end());
   incident.erase(std::unique(incident.begin(), incident.end()), incident.end());
-  std::vector<std::pair<uint32_t, Vec3>> directions;
-  for (uint32_t e : incident) {
+  std::vector<std::pair<EdgeIndex, Vec3>> directions;
+  for (EdgeIndex e : incident) {
     if (m.is_loose_edge(e)) continue;
     const std::span<const Vec3> line = m.polyline(e);
     for (int side = 0; side < 2; ++side)
@@ -179,17 +179,17 @@ int fan_turn(const Mesh& m, const Fan& fan, uint32_t v) {
     return size_t(std::find_if(fan.edges.begin(), fan.edges.end(), [&](const auto& x) { return x.second == e; }) - fan.edges.begin());
   };
   // The faces at v: those beside its curves, each once.
-  std::vector<uint32_t> faces;
+  std::vector<FaceIndex> faces;
   for (const auto& [angle, e] : fan.edges)
     for (uint32_t f : m.edges.face[e])
-      if (f != kNone) faces.push_back(f);
+      if (f != kNone) faces.push_back(FaceIndex{f});
   std::sort(faces.begin(), faces.end());
   faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
   int votes = 0;
-  for (uint32_t f : faces) {
-    const std::span<const uint32_t> loop = m.face_loop(f);
+  for (FaceIndex f : faces) {
+    const std::span<const OrientedEdge> loop = m.face_loop(f);
     for (size_t i = 0; i < loop.size(); ++i) {
-      const uint32_t in = loop[i], out = loop[(i + 1) % loop.size()];
+      const OrientedEdge in = loop[i], out = loop[(i + 1) % loop.size()];
       if (m.head(in) != v || edge_of(in) == edge_of(out)) continue;
       const size_t r_in = rank(edge_of(in)), r_out = rank(edge_of(out));
       if (r_in == n || r_out == n) continue;
@@ -234,7 +234,7 @@ std::optional<Vec3> network_normal(const Mesh& m, const SnapIndex& index, const 
 // vertex, f's sector lies counter-clockwise from its curve out to its curve in about the fan's normal when the
 // faces turn that way there (`turn`); elsewhere, f lies to the left of its walk about the normal. `normal`: the
 // surface's normal there, toward the camera.
-bool goes_into(const Mesh& m, uint32_t f, const CurveEnd& end, std::span<const Vec3> path, const Vec3& normal, int turn) {
+bool goes_into(const Mesh& m, FaceIndex f, const CurveEnd& end, std::span<const Vec3> path, const Vec3& normal, int turn) {
   const Vec3 q = m.polyline(end.edge)[end.point];
   const std::vector<Vec3> loop = m.face_boundary(f);
   const size_t n = loop.size(), at = size_t(std::find(loop.begin(), loop.end(), q) - loop.begin());
@@ -260,7 +260,7 @@ std::vector<uint32_t> part_labels(const Mesh& m) {
     while (up[v] != v) v = up[v] = up[up[v]];
     return v;
   };
-  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e)
     if (m.edge_alive(e)) up[find(m.edges.vertex[e][0])] = find(m.edges.vertex[e][1]);
   for (uint32_t v = 0; v < up.size(); ++v) up[v] = find(v);
   return up;
@@ -279,9 +279,9 @@ SnapHit network_nearest(const Mesh& m, const SnapIndex& index, const Vec3& p, do
 }
 
 // The points of a pending chain's pieces, from where it began to its free end.
-std::vector<Vec3> chain_points(const Mesh& m, const std::vector<uint32_t>& chain) {
+std::vector<Vec3> chain_points(const Mesh& m, const std::vector<EdgeIndex>& chain) {
   std::vector<Vec3> points;
-  for (uint32_t e : chain) {
+  for (EdgeIndex e : chain) {
     const std::span<const Vec3> line = m.polyline(e);
     points.insert(points.end(), line.begin() + (points.empty() ? 0 : 1), line.end());
   }
@@ -289,12 +289,12 @@ std::vector<Vec3> chain_points(const Mesh& m, const std::vector<uint32_t>& chain
 }
 
 // The open border's first and last vertices (the first is the start of the first edge drawn).
-std::pair<uint32_t, uint32_t> border_ends(const Mesh& m) {
-  uint32_t first = kNone, last = kNone;
-  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+std::pair<VertexIndex, VertexIndex> border_ends(const Mesh& m) {
+  VertexIndex first, last;
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e) {
     if (!m.edge_alive(e)) continue;
-    if (m.valence(m.edges.vertex[e][0]) == 1) first = m.edges.vertex[e][0];
-    if (m.valence(m.edges.vertex[e][1]) == 1) last = m.edges.vertex[e][1];
+    if (const VertexIndex v{m.edges.vertex[e][0]}; m.valence(v) == 1) first = v;
+    if (const VertexIndex v{m.edges.vertex[e][1]}; m.valence(v) == 1) last = v;
   }
   return {first, last};
 }
@@ -344,7 +344,7 @@ class FaceBySide {
   const Slab& slab(uint32_t f) {
     for (const Slab& s : slabs_)
       if (s.face == f) return s;
-    const std::vector<Vec3> boundary = m_.face_boundary(f);
+    const std::vector<Vec3> boundary = m_.face_boundary(FaceIndex{f});
     const LoopPlane plane = loop_plane(boundary);
     double low = 0, high = 0, extent = 0;
     for (const Vec3& q : boundary) {
@@ -381,10 +381,10 @@ std::vector<FaceRun> face_runs(const std::vector<Vec3>& stroke, FaceBySide& face
 }
 
 // Whether faces a and b share a corner (and so maybe a curve).
-bool faces_touch(const Mesh& m, uint32_t a, uint32_t b) {
-  const std::span<const uint32_t> la = m.face_loop(a), lb = m.face_loop(b);
-  return std::any_of(la.begin(), la.end(), [&](uint32_t oa) {
-    return std::any_of(lb.begin(), lb.end(), [&](uint32_t ob) { return m.tail(oa) == m.tail(ob); });
+bool faces_touch(const Mesh& m, FaceIndex a, FaceIndex b) {
+  const std::span<const OrientedEdge> la = m.face_loop(a), lb = m.face_loop(b);
+  return std::any_of(la.begin(), la.end(), [&](OrientedEdge oa) {
+    return std::any_of(lb.begin(), lb.end(), [&](OrientedEdge ob) { return m.tail(oa) == m.tail(ob); });
   });
 }
 
@@ -395,11 +395,11 @@ struct Cut {
   size_t sample = 0;
 };
 
-std::optional<Cut> crossing_between(const Mesh& m, uint32_t a, uint32_t b, const std::vector<Vec3>& stroke, size_t from, size_t to,
+std::optional<Cut> crossing_between(const Mesh& m, FaceIndex a, FaceIndex b, const std::vector<Vec3>& stroke, size_t from, size_t to,
                                     double vertex_radius) {
   std::optional<Cut> best;
   double best_distance = std::numeric_limits<double>::infinity();
-  auto consider = [&](uint32_t e, uint32_t k) {
+  auto consider = [&](EdgeIndex e, uint32_t k) {
     const Vec3& q = m.polyline(e)[k];
     for (size_t j = from; j <= to; ++j)
       if (const double d = (stroke[j] - q).norm(); d < best_distance) {
@@ -407,14 +407,14 @@ std::optional<Cut> crossing_between(const Mesh& m, uint32_t a, uint32_t b, const
         best = Cut{{e, k}, j};
       }
   };
-  const std::span<const uint32_t> loop = m.face_loop(a);
-  for (uint32_t oe : loop)
+  const std::span<const OrientedEdge> loop = m.face_loop(a);
+  for (OrientedEdge oe : loop)
     if (m.other_face(edge_of(oe), a) == b)
       for (uint32_t k = 0; k < m.edges.point_count[edge_of(oe)]; ++k) consider(edge_of(oe), k);
   if (!best) {
-    const std::span<const uint32_t> other = m.face_loop(b);
-    for (uint32_t oe : loop)
-      if (std::any_of(other.begin(), other.end(), [&](uint32_t ob) { return m.tail(ob) == m.tail(oe); }))
+    const std::span<const OrientedEdge> other = m.face_loop(b);
+    for (OrientedEdge oe : loop)
+      if (std::any_of(other.begin(), other.end(), [&](OrientedEdge ob) { return m.tail(ob) == m.tail(oe); }))
         consider(edge_of(oe), is_reversed(oe) ? m.edges.point_count[edge_of(oe)] - 1 : 0);
   }
   if (best) best->at = at_vertex(m, loop, best->at, stroke[best->sample], vertex_radius);
@@ -443,7 +443,8 @@ std::optional<EditCommand> plan_crossing(const Mesh& m, const SnapIndex& index, 
       for (const SnapHit& h : hits)
         for (uint32_t f : m.edges.face[h.edge]) {
           if (f == told) return told;
-          if (f != kNone && !std::count(touching.begin(), touching.end(), f) && faces_touch(m, f, told)) touching.push_back(f);
+          if (f != kNone && !std::count(touching.begin(), touching.end(), f) && faces_touch(m, FaceIndex{f}, FaceIndex{told}))
+            touching.push_back(f);
         }
       return touching.size() == 1 ? touching.front() : kNone;
     };
@@ -457,8 +458,8 @@ std::optional<EditCommand> plan_crossing(const Mesh& m, const SnapIndex& index, 
   if (runs.size() < 2 || std::any_of(runs.begin(), runs.end(), [](const FaceRun& r) { return r.face == kNone; })) return std::nullopt;
   EditCommand c;
   c.kind = EditKind::CrossCurves;
-  c.face = runs.front().face;
-  const uint32_t last_face = runs.back().face;
+  c.face = FaceIndex{runs.front().face};
+  const FaceIndex last_face{runs.back().face};
   const SnapHit a = index.nearest_on_face(m, c.face, stroke.front(), start_radius);
   const SnapHit b = index.nearest_on_face(m, last_face, stroke.back(), end_radius);
   if (!a.found() || !b.found()) return std::nullopt;
@@ -470,14 +471,14 @@ std::optional<EditCommand> plan_crossing(const Mesh& m, const SnapIndex& index, 
   if (runs.size() < 2 || runs.front().face != c.face || runs.back().face != last_face) return std::nullopt;
   std::vector<Vec3> cuts{start};
   for (size_t r = 0; r + 1 < runs.size(); ++r) {
-    const std::optional<Cut> cut = crossing_between(m, runs[r].face, runs[r + 1].face, stroke, runs[r].last, runs[r + 1].first, vertex_radius);
+    const std::optional<Cut> cut = crossing_between(m, FaceIndex{runs[r].face}, FaceIndex{runs[r + 1].face}, stroke, runs[r].last, runs[r + 1].first, vertex_radius);
     if (!cut) return std::nullopt;  // faces that do not touch: not a stroke over the surface
     const size_t sample = std::max<size_t>(cut->sample, (c.crossings.empty() ? 0 : c.crossings.back().point) + 1);
     if (sample + 1 >= stroke.size()) {
       refusal = "the stroke crosses curves closer together than its pen samples; draw it more slowly";
       return std::nullopt;
     }
-    c.crossings.push_back({cut->at, uint32_t(sample), runs[r + 1].face});
+    c.crossings.push_back({cut->at, uint32_t(sample), FaceIndex{runs[r + 1].face}});
     cuts.push_back(m.polyline(cut->at.edge)[cut->at.point]);
   }
   cuts.push_back(end);
@@ -503,21 +504,21 @@ Snap snap_to_face(const Mesh& m, const SnapIndex& index, const Vec3& start, cons
   index.nearest_per_edge(start, limit, near_start);
   index.nearest_per_edge(end, limit, near_end);
   auto faces_of = [&](const std::vector<SnapHit>& hits) {
-    std::vector<uint32_t> out;
+    std::vector<FaceIndex> out;
     for (const SnapHit& h : hits)
       for (uint32_t f : m.edges.face[h.edge])
-        if (f != kNone) out.push_back(f);
+        if (f != kNone) out.push_back(FaceIndex{f});
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
     return out;
   };
-  const std::vector<uint32_t> a_faces = faces_of(near_start), b_faces = faces_of(near_end);
-  std::vector<uint32_t> candidates;
+  const std::vector<FaceIndex> a_faces = faces_of(near_start), b_faces = faces_of(near_end);
+  std::vector<FaceIndex> candidates;
   std::set_intersection(a_faces.begin(), a_faces.end(), b_faces.begin(), b_faces.end(), std::back_inserter(candidates));
 
   Snap best;
   double best_cost = std::numeric_limits<double>::infinity();
-  for (uint32_t f : candidates) {
+  for (FaceIndex f : candidates) {
     if (!m.face_alive(f)) continue;
     const SnapHit a = index.nearest_on_face(m, f, start, limit), b = index.nearest_on_face(m, f, end, limit);
     if (!a.found() || !b.found()) continue;
@@ -531,12 +532,12 @@ Snap snap_to_face(const Mesh& m, const SnapIndex& index, const Vec3& start, cons
   return best;
 }
 
-uint32_t pick_edge(const SnapIndex& index, const Vec3& p, double limit) { return index.nearest(p, limit).edge; }
+EdgeIndex pick_edge(const SnapIndex& index, const Vec3& p, double limit) { return index.nearest(p, limit).edge; }
 
-uint32_t face_under(const Mesh& m, const Vec3& p) {
-  uint32_t best = kNone;
+FaceIndex face_under(const Mesh& m, const Vec3& p) {
+  FaceIndex best;
   double best_height = std::numeric_limits<double>::infinity();
-  for (uint32_t f = 0; f < m.face_slots(); ++f) {
+  for (FaceIndex f{0}; f < m.face_slots(); ++f) {
     if (!m.face_alive(f)) continue;
     const std::vector<Vec3> loop = m.face_boundary(f);
     const LoopPlane lp = loop_plane(loop);
@@ -576,7 +577,7 @@ void publish_feedback(const Mesh& mesh, const SnapIndex& snap, const SketchState
   fb.closes_border = false;
   if (!fb.pen_seen || mesh.edge_count() == 0) return;
   if (mesh.border_in_progress()) {
-    const uint32_t first = border_ends(mesh).first;
+    const VertexIndex first = border_ends(mesh).first;
     if (first == kNone) return;
     fb.first_vertex = mesh.vertex_id(first);
     fb.closes_border = (fb.pen - mesh.vertices.position[first]).norm() <= fb.radius;
@@ -599,7 +600,7 @@ void publish_feedback(const Mesh& mesh, const SnapIndex& snap, const SketchState
     fb.target_point = h.point;
     fb.target = mesh.polyline(h.edge)[h.point];
   }
-  if (const uint32_t f = face_under(mesh, fb.pen); f != kNone) fb.face = mesh.face_id(f);
+  if (const FaceIndex f = face_under(mesh, fb.pen); f != kNone) fb.face = mesh.face_id(f);
 }
 
 }  // namespace
@@ -676,14 +677,14 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
         } else {
           // A stroke in pieces: one that ends off the network waits as a pending chain, and the next stroke from
           // its free end goes on with it, until one reaches the network and the whole curve is drawn.
-          uint32_t chain_last = kNone;
+          EdgeIndex chain_last;
           if (settings.topology_strokes && mesh.face_count() > 0) {
             const double start_radius = radius(state.start_snap);
             const bool end_on_network = network_nearest(mesh, snap, r.command.points.back(), end_snap).found();
-            const std::vector<std::vector<uint32_t>> chains = mesh.pending_chains();
+            const std::vector<std::vector<EdgeIndex>> chains = mesh.pending_chains();
             double nearest_free_end = std::numeric_limits<double>::infinity();
-            const std::vector<uint32_t>* chain = nullptr;
-            for (const std::vector<uint32_t>& c : chains) {
+            const std::vector<EdgeIndex>* chain = nullptr;
+            for (const std::vector<EdgeIndex>& c : chains) {
               const double d = (mesh.vertices.position[mesh.edges.vertex[c.back()][1]] - r.command.points.front()).norm();
               if (d < nearest_free_end) {
                 nearest_free_end = d;
@@ -735,21 +736,21 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
             };
             // Each judged end of the stroke as it lands on face c's boundary, with the path from it.
             auto judged_ends = [&](const Snap& c) {
-              const std::span<const uint32_t> loop = mesh.face_loop(c.face);
+              const std::span<const OrientedEdge> loop = mesh.face_loop(c.face);
               std::vector<std::pair<CurveEnd, std::span<const Vec3>>> out;
               if (start_judged) out.emplace_back(at_vertex(mesh, loop, c.start, ahead.front(), vertex_radius(state.start_snap)), ahead);
               out.emplace_back(at_vertex(mesh, loop, c.end, ahead.back(), vertex_radius(state.end_snap)), back);
               return out;
             };
             auto fan_of = [&](const CurveEnd& e, std::span<const Vec3> path) -> std::optional<Fan> {
-              const uint32_t v = vertex_of(e);
+              const VertexIndex v{vertex_of(e)};
               if (v == kNone) return std::nullopt;
               return fan_at(mesh, v, direction_along(path, mesh.vertices.position[v]), *viewpoint);
             };
             // The surface's normal at an end on face f's boundary, toward the camera. Where the camera looks along
             // the surface, the faces' turn about the outside, where known (`turn` not 0), orients it instead: face f
             // walks `turn` about it.
-            auto normal_at = [&](const CurveEnd& e, std::span<const Vec3> path, uint32_t f, int turn) {
+            auto normal_at = [&](const CurveEnd& e, std::span<const Vec3> path, FaceIndex f, int turn) {
               if (const std::optional<Fan> fan = fan_of(e, path)) return fan->normal;
               const Vec3 q = mesh.polyline(e.edge)[e.point];
               const Vec3 view = (*viewpoint - q).normalized();
@@ -772,10 +773,10 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
             };
             // The way the faces turn: as the part's first split found it; else as the fans at the judged ends say.
             const std::vector<uint32_t> part = part_labels(mesh);
-            auto part_of = [&](uint32_t f) { return part[mesh.tail(mesh.face_loop(f)[0])]; };
+            auto part_of = [&](FaceIndex f) { return part[mesh.tail(mesh.face_loop(f)[0])]; };
             auto faces_in = [&](uint32_t p) {
               size_t n = 0;
-              for (uint32_t f = 0; f < mesh.face_slots(); ++f) n += mesh.face_alive(f) && part_of(f) == p;
+              for (FaceIndex f{0}; f < mesh.face_slots(); ++f) n += mesh.face_alive(f) && part_of(f) == p;
               return n;
             };
             // A part drawn back to its border by undo is split first again, maybe from its other side.
@@ -839,8 +840,8 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
                    format_mm(end_hit.distance) + ")");
             break;
           }
-          const std::span<const uint32_t> loop = s.face != kNone ? mesh.face_loop(s.face) : std::span<const uint32_t>(h.rim);
-          const std::span<const uint32_t> end_loop = s.face != kNone ? loop : std::span<const uint32_t>(h.end_rim);
+          const std::span<const OrientedEdge> loop = s.face != kNone ? mesh.face_loop(s.face) : std::span<const OrientedEdge>(h.rim);
+          const std::span<const OrientedEdge> end_loop = s.face != kNone ? loop : std::span<const OrientedEdge>(h.end_rim);
           r.command.kind = s.face != kNone ? EditKind::SplitFace : h.join ? EditKind::JoinBorders : EditKind::SplitHole;
           r.command.face = s.face;
           r.command.start = at_vertex(mesh, loop, s.face != kNone ? s.start : h.start, r.command.points.front(), vertex_radius(state.start_snap));
@@ -880,7 +881,7 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           r.command.kind = EditKind::CloseBorder;
           r.command.snap_distance = settings.snap_distance;
         } else if (ev.command == CommandKind::Hole) {
-          const uint32_t f = face_under(mesh, ev.p);
+          const FaceIndex f = face_under(mesh, ev.p);
           if (f == kNone) {
             reject("hole: no face under the picked point (" + format_double(ev.p.x()) + ", " + format_double(ev.p.y()) + ", " +
                    format_double(ev.p.z()) + ")");
@@ -890,7 +891,7 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           r.command.face = f;
         } else {  // delete or sharp: the curve nearest to the picked point
           const bool remove = ev.command == CommandKind::Delete;
-          uint32_t e = pick_edge(snap, ev.p, settings.snap_distance);
+          const EdgeIndex e = pick_edge(snap, ev.p, settings.snap_distance);
           if (e == kNone) {
             reject(std::string(remove ? "delete" : "sharp") + ": no curve within " +
                    std::to_string(settings.snap_distance) + " of the picked point");

@@ -60,7 +60,7 @@ struct SketchState {
 
 // Where a stroke end lands: the face, and the polyline point on that face's boundary.
 struct Snap {
-  uint32_t face = kNone;
+  FaceIndex face;
   CurveEnd start, end;
   double start_distance = 0, end_distance = 0;
 };
@@ -71,12 +71,12 @@ struct Snap {
 Snap snap_to_face(const Mesh& mesh, const SnapIndex& index, const Vec3& start, const Vec3& end, double limit,
                   const std::function<bool(const Snap&)>& accept = {});
 // The live edge with a polyline point nearest to p within `limit` (the lowest slot on ties), or kNone.
-uint32_t pick_edge(const SnapIndex& index, const Vec3& p, double limit);
+EdgeIndex pick_edge(const SnapIndex& index, const Vec3& p, double limit);
 
 // The live face the pen is over: the pen projects inside its boundary, seen along the boundary's mean normal
 // (Newell), and lies off that plane by at most the boundary's distance from its centroid; of several, the one
 // nearest its plane (the lowest slot on ties). kNone when there is none.
-uint32_t face_under(const Mesh& mesh, const Vec3& p);
+FaceIndex face_under(const Mesh& mesh, const Vec3& p);
 
 // Emits at most one request per frame (see `pending`). `snap` is in step with `mesh`. Publishes `feedback`
 // (engine/pen_feedback.hpp) for the mesh as this frame found it, from the last pen sample handled.

@@ -23,24 +23,25 @@ bool has_faces(const Mesh& m) { return m.face_count() > 0; }
 
 // The open border chain, in drawing order: its first and last vertices and its edges.
 struct BorderChain {
-  uint32_t first = kNone, last = kNone;
-  std::vector<uint32_t> edges;
+  VertexIndex first, last;
+  std::vector<EdgeIndex> edges;
 };
 
 BorderChain open_border(const Mesh& m) {
   BorderChain chain;
-  for (uint32_t e = 0; e < m.edge_slots(); ++e)
-    if (m.edge_alive(e) && m.valence(m.edges.vertex[e][0]) == 1) chain.first = m.edges.vertex[e][0];
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e)
+    if (m.edge_alive(e) && m.valence(VertexIndex{m.edges.vertex[e][0]}) == 1) chain.first = VertexIndex{m.edges.vertex[e][0]};
   if (chain.first == kNone) return chain;
-  uint32_t v = chain.first, came = kNone;
+  VertexIndex v = chain.first;
+  EdgeIndex came;
   for (;;) {
-    uint32_t next = kNone;
-    for (uint32_t e : m.vertex_edges(v))
+    EdgeIndex next;
+    for (EdgeIndex e : m.vertex_edges(v))
       if (e != came && m.edges.vertex[e][0] == v) next = e;
     if (next == kNone) break;
     chain.edges.push_back(next);
     came = next;
-    v = m.edges.vertex[next][1];
+    v = VertexIndex{m.edges.vertex[next][1]};
   }
   chain.last = v;
   return chain;
@@ -59,8 +60,8 @@ Status start_border(Mesh& m, const EditCommand& c) {
   if (m.pending_piece_count() > 0) return Status::failure("a stroke in pieces is pending; finish it or undo it before starting another part");
   if (auto ok = check_points(c.points); !ok.ok()) return ok;
   if (c.points.front() == c.points.back()) return Status::failure("the first border curve ends where it starts");
-  uint32_t a = m.add_vertex(c.points.front());
-  uint32_t b = m.add_vertex(c.points.back());
+  const VertexIndex a = m.add_vertex(c.points.front());
+  const VertexIndex b = m.add_vertex(c.points.back());
   m.add_edge(a, b, c.points);
   return Status::success();
 }
@@ -70,10 +71,10 @@ Status append_border(Mesh& m, const EditCommand& c) {
   BorderChain chain = open_border(m);
   if (c.points.back() == m.vertices.position[chain.last])
     return Status::failure("the border curve ends where it starts (at the last border vertex)");
-  for (uint32_t v = 0; v < m.vertex_slots(); ++v)
+  for (VertexIndex v{0}; v < m.vertex_slots(); ++v)
     if (m.vertex_alive(v) && m.vertices.position[v] == c.points.back())
       return Status::failure("the border curve ends on existing vertex " + str(v) + "; close the border instead");
-  uint32_t b = m.add_vertex(c.points.back());
+  const VertexIndex b = m.add_vertex(c.points.back());
   m.add_edge(chain.last, b, c.points);
   return Status::success();
 }
@@ -84,18 +85,18 @@ Status close_border(Mesh& m, const EditCommand& c) {
   double gap = (c.points.back() - m.vertices.position[chain.first]).norm();
   if (!(gap <= c.snap_distance))
     return Status::failure("the closing curve ends " + std::to_string(gap) + " from the first border vertex, farther than the snap distance " + std::to_string(c.snap_distance));
-  uint32_t e = m.add_edge(chain.last, chain.first, c.points);
-  std::vector<uint32_t> loop;
-  for (uint32_t x : chain.edges) loop.push_back(make_oriented(x, false));
+  const EdgeIndex e = m.add_edge(chain.last, chain.first, c.points);
+  std::vector<OrientedEdge> loop;
+  for (EdgeIndex x : chain.edges) loop.push_back(make_oriented(x, false));
   loop.push_back(make_oriented(e, false));
   if (m.add_face(loop) == kNone) return Status::failure("internal: the border does not form a closed loop");
   return Status::success();
 }
 
 // Replaces the oriented edge `old` in f's loop by `with` (already oriented in f's walking direction).
-void replace_in_loop(Mesh& m, uint32_t f, uint32_t old_edge, const std::vector<uint32_t>& with) {
-  std::vector<uint32_t> loop;
-  for (uint32_t oe : m.face_loop(f)) {
+void replace_in_loop(Mesh& m, FaceIndex f, EdgeIndex old_edge, const std::vector<OrientedEdge>& with) {
+  std::vector<OrientedEdge> loop;
+  for (OrientedEdge oe : m.face_loop(f)) {
     if (edge_of(oe) == old_edge) loop.insert(loop.end(), with.begin(), with.end());
     else loop.push_back(oe);
   }
@@ -104,8 +105,8 @@ void replace_in_loop(Mesh& m, uint32_t f, uint32_t old_edge, const std::vector<u
 
 // Resolves a curve end to a vertex of face f, or reports why it cannot be used.
 struct ResolvedEnd {
-  uint32_t vertex = kNone;  // the end is this vertex
-  uint32_t edge = kNone;    // or an interior point of this edge
+  VertexIndex vertex{};  // the end is this vertex
+  EdgeIndex edge{};      // or an interior point of this edge
   uint32_t point = 0;
 };
 
@@ -113,8 +114,8 @@ Status resolve_point(const Mesh& m, const CurveEnd& end, const char* which, Reso
   uint32_t count = m.edges.point_count[end.edge];
   if (end.point >= count) return Status::failure(std::string("the curve's ") + which + " names point " + str(end.point) + " of edge " + str(end.edge) + ", which has " + str(count));
   out = {};
-  if (end.point == 0) out.vertex = m.edges.vertex[end.edge][0];
-  else if (end.point == count - 1) out.vertex = m.edges.vertex[end.edge][1];
+  if (end.point == 0) out.vertex = VertexIndex{m.edges.vertex[end.edge][0]};
+  else if (end.point == count - 1) out.vertex = VertexIndex{m.edges.vertex[end.edge][1]};
   else {
     out.edge = end.edge;
     out.point = end.point;
@@ -122,7 +123,7 @@ Status resolve_point(const Mesh& m, const CurveEnd& end, const char* which, Reso
   return Status::success();
 }
 
-Status resolve_end(const Mesh& m, uint32_t f, const CurveEnd& end, const char* which, ResolvedEnd& out) {
+Status resolve_end(const Mesh& m, FaceIndex f, const CurveEnd& end, const char* which, ResolvedEnd& out) {
   if (!m.edge_alive(end.edge)) return Status::failure(std::string("the curve's ") + which + " names edge " + str(end.edge) + ", which does not exist");
   if (m.loop_position(f, end.edge) == kNone)
     return Status::failure(std::string("the curve's ") + which + " lies on edge " + str(end.edge) + ", which is not on face " + str(f) + ": a curve must start and end on the same face");
@@ -130,9 +131,9 @@ Status resolve_end(const Mesh& m, uint32_t f, const CurveEnd& end, const char* w
 }
 
 // The same ends checked against a hole: both on the border loop `loop` (a Mesh::border_loop).
-Status resolve_hole_end(const Mesh& m, const std::vector<uint32_t>& loop, const CurveEnd& end, const char* which, ResolvedEnd& out) {
+Status resolve_hole_end(const Mesh& m, const std::vector<OrientedEdge>& loop, const CurveEnd& end, const char* which, ResolvedEnd& out) {
   if (!m.edge_alive(end.edge)) return Status::failure(std::string("the curve's ") + which + " names edge " + str(end.edge) + ", which does not exist");
-  if (std::none_of(loop.begin(), loop.end(), [&](uint32_t oe) { return edge_of(oe) == end.edge; }))
+  if (std::none_of(loop.begin(), loop.end(), [&](OrientedEdge oe) { return edge_of(oe) == end.edge; }))
     return Status::failure(std::string("the curve's ") + which + " lies on edge " + str(end.edge) +
                            ", which is not on the border loop of its other end: a curve across a hole starts and ends on one border loop "
                            "(joining two border loops, for a handle or two parts, is not supported yet)");
@@ -141,14 +142,14 @@ Status resolve_hole_end(const Mesh& m, const std::vector<uint32_t>& loop, const 
 
 // The part of closed walk `loop` from the vertex `from` to the vertex `to`; the whole loop when they are one
 // vertex and `whole`, else nothing.
-std::vector<uint32_t> arc(const Mesh& m, std::span<const uint32_t> loop, uint32_t from, uint32_t to, bool whole) {
+std::vector<OrientedEdge> arc(const Mesh& m, std::span<const OrientedEdge> loop, VertexIndex from, VertexIndex to, bool whole) {
   const size_t n = loop.size();
   size_t i = 0;
   while (i < n && m.tail(loop[i]) != from) ++i;
-  std::vector<uint32_t> out;
+  std::vector<OrientedEdge> out;
   if (from == to && !whole) return out;
   for (size_t k = 0; k < n; ++k) {
-    const uint32_t oe = loop[(i + k) % n];
+    const OrientedEdge oe = loop[(i + k) % n];
     if (k > 0 && m.tail(oe) == to) break;
     out.push_back(oe);
   }
@@ -157,9 +158,9 @@ std::vector<uint32_t> arc(const Mesh& m, std::span<const uint32_t> loop, uint32_
 
 // Cuts `loop` (a closed walk through va and vb) at both vertices and closes each half with the new edge
 // e = va -> vb: the walk from va to vb comes back along e reversed, the walk from vb to va along e.
-std::pair<std::vector<uint32_t>, std::vector<uint32_t>> cut_loop(const Mesh& m, std::span<const uint32_t> loop, uint32_t va,
-                                                                 uint32_t vb, uint32_t e) {
-  std::vector<uint32_t> first = arc(m, loop, va, vb, false), second = arc(m, loop, vb, va, false);
+std::pair<std::vector<OrientedEdge>, std::vector<OrientedEdge>> cut_loop(const Mesh& m, std::span<const OrientedEdge> loop,
+                                                                         VertexIndex va, VertexIndex vb, EdgeIndex e) {
+  std::vector<OrientedEdge> first = arc(m, loop, va, vb, false), second = arc(m, loop, vb, va, false);
   first.push_back(make_oriented(e, true));
   second.push_back(make_oriented(e, false));
   return {std::move(first), std::move(second)};
@@ -167,9 +168,9 @@ std::pair<std::vector<uint32_t>, std::vector<uint32_t>> cut_loop(const Mesh& m, 
 
 // Steps 3-6 of thesis 5.4.2: the new edge va -> vb, and face f replaced by the two loops on either side of it.
 // Returns the new face (the walk from vb back to va).
-uint32_t split_between(Mesh& m, uint32_t f, uint32_t va, uint32_t vb, std::span<const Vec3> points) {
-  const std::vector<uint32_t> loop(m.face_loop(f).begin(), m.face_loop(f).end());
-  const uint32_t e = m.add_edge(va, vb, points);
+FaceIndex split_between(Mesh& m, FaceIndex f, VertexIndex va, VertexIndex vb, std::span<const Vec3> points) {
+  const std::vector<OrientedEdge> loop(m.face_loop(f).begin(), m.face_loop(f).end());
+  const EdgeIndex e = m.add_edge(va, vb, points);
   auto [first, second] = cut_loop(m, loop, va, vb, e);
   m.set_face_loop(f, first);
   return m.add_face(second);
@@ -188,8 +189,8 @@ Status split_face(Mesh& m, const EditCommand& c) {
     return Status::failure("the curve starts and ends on the same edge " + str(a.edge) + ": it must join two different edges of the face");
 
   // Steps 1-2 of thesis 5.4.2: split the edges the curve ends on; faces on both sides are updated.
-  uint32_t va = a.vertex != kNone ? a.vertex : split_edge(m, a.edge, a.point);
-  uint32_t vb = b.vertex != kNone ? b.vertex : split_edge(m, b.edge, b.point);
+  const VertexIndex va = a.vertex != kNone ? a.vertex : split_edge(m, a.edge, a.point);
+  const VertexIndex vb = b.vertex != kNone ? b.vertex : split_edge(m, b.edge, b.point);
 
   split_between(m, c.face, va, vb, c.points);
   return Status::success();
@@ -199,15 +200,15 @@ Status split_face(Mesh& m, const EditCommand& c) {
 // the border: one beside it would leave a curve with no face at all, one touching it at a corner would pinch
 // the surface to a point there.
 Status make_hole(Mesh& m, const EditCommand& c) {
-  const uint32_t f = c.face;
+  const FaceIndex f = c.face;
   if (!m.face_alive(f)) return Status::failure("face " + str(f) + " does not exist");
-  for (uint32_t oe : m.face_loop(f))
+  for (OrientedEdge oe : m.face_loop(f))
     if (m.is_border_edge(edge_of(oe)))
       return Status::failure("face " + str(f) + " lies beside the border at curve " + str(edge_of(oe)) +
                              ": a hole there would leave that curve with no surface on either side (delete curves to open the border instead)");
-  for (uint32_t oe : m.face_loop(f)) {
-    const uint32_t v = m.tail(oe);
-    for (uint32_t g : m.vertex_edges(v))
+  for (OrientedEdge oe : m.face_loop(f)) {
+    const VertexIndex v = m.tail(oe);
+    for (EdgeIndex g : m.vertex_edges(v))
       if (m.is_border_edge(g))
         return Status::failure("face " + str(f) + " touches the border at vertex " + str(v) + ": a hole there would pinch the surface to a point");
   }
@@ -216,26 +217,26 @@ Status make_hole(Mesh& m, const EditCommand& c) {
 }
 
 // The bridge waiting at a vertex of border loop `loop`, or kNone.
-uint32_t bridge_at(const Mesh& m, const std::vector<uint32_t>& loop) {
-  for (uint32_t oe : loop)
-    for (uint32_t g : m.vertex_edges(m.tail(oe)))
+EdgeIndex bridge_at(const Mesh& m, const std::vector<OrientedEdge>& loop) {
+  for (OrientedEdge oe : loop)
+    for (EdgeIndex g : m.vertex_edges(m.tail(oe)))
       if (m.is_waiting_bridge(g)) return g;
-  return kNone;
+  return EdgeIndex{};
 }
 
-bool on_loop(const Mesh& m, const std::vector<uint32_t>& loop, uint32_t v) {
-  return std::any_of(loop.begin(), loop.end(), [&](uint32_t oe) { return m.tail(oe) == v; });
+bool on_loop(const Mesh& m, const std::vector<OrientedEdge>& loop, uint32_t v) {
+  return std::any_of(loop.begin(), loop.end(), [&](OrientedEdge oe) { return m.tail(oe) == v; });
 }
 
 // The border loop through vertex v, walked by its hole (empty if v is on none).
-std::vector<uint32_t> rim_at(const Mesh& m, uint32_t v) {
-  for (uint32_t g : m.vertex_edges(v))
+std::vector<OrientedEdge> rim_at(const Mesh& m, VertexIndex v) {
+  for (EdgeIndex g : m.vertex_edges(v))
     if (m.is_border_edge(g) && !m.is_loose_edge(g)) return m.border_loop(g);
   return {};
 }
 
 // Checks one end of a curve between border loops: on a border curve with one face, whose loop has a single rim.
-Status border_end(const Mesh& m, const CurveEnd& end, const char* which, std::vector<uint32_t>& loop) {
+Status border_end(const Mesh& m, const CurveEnd& end, const char* which, std::vector<OrientedEdge>& loop) {
   if (!m.edge_alive(end.edge)) return Status::failure(std::string("the curve's ") + which + " names edge " + str(end.edge) + ", which does not exist");
   if (!m.is_border_edge(end.edge) || m.is_loose_edge(end.edge))
     return Status::failure(std::string("the curve's ") + which + " lies on curve " + str(end.edge) + ", which is not on the border");
@@ -252,7 +253,7 @@ Status join_borders(Mesh& m, const EditCommand& c) {
   if (!has_faces(m)) return Status::failure("close a border polygon before joining border loops");
   if (m.border_in_progress()) return Status::failure("a border polygon is being drawn; close it first");
   if (auto ok = check_points(c.points); !ok.ok()) return ok;
-  std::vector<uint32_t> loop_a, loop_b;
+  std::vector<OrientedEdge> loop_a, loop_b;
   if (auto ok = border_end(m, c.start, "start", loop_a); !ok.ok()) return ok;
   if (auto ok = border_end(m, c.end, "end", loop_b); !ok.ok()) return ok;
   if (on_loop(m, loop_a, m.tail(loop_b.front())))
@@ -261,8 +262,8 @@ Status join_borders(Mesh& m, const EditCommand& c) {
   if (auto ok = resolve_point(m, c.start, "start", a); !ok.ok()) return ok;
   if (auto ok = resolve_point(m, c.end, "end", b); !ok.ok()) return ok;
   // A bridge already waiting between these two loops.
-  uint32_t bridge = kNone;
-  for (uint32_t g = 0; g < m.edge_slots() && bridge == kNone; ++g) {
+  EdgeIndex bridge;
+  for (EdgeIndex g{0}; g < m.edge_slots() && bridge == kNone; ++g) {
     if (!m.edge_alive(g) || !m.is_waiting_bridge(g)) continue;
     const auto ends = m.edges.vertex[g];
     if ((on_loop(m, loop_a, ends[0]) && on_loop(m, loop_b, ends[1])) || (on_loop(m, loop_a, ends[1]) && on_loop(m, loop_b, ends[0])))
@@ -272,21 +273,21 @@ Status join_borders(Mesh& m, const EditCommand& c) {
     for (uint32_t v : {a.vertex, b.vertex})
       if (v != kNone && (v == m.edges.vertex[bridge][0] || v == m.edges.vertex[bridge][1]))
         return Status::failure("the curve ends at vertex " + str(v) + ", where the bridge waiting between these loops ends: the face beside them would touch itself there");
-  const uint32_t va = a.vertex != kNone ? a.vertex : split_edge(m, a.edge, a.point);
-  const uint32_t vb = b.vertex != kNone ? b.vertex : split_edge(m, b.edge, b.point);
-  const uint32_t e = m.add_edge(va, vb, c.points);
+  const VertexIndex va = a.vertex != kNone ? a.vertex : split_edge(m, a.edge, a.point);
+  const VertexIndex vb = b.vertex != kNone ? b.vertex : split_edge(m, b.edge, b.point);
+  const EdgeIndex e = m.add_edge(va, vb, c.points);
   if (bridge == kNone) {
     m.set_edge_flag(e, kBridgeEdge, true);
     return Status::success();
   }
-  const std::vector<uint32_t> rim_a = rim_at(m, va), rim_b = rim_at(m, vb);
+  const std::vector<OrientedEdge> rim_a = rim_at(m, va), rim_b = rim_at(m, vb);
   const auto ends = m.edges.vertex[bridge];
-  const uint32_t pa = on_loop(m, rim_a, ends[0]) ? ends[0] : ends[1], qb = pa == ends[0] ? ends[1] : ends[0];
-  const uint32_t bridge_forward = make_oriented(bridge, ends[0] != pa), bridge_back = make_oriented(bridge, ends[0] == pa);
+  const VertexIndex pa{on_loop(m, rim_a, ends[0]) ? ends[0] : ends[1]}, qb{pa == ends[0] ? ends[1] : ends[0]};
+  const OrientedEdge bridge_forward = make_oriented(bridge, ends[0] != pa), bridge_back = make_oriented(bridge, ends[0] == pa);
   // One face walks rim a from va to pa, the bridge, rim b from qb to vb, the new curve back; the other the rest.
-  std::vector<uint32_t> first = arc(m, rim_a, va, pa, false), second = arc(m, rim_a, pa, va, true);
+  std::vector<OrientedEdge> first = arc(m, rim_a, va, pa, false), second = arc(m, rim_a, pa, va, true);
   first.push_back(bridge_forward);
-  const std::vector<uint32_t> b_first = arc(m, rim_b, qb, vb, false), b_second = arc(m, rim_b, vb, qb, true);
+  const std::vector<OrientedEdge> b_first = arc(m, rim_b, qb, vb, false), b_second = arc(m, rim_b, vb, qb, true);
   first.insert(first.end(), b_first.begin(), b_first.end());
   first.push_back(make_oriented(e, true));
   second.push_back(make_oriented(e, false));
@@ -304,7 +305,7 @@ Status split_hole(Mesh& m, const EditCommand& c) {
   if (!has_faces(m)) return Status::failure("close the border polygon before drawing across its hole");
   if (m.border_in_progress()) return Status::failure("a border polygon is being drawn; close it first");
   if (auto ok = check_points(c.points); !ok.ok()) return ok;
-  std::vector<uint32_t> loop;
+  std::vector<OrientedEdge> loop;
   if (auto ok = border_end(m, c.start, "start", loop); !ok.ok()) return ok;
   if (bridge_at(m, loop) != kNone)
     return Status::failure("a bridge from this border loop waits for its second curve: draw that (or undo the bridge) before crossing the loop's hole");
@@ -315,11 +316,11 @@ Status split_hole(Mesh& m, const EditCommand& c) {
     return Status::failure("the curve starts and ends on vertex " + str(a.vertex) + ": it would make a face with fewer than 2 edges");
   if (a.edge != kNone && a.edge == b.edge)
     return Status::failure("the curve starts and ends on the same edge " + str(a.edge) + ": it must join two different border curves");
-  const uint32_t va = a.vertex != kNone ? a.vertex : split_edge(m, a.edge, a.point);
-  const uint32_t vb = b.vertex != kNone ? b.vertex : split_edge(m, b.edge, b.point);
+  const VertexIndex va = a.vertex != kNone ? a.vertex : split_edge(m, a.edge, a.point);
+  const VertexIndex vb = b.vertex != kNone ? b.vertex : split_edge(m, b.edge, b.point);
   // The split edges are new: the rim is walked again from one of va's border curves.
-  const std::vector<uint32_t> rim = rim_at(m, va);
-  const uint32_t e = m.add_edge(va, vb, c.points);
+  const std::vector<OrientedEdge> rim = rim_at(m, va);
+  const EdgeIndex e = m.add_edge(va, vb, c.points);
   auto [first, second] = cut_loop(m, rim, va, vb, e);
   m.add_face(first);
   m.add_face(second);
@@ -327,12 +328,12 @@ Status split_hole(Mesh& m, const EditCommand& c) {
 }
 
 // Joins the two edges at a split vertex that no curve needs any more (valence 2), undoing an edge split.
-void join_at(Mesh& m, uint32_t v) {
+void join_at(Mesh& m, VertexIndex v) {
   if (!m.vertex_alive(v) || !(m.vertices.flags[v] & kSplitVertex) || m.valence(v) != 2) return;
   auto incident = m.vertex_edges(v);
-  uint32_t a = incident[0], b = incident[1];
-  uint32_t u = m.edges.vertex[a][0] == v ? m.edges.vertex[a][1] : m.edges.vertex[a][0];
-  uint32_t w = m.edges.vertex[b][0] == v ? m.edges.vertex[b][1] : m.edges.vertex[b][0];
+  const EdgeIndex a = incident[0], b = incident[1];
+  const VertexIndex u{m.edges.vertex[a][0] == v ? m.edges.vertex[a][1] : m.edges.vertex[a][0]};
+  const VertexIndex w{m.edges.vertex[b][0] == v ? m.edges.vertex[b][1] : m.edges.vertex[b][0]};
   if (u == w) return;  // joining would make an edge from a vertex to itself
   std::vector<Vec3> line;
   auto pa = m.polyline(a);
@@ -343,15 +344,16 @@ void join_at(Mesh& m, uint32_t v) {
   else line.insert(line.end(), pb.rbegin() + 1, pb.rend());
   const auto faces_of_a = m.edges.face[a];
   const bool sharp = (m.edges.flags[a] & kSharpEdge) && (m.edges.flags[b] & kSharpEdge);
-  uint32_t c = m.add_edge(u, w, line);
+  const EdgeIndex c = m.add_edge(u, w, line);
   if (sharp) m.set_edge_flag(c, kSharpEdge, true);
-  for (uint32_t f : faces_of_a) {
+  for (uint32_t side : faces_of_a) {
+    const FaceIndex f{side};
     if (f == kNone) continue;
-    std::vector<uint32_t> loop;
+    std::vector<OrientedEdge> loop;
     auto old = m.face_loop(f);
     // The face walks u -> v -> w (forward c) or w -> v -> u (reversed c); drop b, put c where a was.
-    for (uint32_t oe : old) {
-      uint32_t x = edge_of(oe);
+    for (OrientedEdge oe : old) {
+      const EdgeIndex x = edge_of(oe);
       if (x == b) continue;
       if (x == a) loop.push_back(make_oriented(c, m.head(oe) == u));
       else loop.push_back(oe);
@@ -364,22 +366,22 @@ void join_at(Mesh& m, uint32_t v) {
 }
 
 Status delete_curve(Mesh& m, const EditCommand& c) {
-  uint32_t e = c.edge;
+  const EdgeIndex e = c.edge;
   if (!m.edge_alive(e)) return Status::failure("edge " + str(e) + " does not exist");
   if (!has_faces(m)) return Status::failure("curves can be deleted once the border polygon is closed");
   if (m.is_pending(e)) return Status::failure("edge " + str(e) + " is a piece of a stroke still pending; undo removes its last piece");
   if (m.is_waiting_bridge(e)) {  // it goes alone
     const auto ends = m.edges.vertex[e];
     m.remove_edge(e);
-    join_at(m, ends[0]);
-    join_at(m, ends[1]);
+    join_at(m, VertexIndex{ends[0]});
+    join_at(m, VertexIndex{ends[1]});
     return Status::success();
   }
-  uint32_t f0 = m.edges.face[e][0], f1 = m.edges.face[e][1];
+  const FaceIndex f0{m.edges.face[e][0]}, f1{m.edges.face[e][1]};
   if (f0 == kNone || f1 == kNone) return Status::failure("edge " + str(e) + " is on the border polygon; only curves inside it can be deleted");
   // The merged face walks f0 after e, then f1 after e: it must stay a simple loop.
-  std::vector<uint32_t> merged;
-  auto append_after = [&](uint32_t f) {
+  std::vector<OrientedEdge> merged;
+  auto append_after = [&](FaceIndex f) {
     auto loop = m.face_loop(f);
     uint32_t at = m.loop_position(f, e), n = static_cast<uint32_t>(loop.size());
     for (uint32_t k = 1; k < n; ++k) merged.push_back(loop[(at + k) % n]);
@@ -387,7 +389,7 @@ Status delete_curve(Mesh& m, const EditCommand& c) {
   append_after(f0);
   append_after(f1);
   std::vector<uint32_t> seen_edges, seen_vertices;
-  for (uint32_t oe : merged) {
+  for (OrientedEdge oe : merged) {
     seen_edges.push_back(edge_of(oe));
     seen_vertices.push_back(m.tail(oe));
   }
@@ -402,23 +404,23 @@ Status delete_curve(Mesh& m, const EditCommand& c) {
   m.remove_face(f1);
   m.set_face_loop(f0, merged);
   m.remove_edge(e);
-  join_at(m, ends[0]);
-  join_at(m, ends[1]);
+  join_at(m, VertexIndex{ends[0]});
+  join_at(m, VertexIndex{ends[1]});
   return Status::success();
 }
 
-bool on_face(const Mesh& m, uint32_t f, const ResolvedEnd& r) {
+bool on_face(const Mesh& m, FaceIndex f, const ResolvedEnd& r) {
   if (r.vertex == kNone) return m.loop_position(f, r.edge) != kNone;
-  const std::span<const uint32_t> loop = m.face_loop(f);
-  return std::any_of(loop.begin(), loop.end(), [&](uint32_t oe) { return m.tail(oe) == r.vertex; });
+  const std::span<const OrientedEdge> loop = m.face_loop(f);
+  return std::any_of(loop.begin(), loop.end(), [&](OrientedEdge oe) { return m.tail(oe) == r.vertex; });
 }
 
 // Where a cut lies along face f's walk: the loop position of its edge (of its vertex's first edge), then how far
 // along that edge in the walking direction.
-std::pair<size_t, uint32_t> along_loop(const Mesh& m, uint32_t f, const ResolvedEnd& r) {
-  const std::span<const uint32_t> loop = m.face_loop(f);
+std::pair<size_t, uint32_t> along_loop(const Mesh& m, FaceIndex f, const ResolvedEnd& r) {
+  const std::span<const OrientedEdge> loop = m.face_loop(f);
   for (size_t i = 0; i < loop.size(); ++i) {
-    const uint32_t e = edge_of(loop[i]);
+    const EdgeIndex e = edge_of(loop[i]);
     if (r.vertex != kNone && m.tail(loop[i]) == r.vertex) return {i, 0};
     if (r.vertex == kNone && e == r.edge) return {i, is_reversed(loop[i]) ? m.edges.point_count[e] - 1 - r.point : r.point};
   }
@@ -444,7 +446,8 @@ Status cross_curves(Mesh& m, const EditCommand& c) {
   if (!has_faces(m)) return Status::failure("close the border polygon before drawing across curves");
   if (auto ok = check_points(c.points); !ok.ok()) return ok;
   if (c.crossings.empty()) return Status::failure("the stroke across curves names no crossing");
-  std::vector<uint32_t> faces{c.face}, at{0};
+  std::vector<FaceIndex> faces{c.face};
+  std::vector<uint32_t> at{0};
   std::vector<CurveEnd> cuts{c.start};
   for (const Crossing& x : c.crossings) {
     faces.push_back(x.face);
@@ -485,7 +488,8 @@ Status cross_curves(Mesh& m, const EditCommand& c) {
 
   // Cut the curves. On each edge from its last cut point to its first, so the points still to cut stay on the
   // first half, which is the edge that ends at the new vertex.
-  std::vector<uint32_t> vertex(cut.size(), kNone), order;
+  std::vector<VertexIndex> vertex(cut.size());
+  std::vector<uint32_t> order;
   for (size_t i = 0; i < cut.size(); ++i) {
     if (cut[i].vertex != kNone) vertex[i] = cut[i].vertex;
     else order.push_back(uint32_t(i));
@@ -496,19 +500,19 @@ Status cross_curves(Mesh& m, const EditCommand& c) {
   for (size_t k = 0; k < order.size(); ++k) {
     const uint32_t i = order[k];
     const bool same_edge_as_last = k > 0 && cut[order[k - 1]].edge == cut[i].edge;
-    uint32_t edge = cut[i].edge;
+    EdgeIndex edge = cut[i].edge;
     if (same_edge_as_last)
-      for (uint32_t e : m.vertex_edges(vertex[order[k - 1]]))
+      for (EdgeIndex e : m.vertex_edges(vertex[order[k - 1]]))
         if (m.edges.vertex[e][1] == vertex[order[k - 1]]) edge = e;
     vertex[i] = split_edge(m, edge, cut[i].point);
   }
 
   // Each piece splits the part of its face (as earlier pieces left it) that holds both its ends.
-  std::vector<std::pair<uint32_t, uint32_t>> parts;  // (face the stroke was drawn over, a face it has become)
-  for (uint32_t f : faces) parts.emplace_back(f, f);
+  std::vector<std::pair<FaceIndex, FaceIndex>> parts;  // (face the stroke was drawn over, a face it has become)
+  for (FaceIndex f : faces) parts.emplace_back(f, f);
   for (size_t i = 0; i + 1 < cut.size(); ++i) {
-    const uint32_t va = vertex[i], vb = vertex[i + 1];
-    std::vector<uint32_t> holding;
+    const VertexIndex va = vertex[i], vb = vertex[i + 1];
+    std::vector<FaceIndex> holding;
     for (const auto& [drawn, part] : parts) {
       if (drawn != faces[i] || std::count(holding.begin(), holding.end(), part)) continue;
       if (on_face(m, part, {va}) && on_face(m, part, {vb})) holding.push_back(part);
@@ -525,9 +529,9 @@ Status cross_curves(Mesh& m, const EditCommand& c) {
 }
 
 // The pending chain whose last piece is `last`, in drawing order; empty when `last` is no chain's last piece.
-std::vector<uint32_t> chain_ending(const Mesh& m, uint32_t last) {
+std::vector<EdgeIndex> chain_ending(const Mesh& m, EdgeIndex last) {
   if (!m.edge_alive(last) || !m.is_pending(last)) return {};
-  for (std::vector<uint32_t>& chain : m.pending_chains())
+  for (std::vector<EdgeIndex>& chain : m.pending_chains())
     if (chain.back() == last) return std::move(chain);
   return {};
 }
@@ -537,32 +541,32 @@ Status extend_chain(Mesh& m, const EditCommand& c) {
   if (!has_faces(m)) return Status::failure("close the border polygon before drawing a stroke in pieces");
   if (auto ok = check_points(c.points); !ok.ok()) return ok;
   if (c.points.front() == c.points.back()) return Status::failure("the piece ends where it starts");
-  uint32_t from = kNone;
+  VertexIndex from;
   if (c.edge != kNone) {
     if (chain_ending(m, c.edge).empty()) return Status::failure("edge " + str(c.edge) + " is not the last piece of a pending chain");
-    from = m.edges.vertex[c.edge][1];
+    from = VertexIndex{m.edges.vertex[c.edge][1]};
     if (c.points.front() != m.vertices.position[from]) return Status::failure("the piece does not start at the chain's free end");
   } else {
     from = m.add_vertex(c.points.front());
   }
-  const uint32_t e = m.add_edge(from, m.add_vertex(c.points.back()), c.points);
+  const EdgeIndex e = m.add_edge(from, m.add_vertex(c.points.back()), c.points);
   m.set_edge_flag(e, kPendingEdge, true);
   return Status::success();
 }
 
 // The pieces of a finished chain go: the curve that finished it holds their points.
-void remove_chain(Mesh& m, const std::vector<uint32_t>& chain) {
+void remove_chain(Mesh& m, const std::vector<EdgeIndex>& chain) {
   for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
     const auto ends = m.edges.vertex[*it];
     m.remove_edge(*it);
-    m.remove_vertex(ends[1]);
-    if (it + 1 == chain.rend()) m.remove_vertex(ends[0]);
+    m.remove_vertex(VertexIndex{ends[1]});
+    if (it + 1 == chain.rend()) m.remove_vertex(VertexIndex{ends[0]});
   }
 }
 
 // A crease for subdivision along an inner curve; the border is a crease already.
 Status toggle_sharp(Mesh& m, const EditCommand& c) {
-  const uint32_t e = c.edge;
+  const EdgeIndex e = c.edge;
   if (!m.edge_alive(e)) return Status::failure("edge " + str(e) + " does not exist");
   if (m.is_pending(e)) return Status::failure("edge " + str(e) + " is a piece of a stroke still pending, not a curve yet");
   if (m.is_border_edge(e))
@@ -573,22 +577,22 @@ Status toggle_sharp(Mesh& m, const EditCommand& c) {
 
 }  // namespace
 
-uint32_t split_edge(Mesh& m, uint32_t e, uint32_t point) {
+VertexIndex split_edge(Mesh& m, EdgeIndex e, uint32_t point) {
   auto line = m.polyline(e);
   std::vector<Vec3> first(line.begin(), line.begin() + point + 1);
   std::vector<Vec3> second(line.begin() + point, line.end());
   const auto ends = m.edges.vertex[e];
   const auto sides = m.edges.face[e];
   const bool sharp = m.edges.flags[e] & kSharpEdge;
-  uint32_t v = m.add_vertex(first.back(), kSplitVertex);
-  uint32_t ea = m.add_edge(ends[0], v, first);
-  uint32_t eb = m.add_edge(v, ends[1], second);
+  const VertexIndex v = m.add_vertex(first.back(), kSplitVertex);
+  const EdgeIndex ea = m.add_edge(VertexIndex{ends[0]}, v, first);
+  const EdgeIndex eb = m.add_edge(v, VertexIndex{ends[1]}, second);
   if (sharp) {
     m.set_edge_flag(ea, kSharpEdge, true);
     m.set_edge_flag(eb, kSharpEdge, true);
   }
-  if (sides[0] != kNone) replace_in_loop(m, sides[0], e, {make_oriented(ea, false), make_oriented(eb, false)});
-  if (sides[1] != kNone) replace_in_loop(m, sides[1], e, {make_oriented(eb, true), make_oriented(ea, true)});
+  if (sides[0] != kNone) replace_in_loop(m, FaceIndex{sides[0]}, e, {make_oriented(ea, false), make_oriented(eb, false)});
+  if (sides[1] != kNone) replace_in_loop(m, FaceIndex{sides[1]}, e, {make_oriented(eb, true), make_oriented(ea, true)});
   m.remove_edge(e);
   return v;
 }
@@ -618,7 +622,7 @@ Status execute_edit(Mesh& mesh, const EditCommand& c) {
   // A curve that finishes a pending chain: the curve first, which checks before it writes, then the chain goes.
   const bool splits = c.kind == EditKind::SplitFace || c.kind == EditKind::SplitHole || c.kind == EditKind::JoinBorders ||
                       c.kind == EditKind::CrossCurves;
-  std::vector<uint32_t> chain;
+  std::vector<EdgeIndex> chain;
   if (splits && c.edge != kNone) {
     chain = chain_ending(mesh, c.edge);
     if (chain.empty()) return Status::failure("edge " + str(c.edge) + " is not the last piece of a pending chain");

@@ -29,7 +29,7 @@ Status execute_edit(Mesh& mesh, const EditCommand& command);
 
 // Splits edge e at interior polyline point `point` (0 < point < count-1): a new vertex and two edges
 // replace e in every face that uses it. Returns the new vertex. Exposed for tools and tests.
-uint32_t split_edge(Mesh& mesh, uint32_t e, uint32_t point);
+VertexIndex split_edge(Mesh& mesh, EdgeIndex e, uint32_t point);
 
 // Undo by journal rollback (bit-identical pools); redo by running the command again, which is
 // deterministic from the restored state.

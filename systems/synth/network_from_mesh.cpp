@@ -522,7 +522,7 @@ Result<Mesh> network_from_mesh(const PolygonMeshView& control, const UnrefineOpt
   }
 
   Mesh mesh;
-  std::vector<uint32_t> net_vertex(nv, kNone);
+  std::vector<VertexIndex> net_vertex(nv);
   for (uint32_t v = 0; v < nv; ++v)
     if (survives[v]) net_vertex[v] = mesh.add_vertex(limit ? limit->vertex(v) : c.positions[v]);
 
@@ -531,7 +531,7 @@ Result<Mesh> network_from_mesh(const PolygonMeshView& control, const UnrefineOpt
   const double sigma = o.noise_percent / 100.0 * (total_length / double(ne));
   const double correlation = o.noise_correlation_percent / 100.0 * (total_length / double(ne));
   Gaussian noise(o.seed);
-  std::vector<uint32_t> chain_edge(chains.size());
+  std::vector<EdgeIndex> chain_edge(chains.size());
   std::vector<Vec3> line;
   for (size_t k = 0; k < chains.size(); ++k) {
     const auto& cv = chains[k].vertices;
@@ -565,7 +565,7 @@ Result<Mesh> network_from_mesh(const PolygonMeshView& control, const UnrefineOpt
     // Start at a network vertex so that every chain's half-edges are consecutive.
     size_t start = 0;
     while (!survives[c.tail(walk[start])]) ++start;
-    std::vector<uint32_t> loop;
+    std::vector<OrientedEdge> loop;
     for (size_t i = 0; i < walk.size(); ++i) {
       const uint32_t h = walk[(start + i) % walk.size()];
       if (!survives[c.tail(h)]) continue;

@@ -4,10 +4,10 @@
 
 namespace fire::test {
 
-SnapHit exhaustive_nearest_on_face(const Mesh& m, uint32_t f, const Vec3& p) {
+SnapHit exhaustive_nearest_on_face(const Mesh& m, FaceIndex f, const Vec3& p) {
   SnapHit best;
-  for (uint32_t oe : m.face_loop(f)) {
-    uint32_t e = edge_of(oe);
+  for (OrientedEdge oe : m.face_loop(f)) {
+    const EdgeIndex e = edge_of(oe);
     auto line = m.polyline(e);
     for (uint32_t k = 0; k < line.size(); ++k) {
       double d = (line[k] - p).norm();
@@ -20,7 +20,7 @@ SnapHit exhaustive_nearest_on_face(const Mesh& m, uint32_t f, const Vec3& p) {
 Snap exhaustive_snap_to_face(const Mesh& m, const Vec3& start, const Vec3& end, double limit) {
   Snap best;
   double best_cost = std::numeric_limits<double>::infinity();
-  for (uint32_t f = 0; f < m.face_slots(); ++f) {
+  for (FaceIndex f{0}; f < m.face_slots(); ++f) {
     if (!m.face_alive(f)) continue;
     SnapHit a = exhaustive_nearest_on_face(m, f, start), b = exhaustive_nearest_on_face(m, f, end);
     if (a.distance > limit || b.distance > limit) continue;
@@ -33,10 +33,10 @@ Snap exhaustive_snap_to_face(const Mesh& m, const Vec3& start, const Vec3& end, 
   return best;
 }
 
-uint32_t exhaustive_pick_edge(const Mesh& m, const Vec3& p, double limit) {
-  uint32_t best = kNone;
+EdgeIndex exhaustive_pick_edge(const Mesh& m, const Vec3& p, double limit) {
+  EdgeIndex best;
   double best_d = limit;
-  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e) {
     if (!m.edge_alive(e)) continue;
     for (const Vec3& q : m.polyline(e)) {
       double d = (q - p).norm();
@@ -51,7 +51,7 @@ uint32_t exhaustive_pick_edge(const Mesh& m, const Vec3& p, double limit) {
 
 SnapHit exhaustive_nearest(const Mesh& m, const Vec3& p, double radius) {
   SnapHit best;
-  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e) {
     if (!m.edge_alive(e)) continue;
     auto line = m.polyline(e);
     for (uint32_t k = 0; k < line.size(); ++k) {
@@ -64,7 +64,7 @@ SnapHit exhaustive_nearest(const Mesh& m, const Vec3& p, double radius) {
 
 std::vector<SnapHit> exhaustive_nearest_per_edge(const Mesh& m, const Vec3& p, double radius) {
   std::vector<SnapHit> out;
-  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e) {
     if (!m.edge_alive(e)) continue;
     SnapHit best;
     auto line = m.polyline(e);

@@ -38,42 +38,46 @@ EditCommand make(EditKind kind, std::vector<Vec3> points) {
 
 EditCommand remove(uint32_t e) {
   EditCommand c = make(EditKind::DeleteCurve);
-  c.edge = e;
+  c.edge = EdgeIndex{e};
   return c;
 }
 
 EditCommand split(uint32_t face, CurveEnd a, CurveEnd b, const std::vector<Vec3>& points) {
   EditCommand c = make(EditKind::SplitFace, points);
-  c.face = face;
+  c.face = FaceIndex{face};
   c.start = a;
   c.end = b;
   return c;
 }
 
-Vec3 at(const Mesh& m, uint32_t e, uint32_t k) { return m.polyline(e)[k]; }
+EditCommand split(uint32_t face, SlotEnd a, SlotEnd b, const std::vector<Vec3>& points) {
+  return split(face, CurveEnd{EdgeIndex{a.edge}, a.point}, CurveEnd{EdgeIndex{b.edge}, b.point}, points);
+}
+
+Vec3 at(const Mesh& m, uint32_t e, uint32_t k) { return m.polyline(EdgeIndex{e})[k]; }
 
 std::vector<uint32_t> face_sizes(const Mesh& m) {
   std::vector<uint32_t> s;
-  for (uint32_t f = 0; f < m.face_slots(); ++f)
+  for (FaceIndex f{0}; f < m.face_slots(); ++f)
     if (m.face_alive(f)) s.push_back(m.faces.edge_count[f]);
   std::sort(s.begin(), s.end());
   return s;
 }
 
-uint32_t edge_between(const Mesh& m, uint32_t a, uint32_t b) {
-  for (uint32_t e : m.vertex_edges(a))
+EdgeIndex edge_between(const Mesh& m, uint32_t a, uint32_t b) {
+  for (EdgeIndex e : m.vertex_edges(VertexIndex{a}))
     if (m.edges.vertex[e][0] == b || m.edges.vertex[e][1] == b) return e;
-  return kNone;
+  return EdgeIndex{};
 }
 
 EditCommand random_split(const Mesh& m, std::mt19937_64& rng, int max_points) {
-  std::vector<uint32_t> live;
-  for (uint32_t f = 0; f < m.face_slots(); ++f)
+  std::vector<FaceIndex> live;
+  for (FaceIndex f{0}; f < m.face_slots(); ++f)
     if (m.face_alive(f)) live.push_back(f);
-  const uint32_t f = live[rng() % live.size()];
+  const FaceIndex f = live[rng() % live.size()];
   auto loop = m.face_loop(f);
   auto pick = [&] {
-    uint32_t e = edge_of(loop[rng() % loop.size()]);
+    const EdgeIndex e = edge_of(loop[rng() % loop.size()]);
     return CurveEnd{e, uint32_t(rng() % m.edges.point_count[e])};
   };
   CurveEnd a = pick(), b = pick();

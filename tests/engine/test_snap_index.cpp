@@ -24,7 +24,7 @@ std::vector<uint32_t> all_slots(const Mesh& m) {
 // Exactly the edge slots whose life or polyline differ between two states of a mesh.
 std::vector<uint32_t> diff_slots(const Mesh& before, const Mesh& after) {
   std::vector<uint32_t> out;
-  for (uint32_t e = 0; e < std::max(before.edge_slots(), after.edge_slots()); ++e) {
+  for (EdgeIndex e{0}; e < std::max(before.edge_slots(), after.edge_slots()); ++e) {
     const bool a = before.edge_alive(e), b = after.edge_alive(e);
     if (a != b) {
       out.push_back(e);
@@ -46,9 +46,9 @@ void require_same(const Snap& a, const Snap& b) {
   REQUIRE(a.end_distance == b.end_distance);
 }
 
-std::vector<uint32_t> live_faces(const Mesh& m) {
-  std::vector<uint32_t> out;
-  for (uint32_t f = 0; f < m.face_slots(); ++f)
+std::vector<FaceIndex> live_faces(const Mesh& m) {
+  std::vector<FaceIndex> out;
+  for (FaceIndex f{0}; f < m.face_slots(); ++f)
     if (m.face_alive(f)) out.push_back(f);
   return out;
 }
@@ -56,16 +56,16 @@ std::vector<uint32_t> live_faces(const Mesh& m) {
 
 // A query point: on a polyline point (ties at vertices), halfway between two neighbours (ties between
 // points), near the network at several scales, or far from it.
-Vec3 random_query(const Mesh& m, std::mt19937_64& rng, uint32_t face = kNone) {
+Vec3 random_query(const Mesh& m, std::mt19937_64& rng, FaceIndex face = FaceIndex{}) {
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   const uint64_t kind = rng() % 6;
   if (kind == 5) return Vec3(5 * unit(rng), 5 * unit(rng), 5 * unit(rng));
-  uint32_t e;
+  EdgeIndex e;
   if (face != kNone) {
     auto loop = m.face_loop(face);
     e = edge_of(loop[rng() % loop.size()]);
   } else {
-    do e = uint32_t(rng() % m.edge_slots());
+    do e = EdgeIndex{uint32_t(rng() % m.edge_slots())};
     while (!m.edge_alive(e));
   }
   auto line = m.polyline(e);
@@ -82,7 +82,7 @@ void check_queries(const Mesh& m, const SnapIndex& index, std::mt19937_64& rng, 
   REQUIRE(index.validate(m) == "");
   if (m.edge_count() == 0) return;
   const double radii[] = {0.0, 1e-3, 1e-2, 5e-2, 0.3, SnapIndex::kUnbounded};
-  const std::vector<uint32_t> faces = live_faces(m);
+  const std::vector<FaceIndex> faces = live_faces(m);
   for (int i = 0; i < count; ++i) {
     const Vec3 p = random_query(m, rng);
     const double r = radii[rng() % std::size(radii)];
@@ -93,7 +93,7 @@ void check_queries(const Mesh& m, const SnapIndex& index, std::mt19937_64& rng, 
     index.nearest_per_edge(p, r, per_edge);
     REQUIRE(per_edge == exhaustive_nearest_per_edge(m, p, r));
     if (faces.empty()) continue;
-    const uint32_t f = faces[rng() % faces.size()];
+    const FaceIndex f = faces[rng() % faces.size()];
     const SnapHit on_face = exhaustive_nearest_on_face(m, f, p);
     REQUIRE(index.nearest_on_face(m, f, p) == on_face);
     REQUIRE(index.nearest_on_face(m, f, p, r) == (on_face.distance <= r ? on_face : SnapHit{}));
@@ -150,7 +150,7 @@ TEST_CASE("the index follows explicit lists of changed slots", "[snap]") {
   REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line(at(m, 0, 2), at(m, 2, 2), 11))).ok());
   index.update(m, diff_slots(before, m));
   uint32_t interior = kNone;
-  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e)
     if (m.edge_alive(e) && !m.is_border_edge(e)) interior = e;
   REQUIRE(interior != kNone);
   before = m;
@@ -179,8 +179,8 @@ TEST_CASE("ties break as in the exhaustive search", "[snap]") {
   CHECK(half.edge == 0);
   CHECK(half.point == 1);
   // On the face, the edge first in loop order wins the corner where the loop closes.
-  const uint32_t f = live_faces(m).front();
-  const uint32_t first = edge_of(m.face_loop(f)[0]);
+  const FaceIndex f = live_faces(m).front();
+  const EdgeIndex first = edge_of(m.face_loop(f)[0]);
   const Vec3 start = m.vertices.position[m.tail(m.face_loop(f)[0])];
   CHECK(index.nearest_on_face(m, f, start) == exhaustive_nearest_on_face(m, f, start));
   CHECK(index.nearest_on_face(m, f, start).edge == first);
@@ -210,7 +210,7 @@ TEST_CASE("the index equals the exhaustive search through random edits, undos an
         (void)h.apply(m, random_split(m, rng, 24));  // up to three leaves' worth of points per curve
       } else if (dice < 68) {
         std::vector<uint32_t> interior;
-        for (uint32_t e = 0; e < m.edge_slots(); ++e)
+        for (EdgeIndex e{0}; e < m.edge_slots(); ++e)
           if (m.edge_alive(e) && !m.is_border_edge(e)) interior.push_back(e);
         if (!interior.empty()) (void)h.apply(m, remove(interior[rng() % interior.size()]));
       } else if (dice < 86) {

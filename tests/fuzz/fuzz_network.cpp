@@ -17,7 +17,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     return 0;
   }
   FUZZ_CHECK(mesh->validate().empty(), "a parsed network is valid");
-  for (uint32_t v = 0; v < mesh->vertex_slots(); ++v)
+  for (VertexIndex v{0}; v < mesh->vertex_slots(); ++v)
     FUZZ_CHECK(mesh->vertices.position[v].allFinite(), "vertex positions are finite");
   const std::string written = network_to_json(*mesh);
   const Result<Mesh> again = network_from_json(written, fuzz::kSource);

@@ -100,7 +100,7 @@ TEST_CASE("a curve marked sharp creases the surface, undo, redo and a replay of 
   const auto sharp = replay_text(marked);
   CHECK(sharp->rejections.empty());
   uint32_t middle = kNone;
-  for (uint32_t e = 0; e < sharp->mesh.edge_slots(); ++e)
+  for (EdgeIndex e{0}; e < sharp->mesh.edge_slots(); ++e)
     if (sharp->mesh.edge_alive(e) && !sharp->mesh.is_border_edge(e)) middle = e;
   REQUIRE(middle != kNone);
   CHECK((sharp->mesh.edges.flags[middle] & kSharpEdge) != 0);
@@ -178,8 +178,8 @@ TEST_CASE("snapping bends the whole stroke instead of kinking its end", "[replay
   text += stroke(t, {{0.05, 0, 0}, {0.05, 0.05, 0.01}, {0.054, 0.1, 0}});
   auto w = replay_text(text);
   REQUIRE(w->mesh.face_count() == 2);
-  uint32_t curve = kNone;
-  for (uint32_t e = 0; e < w->mesh.edge_slots(); ++e)
+  EdgeIndex curve;
+  for (EdgeIndex e{0}; e < w->mesh.edge_slots(); ++e)
     if (w->mesh.edge_alive(e) && !w->mesh.is_border_edge(e)) curve = e;
   REQUIRE(curve != kNone);
   auto line = w->mesh.polyline(curve);

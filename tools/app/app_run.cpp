@@ -81,7 +81,7 @@ uint32_t curve_point_under(const Mesh& mesh, const render::Camera& camera, uint3
                            glm::vec2 cursor, float radius, Vec3& out) {
   float best = radius * radius;
   uint32_t found = kNone;
-  for (uint32_t e = 0; e < mesh.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < mesh.edge_slots(); ++e) {
     if (!mesh.edge_alive(e)) continue;
     for (const Vec3& p : mesh.polyline(e)) {
       const glm::vec4 clip = camera.view_projection() * glm::vec4(float(p.x()), float(p.y()), float(p.z()), 1.0f);

@@ -6,7 +6,7 @@ namespace fire::app {
 
 render::Box scene_box(const Mesh& mesh, const SurfaceLevels& surface, std::span<const Vec3> reference) {
   render::Box box;
-  for (uint32_t e = 0; e < mesh.edge_slots(); ++e)
+  for (EdgeIndex e{0}; e < mesh.edge_slots(); ++e)
     if (mesh.edge_alive(e))
       for (const Vec3& p : mesh.polyline(e)) box.add(p);
   for (const Vec3& p : surface.positions) box.add(p);

@@ -62,7 +62,7 @@ struct Creases {
 };
 Creases measure_creases(const Mesh& network, const evaluate::TriangleBvh& surface, const evaluate::TriangleBvh& reference, double radius) {
   Creases out;
-  for (uint32_t e = 0; e < network.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < network.edge_slots(); ++e) {
     if (!network.edge_alive(e) || !(network.edges.flags[e] & kSharpEdge)) continue;
     ++out.curves;
     const auto line = network.polyline(e);
@@ -154,7 +154,7 @@ int run_eval(const EvalArgs& a) {
     auto loaded = load_network(a.network_path);
     if (!loaded) return fail(loaded.error());
     network = std::move(*loaded);
-    for (uint32_t e = 0; e < network->edge_slots(); ++e)
+    for (EdgeIndex e{0}; e < network->edge_slots(); ++e)
       if (network->edge_alive(e)) {
         const auto polyline = network->polyline(e);
         for (uint32_t i = 0; i < polyline.size(); ++i) {

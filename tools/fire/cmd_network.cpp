@@ -260,7 +260,7 @@ int run_replay(const ReplayOptions& o) {
   }
   const Mesh& m = world->mesh;
   // Nothing pending is dropped in silence: a stroke in pieces the log never finished is in the network, not the surface.
-  for (const std::vector<uint32_t>& chain : m.pending_chains()) {
+  for (const std::vector<EdgeIndex>& chain : m.pending_chains()) {
     const Vec3& free_end = m.vertices.position[m.edges.vertex[chain.back()][1]];
     std::cerr << lines_of << ": a stroke in " << chain.size() << " piece(s) is still pending: it ends off the network at ("
               << format_double(free_end.x()) << ", " << format_double(free_end.y()) << ", " << format_double(free_end.z())

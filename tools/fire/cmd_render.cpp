@@ -168,7 +168,7 @@ int run_render(const RenderArgs& a, const CLI::App& cmd) {
   surface.level = options->levels;
 
   render::Box box;
-  for (uint32_t e = 0; e < network->edge_slots(); ++e)
+  for (EdgeIndex e{0}; e < network->edge_slots(); ++e)
     if (network->edge_alive(e))
       for (const Vec3& p : network->polyline(e)) box.add(p);
   for (const Vec3& p : surface.positions) box.add(p);

@@ -35,7 +35,7 @@ int run_network_from_mesh(const SynthArgs& a) {
     return 1;
   }
   std::map<uint32_t, size_t> sizes;  // numeric order, not the string order of JSON keys
-  for (uint32_t f = 0; f < m.face_slots(); ++f)
+  for (FaceIndex f{0}; f < m.face_slots(); ++f)
     if (m.face_alive(f)) ++sizes[m.faces.edge_count[f]];
   nlohmann::ordered_json out;
   out["vertices"] = m.vertex_count();

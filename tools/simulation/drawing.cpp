@@ -561,17 +561,17 @@ DrawingNetwork drawing_network(const Mesh& m) {
   DrawingNetwork net;
   std::vector<uint32_t> curve_of(m.edge_slots(), 0);
   for (uint32_t v = 0; v < m.vertex_slots(); ++v) net.vertices.push_back(m.vertices.position[v]);
-  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e) {
     if (!m.edge_alive(e)) continue;
     const std::span<const Vec3> points = m.polyline(e);
     curve_of[e] = static_cast<uint32_t>(net.curves.size());
     net.curves.push_back({m.edges.vertex[e][0], m.edges.vertex[e][1], {points.begin(), points.end()}, m.is_border_edge(e),
                           (m.edges.flags[e] & kSharpEdge) != 0});
   }
-  for (uint32_t f = 0; f < m.face_slots(); ++f) {
+  for (FaceIndex f{0}; f < m.face_slots(); ++f) {
     if (!m.face_alive(f)) continue;
     Chain& loop = net.faces.emplace_back();
-    for (uint32_t oe : m.face_loop(f)) loop.push_back({curve_of[edge_of(oe)], !is_reversed(oe)});
+    for (OrientedEdge oe : m.face_loop(f)) loop.push_back({curve_of[edge_of(oe)], !is_reversed(oe)});
   }
   return net;
 }

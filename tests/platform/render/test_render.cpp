@@ -198,7 +198,7 @@ TEST_CASE("a pending piece of a stroke is drawn in the stroke's colour, not as a
   CHECK(stroke_pixels(render_scene(*context, **renderer, scene, View::top)) == 0);
   // From the middle of a curve a fifth of the object's width outwards, as a stroke that ended off the network.
   Mesh& net = scene.network;
-  uint32_t curve = 0;
+  EdgeIndex curve{0};
   while (!net.edge_alive(curve) || net.edges.point_count[curve] < 3) ++curve;
   const Box box = box_of(scene);
   const Vec3 from = net.polyline(curve)[net.edges.point_count[curve] / 2];
@@ -207,7 +207,7 @@ TEST_CASE("a pending piece of a stroke is drawn in the stroke's colour, not as a
   for (int k = 0; k <= 8; ++k) piece.push_back(from + (to - from) * (k / 8.0));
   piece.back() = to;
   net.begin_frame(net.frame() + 1);
-  const uint32_t e = net.add_edge(net.add_vertex(from), net.add_vertex(to), piece);
+  const EdgeIndex e = net.add_edge(net.add_vertex(from), net.add_vertex(to), piece);
   net.set_edge_flag(e, kPendingEdge, true);
   REQUIRE(net.validate() == "");
   const Image image = render_scene(*context, **renderer, scene, View::top);
@@ -227,9 +227,9 @@ TEST_CASE("uploads copy only what changed and the image equals a fresh upload's"
   Mesh& net = scene.network;
 
   uint64_t points = 0, vertices = 0;
-  for (uint32_t e = 0; e < net.edge_slots(); ++e)
+  for (EdgeIndex e{0}; e < net.edge_slots(); ++e)
     if (net.edge_alive(e)) points += net.edges.point_count[e];
-  for (uint32_t v = 0; v < net.vertex_slots(); ++v) vertices += net.vertex_alive(v);
+  for (VertexIndex v{0}; v < net.vertex_slots(); ++v) vertices += net.vertex_alive(v);
   REQUIRE(r.upload(net, scene.surface));
   CHECK(r.last_upload().bytes ==
         12 * (points + vertices) + 24ull * scene.surface.vertex_count() + 24ull * scene.surface.quad_count());
@@ -241,10 +241,10 @@ TEST_CASE("uploads copy only what changed and the image equals a fresh upload's"
   CHECK(r.last_upload().bytes == 0);
 
   // Moving one vertex re-sends the points of its edges and its marker, nothing else.
-  uint32_t moved = 0;
+  VertexIndex moved{0};
   while (!net.vertex_alive(moved) || net.valence(moved) < 3) ++moved;
   uint64_t edge_points = 0;
-  for (uint32_t e : net.vertex_edges(moved)) edge_points += net.edges.point_count[e];
+  for (EdgeIndex e : net.vertex_edges(moved)) edge_points += net.edges.point_count[e];
   net.begin_frame(net.frame() + 1);  // an edit belongs to a frame after the last upload's
   net.move_vertex(moved, net.vertices.position[moved] + Vec3(0, 0, 0.01));
   REQUIRE(r.upload(net, scene.surface));
@@ -412,10 +412,10 @@ TEST_CASE("the pen's feedback: the face under the pen tinted, the snap target an
     return im.pixel(uint32_t(px.x), uint32_t(px.y));
   };
   const Mesh& net = scene.network;
-  uint32_t face = 0;
+  FaceIndex face{0};
   while (!net.face_alive(face)) ++face;
   const Vec3 centre = loop_plane(net.face_boundary(face)).centroid;
-  const uint32_t edge = edge_of(net.face_loop(face)[0]);
+  const EdgeIndex edge = edge_of(net.face_loop(face)[0]);
   const uint32_t point = net.edges.point_count[edge] / 2;
 
   const Image plain = draw(net, {});
@@ -451,7 +451,7 @@ TEST_CASE("the pen's feedback: the face under the pen tinted, the snap target an
   // Border mode: an open border of two curves, the pen by its first vertex.
   Mesh border;
   const Vec3 a = net.vertices.position[net.edges.vertex[edge][0]], b = net.vertices.position[net.edges.vertex[edge][1]];
-  const uint32_t va = border.add_vertex(a), vb = border.add_vertex(b), vc = border.add_vertex(centre);
+  const VertexIndex va = border.add_vertex(a), vb = border.add_vertex(b), vc = border.add_vertex(centre);
   border.add_edge(va, vb, std::vector<Vec3>{a, b});
   border.add_edge(vb, vc, std::vector<Vec3>{b, centre});
   PenFeedback closing;
@@ -474,9 +474,9 @@ TEST_CASE("a still frame is not drawn again: its layer is copied and the stroke 
   const Camera camera = frame_box(box_of(scene), View::iso, kWidth, kHeight);
   const Camera elsewhere = frame_box(box_of(scene), View::top, kWidth, kHeight);
   const Mesh& net = scene.network;
-  uint32_t face = 0;
+  FaceIndex face{0};
   while (!net.face_alive(face)) ++face;
-  const uint32_t edge = edge_of(net.face_loop(face)[0]);
+  const EdgeIndex edge = edge_of(net.face_loop(face)[0]);
   PenFeedback feedback;
   feedback.pen_seen = true;
   feedback.face = net.face_id(face);

@@ -540,7 +540,7 @@ TEST_CASE("fire app: K marks the curve under the cursor sharp, E exports the sur
   auto replayed = fire::load_network(network);
   REQUIRE(replayed);
   size_t sharp = 0;
-  for (uint32_t e = 0; e < replayed->edge_slots(); ++e)
+  for (fire::EdgeIndex e{0}; e < replayed->edge_slots(); ++e)
     sharp += replayed->edge_alive(e) && (replayed->edges.flags[e] & fire::kSharpEdge);
   CHECK(sharp == 1);
   // The export: the surface's quads, read back from the PLY.

@@ -24,9 +24,9 @@ Cage pawn_cage(bool with_crease) {
   REQUIRE(net.ok());
   if (with_crease) {
     // Every curve of one face of the network, sharp: the cage gets creases and the surface a ridge.
-    uint32_t face = 0;
+    fire::FaceIndex face{0};
     while (!net->face_alive(face)) ++face;
-    for (uint32_t e = 0; e < net->edge_slots(); ++e)
+    for (fire::EdgeIndex e{0}; e < net->edge_slots(); ++e)
       if (net->edge_alive(e) && (net->edges.face[e][0] == face || net->edges.face[e][1] == face))
         net->set_edge_flag(e, fire::kSharpEdge, true);
   }

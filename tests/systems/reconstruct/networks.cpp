@@ -13,8 +13,8 @@ namespace {
 
 // Builds faces from loops of (edge, reversed) and checks the result.
 void add_face(Mesh& m, std::initializer_list<std::pair<uint32_t, bool>> loop) {
-  std::vector<uint32_t> oriented;
-  for (auto [e, reversed] : loop) oriented.push_back(make_oriented(e, reversed));
+  std::vector<OrientedEdge> oriented;
+  for (auto [e, reversed] : loop) oriented.push_back(make_oriented(EdgeIndex{e}, reversed));
   REQUIRE(m.add_face(oriented) != kNone);
 }
 
@@ -33,9 +33,9 @@ Mesh polygon_network(const std::vector<double>& angles, uint32_t samples) {
   Mesh m;
   auto point = [](double angle) { return Vec3(std::cos(angle), std::sin(angle), 0.2 * std::cos(2 * angle)); };
   const size_t n = angles.size();
-  std::vector<uint32_t> corners;
+  std::vector<VertexIndex> corners;
   for (double a : angles) corners.push_back(m.add_vertex(point(a)));
-  std::vector<uint32_t> oriented;
+  std::vector<OrientedEdge> oriented;
   for (size_t k = 0; k < n; ++k) {
     const double from = angles[k], to = k + 1 < n ? angles[k + 1] : angles[0] + 2 * std::numbers::pi;
     std::vector<Vec3> line;
@@ -54,12 +54,12 @@ Mesh cornered_polygon_network(const std::vector<double>& angles, uint32_t sample
   auto lifted = [](const Eigen::Vector2d& q) { return Vec3(q.x(), q.y(), 0.2 * std::cos(2 * std::atan2(q.y(), q.x()))); };
   const size_t n = angles.size();
   std::vector<Eigen::Vector2d> at;
-  std::vector<uint32_t> corners;
+  std::vector<VertexIndex> corners;
   for (double a : angles) {
     at.emplace_back(std::cos(a), std::sin(a));
     corners.push_back(m.add_vertex(lifted(at.back())));
   }
-  std::vector<uint32_t> oriented;
+  std::vector<OrientedEdge> oriented;
   for (size_t k = 0; k < n; ++k) {
     const Eigen::Vector2d &from = at[k], &to = at[(k + 1) % n];
     std::vector<Vec3> line;
@@ -74,7 +74,7 @@ Mesh cornered_polygon_network(const std::vector<double>& angles, uint32_t sample
 Mesh grid_network(uint32_t nx, uint32_t ny, uint32_t samples, const Height& height) {
   Mesh m;
   auto at = [&](double x, double y) { return Vec3(x, y, height(x, y)); };
-  std::vector<uint32_t> v((nx + 1) * (ny + 1));
+  std::vector<VertexIndex> v((nx + 1) * (ny + 1));
   for (uint32_t j = 0; j <= ny; ++j)
     for (uint32_t i = 0; i <= nx; ++i) v[j * (nx + 1) + i] = m.add_vertex(at(i, j));
   auto curve = [&](double x0, double y0, double x1, double y1) {
@@ -138,7 +138,7 @@ Mesh limit_grid_network(uint32_t m, uint32_t levels, const Height& height) {
     }
     return line;
   };
-  std::vector<uint32_t> v((m + 1) * (m + 1));
+  std::vector<VertexIndex> v((m + 1) * (m + 1));
   for (uint32_t j = 0; j <= m; ++j)
     for (uint32_t i = 0; i <= m; ++i) v[j * (m + 1) + i] = net.add_vertex(on_grid.at({long(2 * i * steps), long(2 * j * steps)}));
   for (uint32_t j = 0; j <= m; ++j)

@@ -33,9 +33,9 @@ bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
 size_t local_bound(const Mesh& m, Frame f) {
   std::set<uint32_t> faces;
   for (uint32_t face : m.faces.changes.since(f - 1))
-    if (m.face_alive(face)) faces.insert(face);
+    if (m.face_alive(FaceIndex{face})) faces.insert(face);
   for (uint32_t e : m.edges.changes.since(f - 1)) {
-    if (!m.edge_alive(e)) continue;
+    if (!m.edge_alive(EdgeIndex{e})) continue;
     for (uint32_t face : m.edges.face[e])
       if (face != kNone) faces.insert(face);
   }
@@ -172,7 +172,7 @@ TEST_CASE("random edits through the frame: shown in the commit frame, settled wi
       finer_faces += corners > 4;
     }
     for (uint32_t p = 0; p < surface.patch_count(); ++p) {
-      const uint32_t f = surface.patch_keys[p];
+      const FaceIndex f{surface.patch_keys[p]};
       REQUIRE(net.face_alive(f));
       CHECK((p == 0 || surface.patch_keys[p - 1] < f));
       const size_t corners = net.face_loop(f).size();

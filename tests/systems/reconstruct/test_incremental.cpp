@@ -70,9 +70,9 @@ TEST_CASE("adding, moving and deleting a curve on a 200-face network", "[reconst
     const uint32_t i = 7, j = 4, face = j * nx + i;
     EditCommand add;
     add.kind = EditKind::SplitFace;
-    add.face = face;
-    add.start = {j * nx + i, 4};
-    add.end = {(j + 1) * nx + i, 4};
+    add.face = FaceIndex{face};
+    add.start = {EdgeIndex{j * nx + i}, 4};
+    add.end = {EdgeIndex{(j + 1) * nx + i}, 4};
     for (int k = 0; k <= 8; ++k) add.points.emplace_back(i + 0.5, j + k / 8.0, height(i + 0.5, j + k / 8.0));
     REQUIRE(execute_edit(net, add).ok());
     REQUIRE(net.face_count() == 201);
@@ -85,7 +85,7 @@ TEST_CASE("adding, moving and deleting a curve on a 200-face network", "[reconst
     check_equals_full_rebuild(net, options, surface);
 
     // Moving an interior vertex: its four faces, a back-substitution for the FIRE fit.
-    const uint32_t v = 3 * (nx + 1) + 12;
+    const VertexIndex v{3 * (nx + 1) + 12};
     net.move_vertex(v, net.vertices.position[v] + Vec3(0, 0, 0.05));
     update(net, options, state, surface);
     CHECK(state.last_update().faces_recomputed == 4);
@@ -104,8 +104,8 @@ TEST_CASE("adding, moving and deleting a curve on a 200-face network", "[reconst
     check_equals_full_rebuild(net, options, surface);
 
     // Deleting the curve again.
-    uint32_t curve = kNone;
-    for (uint32_t e = 0; e < net.edge_slots(); ++e)
+    EdgeIndex curve;
+    for (EdgeIndex e{0}; e < net.edge_slots(); ++e)
       if (net.edge_alive(e) && net.polyline(e).front().x() == i + 0.5 && net.polyline(e).back().x() == i + 0.5) curve = e;
     REQUIRE(curve != kNone);
     EditCommand remove;
@@ -148,7 +148,7 @@ TEST_CASE("a noisy network's fit follows its noise, and a move that changes the 
   SurfaceMesh surface;
   update(net, options, state, surface);
   check_equals_full_rebuild(net, options, surface);
-  const uint32_t v = 2 * 7 + 3;  // an interior vertex
+  const VertexIndex v{2 * 7 + 3};  // an interior vertex
   net.move_vertex(v, net.vertices.position[v] + Vec3(0.3, 0.2, 0.1));
   CHECK(fit_fairness(options, noise_estimate(net)) != fit_fairness(options, noise));
   update(net, options, state, surface);
@@ -194,7 +194,7 @@ TEST_CASE("a noisy curve as short as its noise is taken nearer its chord, and a 
   };
   auto squeezed = [&](const Height& h) {
     Mesh net = grid_network(6, 4, 20, h);
-    for (uint32_t v = 0; v < net.vertex_slots(); ++v) net.vertices.position.set(v, squeeze(net.vertices.position[v]));
+    for (VertexIndex v{0}; v < net.vertex_slots(); ++v) net.vertices.position.set(v, squeeze(net.vertices.position[v]));
     for (uint32_t i = 0; i < uint32_t(net.points.size()); ++i) net.points.set(i, squeeze(net.points[i]));
     return net;
   };
@@ -221,7 +221,7 @@ TEST_CASE("a noisy curve as short as its noise is taken nearer its chord, and a 
   REQUIRE(before.size() == net.edge_count());
   auto border = [&](uint32_t e) { return net.edges.face[e][0] == kNone || net.edges.face[e][1] == kNone; };
   uint32_t border_curves = 0, nearer_border = 0, partly = 0;
-  for (uint32_t e = 0; e < net.edge_count(); ++e) {
+  for (EdgeIndex e{0}; e < net.edge_count(); ++e) {
     const auto line = net.polyline(e);
     const double drawn = farthest_from_chord(line, line.front(), line.back());
     CHECK(before[e] <= drawn);
@@ -235,8 +235,8 @@ TEST_CASE("a noisy curve as short as its noise is taken nearer its chord, and a 
   // A vertex far from them raised: the curves' mean length, and with it how much of the short curves'
   // shape the surface takes and how far every curve is taken straight, change; so their faces are redone too:
   // every curve's but the raised vertex's own (redone as moved). The border's corners stay where they were.
-  const uint32_t far = 3 * 7 + 5;
-  const std::vector<uint32_t> at_far = net.vertex_edges(far);
+  const VertexIndex far{3 * 7 + 5};
+  const std::vector<EdgeIndex> at_far = net.vertex_edges(far);
   uint32_t elsewhere = 0;
   for (uint32_t e = 0; e < net.edge_count(); ++e)
     elsewhere += std::find(at_far.begin(), at_far.end(), e) == at_far.end();
@@ -256,7 +256,7 @@ TEST_CASE("smooth curves whose tangents disagree where they meet are fitted as n
   // Every curve bowed up by a smooth bump of 3 % of its length, as a tracked pen errs smoothly along a
   // stroke: each stays smooth, but the curves now leave every vertex out of one plane, by 5.4 degrees
   // where four meet and 4.4 on the border, where three do (the median).
-  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < net.edge_slots(); ++e) {
     const uint32_t first = net.edges.point_offset[e], count = net.edges.point_count[e];
     for (uint32_t s = 1; s + 1 < count; ++s)
       net.points.set(first + s, net.points[first + s] + Vec3(0, 0, 0.03 * std::sin(std::numbers::pi * s / (count - 1))));
@@ -273,8 +273,8 @@ TEST_CASE("noisy curves meeting at an inner vertex of valence 2 are one side of 
   const Options options;
   // An inner horizontal curve of a 6 x 4 grid split at its 6th of 20 samples: a vertex of valence 2 between
   // two faces, which become pentagons.
-  const uint32_t edge = 2 * 6 + 2;
-  auto with_vertex = [&](const Height& h, uint32_t& v) {
+  const EdgeIndex edge{2 * 6 + 2};
+  auto with_vertex = [&](const Height& h, VertexIndex& v) {
     Mesh net = grid_network(6, 4, 20, h);
     REQUIRE_FALSE(net.is_border_edge(edge));
     v = split_edge(net, edge, 5);
@@ -286,7 +286,7 @@ TEST_CASE("noisy curves meeting at an inner vertex of valence 2 are one side of 
     return std::any_of(b.positions.begin(), b.positions.end(), [&](const Vec3& q) { return q == p; });
   };
   SurfaceMesh surface;
-  uint32_t v = kNone;
+  VertexIndex v;
 
   // Exact: the vertex is a base vertex and each pentagon gives 5 quads.
   Mesh exact = with_vertex(height, v);
@@ -322,7 +322,7 @@ TEST_CASE("noisy curves meeting at an inner vertex of valence 2 are one side of 
 
   // One of the two curves made a crease: the vertex is kept again, then joined again once it is smooth.
   // Only the two faces of the side are redone each time.
-  const std::vector<uint32_t> edges = net.vertex_edges(v);
+  const std::vector<EdgeIndex> edges = net.vertex_edges(v);
   REQUIRE(edges.size() == 2);
   net.set_edge_flag(edges[0], kSharpEdge, true);
   update(net, options, state, surface);

@@ -16,9 +16,9 @@ using namespace fire::test;
 
 namespace {
 
-FacePatch patch_of(const Mesh& net, uint32_t face, const FaceSettings& settings, std::vector<EdgeSplits>& splits) {
+FacePatch patch_of(const Mesh& net, FaceIndex face, const FaceSettings& settings, std::vector<EdgeSplits>& splits) {
   splits.clear();
-  for (uint32_t oe : net.face_loop(face)) splits.push_back(split_network_edge(net.polyline(edge_of(oe)), settings.coons_steps));
+  for (OrientedEdge oe : net.face_loop(face)) splits.push_back(split_network_edge(net.polyline(edge_of(oe)), settings.coons_steps));
   std::vector<const EdgeSplits*> pointers;
   for (const EdgeSplits& s : splits) pointers.push_back(&s);
   return build_face_patch(net, face, pointers, settings);
@@ -50,7 +50,7 @@ double nearest_distance(const std::vector<Vec3>& points, const Vec3& p) {
 TEST_CASE("thesis: a pentagon triquadrifies into a quad and a triangle, then 7 quads", "[reconstruct][thesis]") {
   const Mesh net = polygon_network(5);
   std::vector<EdgeSplits> splits;
-  const FacePatch p = patch_of(net, 0, {Method::thesis, 1, Planarity::least_squares}, splits);
+  const FacePatch p = patch_of(net, FaceIndex{0}, {Method::thesis, 1, Planarity::least_squares}, splits);
   CHECK(p.first_stage_sizes == std::vector<uint32_t>{4, 3});
   CHECK(p.face_count() == 7);
   CHECK(p.interior.size() == 3);  // the cut's midpoint and the two centres
@@ -74,12 +74,12 @@ TEST_CASE("thesis: a pentagon triquadrifies into a quad and a triangle, then 7 q
 TEST_CASE("thesis: the centre of a 4-sided face is its Coons point x(1/2, 1/2)", "[reconstruct][thesis]") {
   const Mesh net = polygon_network(4, 11);
   std::vector<EdgeSplits> splits;
-  const FacePatch p = patch_of(net, 0, {Method::thesis, 1, Planarity::least_squares}, splits);
+  const FacePatch p = patch_of(net, FaceIndex{0}, {Method::thesis, 1, Planarity::least_squares}, splits);
   REQUIRE(p.interior.size() == 1);
   std::vector<std::vector<double>> params;
   std::vector<Side> sides;
-  for (uint32_t oe : net.face_loop(0)) params.push_back(arc_parameters(net.polyline(edge_of(oe))));
-  for (uint32_t k = 0; k < 4; ++k) sides.push_back({net.polyline(edge_of(net.face_loop(0)[k])), params[k], false});
+  for (OrientedEdge oe : net.face_loop(FaceIndex{0})) params.push_back(arc_parameters(net.polyline(edge_of(oe))));
+  for (uint32_t k = 0; k < 4; ++k) sides.push_back({net.polyline(edge_of(net.face_loop(FaceIndex{0})[k])), params[k], false});
   CHECK(p.interior[0] == coons_point(sides, 0.5, 0.5, Sampling::nearest));
   // Two steps: a 5 x 5 grid of base vertices.
   const BaseMesh b = base_of(net, {Method::thesis, 2, 1, Planarity::least_squares});
@@ -102,7 +102,7 @@ TEST_CASE("FIRE: an n-sided face becomes n quads around its centre", "[reconstru
     // Corner k's quad: P_k, M_k, C, M_k-1, where M_k is the middle sample of side k.
     for (uint32_t k = 0; k < n; ++k) {
       CHECK(b.face_vertices[4 * k] == k);
-      const auto line = net.polyline(k);
+      const auto line = net.polyline(EdgeIndex{k});
       CHECK(b.positions[b.face_vertices[4 * k + 1]] == line[middle_sample(arc_parameters(line))]);
     }
     // The surface: n * 4^2 quads.
@@ -184,28 +184,28 @@ TEST_CASE("FIRE: a straight corner joins its sides only where every face of thos
     INFO((squares ? "two squares below" : "a rectangle below"));
     Mesh net;
     std::vector<Vec3> at{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0}, {0, 2, 0}, {2, 2, 0}};
-    std::vector<uint32_t> v;
+    std::vector<VertexIndex> v;
     for (const Vec3& p : at) v.push_back(net.add_vertex(p));
     auto edge = [&](uint32_t a, uint32_t b) { return net.add_edge(v[a], v[b], line(at[a], at[b])); };
-    const uint32_t left = edge(3, 4), right = edge(4, 5), top_right = edge(5, 7), top = edge(7, 6), top_left = edge(6, 3);
-    const uint32_t bottom_left = edge(0, 3), bottom_right = edge(2, 5);
-    std::vector<uint32_t> upper{make_oriented(left, false), make_oriented(right, false), make_oriented(top_right, false),
+    const EdgeIndex left = edge(3, 4), right = edge(4, 5), top_right = edge(5, 7), top = edge(7, 6), top_left = edge(6, 3);
+    const EdgeIndex bottom_left = edge(0, 3), bottom_right = edge(2, 5);
+    std::vector<OrientedEdge> upper{make_oriented(left, false), make_oriented(right, false), make_oriented(top_right, false),
                                 make_oriented(top, false), make_oriented(top_left, false)};
     if (squares) {
-      const uint32_t a = edge(0, 1), b = edge(1, 2), middle = edge(1, 4);
-      const uint32_t first[] = {make_oriented(a, false), make_oriented(middle, false), make_oriented(left, true),
+      const EdgeIndex a = edge(0, 1), b = edge(1, 2), middle = edge(1, 4);
+      const OrientedEdge first[] = {make_oriented(a, false), make_oriented(middle, false), make_oriented(left, true),
                                 make_oriented(bottom_left, true)};
-      const uint32_t second[] = {make_oriented(b, false), make_oriented(bottom_right, false), make_oriented(right, true),
+      const OrientedEdge second[] = {make_oriented(b, false), make_oriented(bottom_right, false), make_oriented(right, true),
                                  make_oriented(middle, true)};
       REQUIRE(net.add_face(first) != kNone);
       REQUIRE(net.add_face(second) != kNone);
     } else {
-      const uint32_t bottom = edge(0, 2);
-      const uint32_t lower[] = {make_oriented(bottom, false), make_oriented(bottom_right, false), make_oriented(right, true),
+      const EdgeIndex bottom = edge(0, 2);
+      const OrientedEdge lower[] = {make_oriented(bottom, false), make_oriented(bottom_right, false), make_oriented(right, true),
                                 make_oriented(left, true), make_oriented(bottom_left, true)};
       REQUIRE(net.add_face(lower) != kNone);
     }
-    const uint32_t upper_face = net.add_face(upper);
+    const FaceIndex upper_face = net.add_face(upper);
     REQUIRE(upper_face != kNone);
     REQUIRE(net.validate() == "");
     const BaseMesh b = base_of(net, {Method::fire, 1, 2, Planarity::least_squares});
@@ -254,7 +254,7 @@ TEST_CASE("FIRE: a border turn no larger than the noise's own turning is no corn
     p.y() -= dip * (1 - std::abs(p.x() - 2) / 2) * (1 - p.y() / 2);
     return p;
   };
-  for (uint32_t v = 0; v < net.vertex_slots(); ++v) net.vertices.position.set(v, bend(net.vertices.position[v]));
+  for (VertexIndex v{0}; v < net.vertex_slots(); ++v) net.vertices.position.set(v, bend(net.vertices.position[v]));
   for (uint32_t i = 0; i < uint32_t(net.points.size()); ++i) net.points.set(i, bend(net.points[i]));
   const Vec3 kink(2, -dip, 0);
   auto kink_is_corner = [&](const Mesh& m) {
@@ -269,7 +269,7 @@ TEST_CASE("FIRE: a border turn no larger than the noise's own turning is no corn
   // Every curve bowed up by a smooth bump, as a tracked pen errs along a stroke: the curves now leave their
   // vertices 4.4 degrees out of one plane (the median), and the kink, tilted up on both sides (a turn of
   // about 32.4 degrees now), is within what that noise makes.
-  for (uint32_t e = 0; e < net.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < net.edge_slots(); ++e) {
     const uint32_t first = net.edges.point_offset[e], count = net.edges.point_count[e];
     for (uint32_t s = 1; s + 1 < count; ++s)
       net.points.set(first + s, net.points[first + s] + Vec3(0, 0, 0.03 * std::sin(std::numbers::pi * s / (count - 1))));
@@ -326,12 +326,13 @@ TEST_CASE("FIRE: a straight corner joins its sides only beyond the noise's own t
   // the faces above, which split the sides there, so the face keeps it.
   Mesh net = grid_network(4, 4, 17, [](double x, double y) { return 0.05 * x * y; });
   const uint32_t nx = 4, vertical = 5 * nx;
-  net.remove_face(0);
-  net.remove_face(1);
-  net.remove_edge(vertical + 1);
-  const uint32_t loop[] = {make_oriented(0, false),          make_oriented(1, false), make_oriented(vertical + 2, false),
-                           make_oriented(nx + 1, true),       make_oriented(nx, true), make_oriented(vertical, true)};
-  const uint32_t merged = net.add_face(loop);
+  net.remove_face(FaceIndex{0});
+  net.remove_face(FaceIndex{1});
+  net.remove_edge(EdgeIndex{vertical + 1});
+  const OrientedEdge loop[] = {make_oriented(EdgeIndex{0}, false),      make_oriented(EdgeIndex{1}, false),
+                               make_oriented(EdgeIndex{vertical + 2}, false), make_oriented(EdgeIndex{nx + 1}, true),
+                               make_oriented(EdgeIndex{nx}, true),        make_oriented(EdgeIndex{vertical}, true)};
+  const FaceIndex merged = net.add_face(loop);
   REQUIRE(merged != kNone);
   REQUIRE(net.validate() == "");
   auto base_faces = [&](const Mesh& m) {
@@ -345,7 +346,7 @@ TEST_CASE("FIRE: a straight corner joins its sides only beyond the noise's own t
   // straight only where it turns by less than 20 degrees less that spread.
   auto bowed = [&](double height) {
     Mesh m = net;
-    for (uint32_t e = 2; e < m.edge_slots(); ++e) {
+    for (EdgeIndex e{2}; e < m.edge_slots(); ++e) {
       if (!m.edge_alive(e)) continue;
       const uint32_t first = m.edges.point_offset[e], count = m.edges.point_count[e];
       for (uint32_t s = 1; s + 1 < count; ++s)
@@ -446,7 +447,7 @@ TEST_CASE("bad networks and options are rejected with the element named", "[reco
 
   // Coincident consecutive points.
   Mesh repeated = polygon_network(3);
-  repeated.points.set(repeated.edges.point_offset[1] + 3, repeated.polyline(1)[2]);
+  repeated.points.set(repeated.edges.point_offset[1] + 3, repeated.polyline(EdgeIndex{1})[2]);
   CHECK_THAT(error_of(repeated, fire), Catch::Contains("edge 1's polyline has coincident consecutive points 2 and 3"));
 
   // NaN.
@@ -456,11 +457,11 @@ TEST_CASE("bad networks and options are rejected with the element named", "[reco
 
   // Two corners at one point; and a polyline of zero length between them.
   Mesh pinched;
-  const uint32_t a = pinched.add_vertex({0, 0, 0}), b = pinched.add_vertex({1, 0, 0}), c = pinched.add_vertex({0, 0, 0});
-  const uint32_t e0 = pinched.add_edge(a, b, std::vector<Vec3>{{0, 0, 0}, {1, 0, 0}});
-  const uint32_t e1 = pinched.add_edge(b, c, std::vector<Vec3>{{1, 0, 0}, {0.5, 0.5, 0}, {0, 0, 0}});
-  const uint32_t e2 = pinched.add_edge(c, a, std::vector<Vec3>{{0, 0, 0}, {-0.5, -0.5, 0}, {0, 0, 0}});
-  REQUIRE(pinched.add_face(std::vector<uint32_t>{make_oriented(e0, false), make_oriented(e1, false), make_oriented(e2, false)}) != kNone);
+  const VertexIndex a = pinched.add_vertex({0, 0, 0}), b = pinched.add_vertex({1, 0, 0}), c = pinched.add_vertex({0, 0, 0});
+  const EdgeIndex e0 = pinched.add_edge(a, b, std::vector<Vec3>{{0, 0, 0}, {1, 0, 0}});
+  const EdgeIndex e1 = pinched.add_edge(b, c, std::vector<Vec3>{{1, 0, 0}, {0.5, 0.5, 0}, {0, 0, 0}});
+  const EdgeIndex e2 = pinched.add_edge(c, a, std::vector<Vec3>{{0, 0, 0}, {-0.5, -0.5, 0}, {0, 0, 0}});
+  REQUIRE(pinched.add_face(std::vector<OrientedEdge>{make_oriented(e0, false), make_oriented(e1, false), make_oriented(e2, false)}) != kNone);
   CHECK_THAT(error_of(pinched, fire), Catch::Contains("face 0 has coincident corners: vertices 0 and 2"));
   Mesh flat = pinched;
   for (uint32_t k = 0; k < 3; ++k) flat.points.set(flat.edges.point_offset[e2] + k, Vec3(0, 0, 0));

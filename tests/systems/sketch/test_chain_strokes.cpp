@@ -57,7 +57,7 @@ TEST_CASE("a stroke in three pieces draws one curve when the last reaches the ne
   CHECK(w->mesh.face_count() == 7);
   CHECK(w->mesh.validate().empty());
   uint32_t longest = 0;
-  for (uint32_t e = 0; e < w->mesh.edge_slots(); ++e)
+  for (EdgeIndex e{0}; e < w->mesh.edge_slots(); ++e)
     if (w->mesh.edge_alive(e) && std::abs(w->mesh.polyline(e).front().x() - 0.03) < 1e-9) longest = std::max(longest, w->mesh.edges.point_count[e]);
   CHECK(longest >= 20);  // the three pieces' samples in one curve
   log.event("cmd undo");  // the whole curve goes, the two pieces come back

@@ -36,10 +36,10 @@ Log& path(Log& log, std::initializer_list<Vec3> corners) {
 }
 
 // The live vertex at p (within 0.1 mm), or kNone.
-uint32_t vertex_at(const Mesh& m, const Vec3& p) {
-  for (uint32_t v = 0; v < m.vertex_slots(); ++v)
+VertexIndex vertex_at(const Mesh& m, const Vec3& p) {
+  for (VertexIndex v{0}; v < m.vertex_slots(); ++v)
     if (m.vertex_alive(v) && (m.vertices.position[v] - p).norm() < 1e-4) return v;
-  return kNone;
+  return VertexIndex{};
 }
 
 }  // namespace
@@ -76,7 +76,7 @@ TEST_CASE("a stroke through a vertex is cut at that vertex, not beside it", "[sk
   line(log, {0, 0.05, 0}, {0.3, 0.05, 0});  // vertices at (x, 5 cm) on every strip's curve
   auto w = replay(log);
   REQUIRE(w->rejections.empty());
-  const uint32_t centre = vertex_at(w->mesh, {0.10, 0.05, 0});
+  const VertexIndex centre = vertex_at(w->mesh, {0.10, 0.05, 0});
   REQUIRE(centre != kNone);
   REQUIRE(w->mesh.valence(centre) == 4);
   const size_t vertices = w->mesh.vertex_count(), faces = w->mesh.face_count();

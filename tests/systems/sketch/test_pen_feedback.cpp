@@ -82,7 +82,7 @@ TEST_CASE("split mode: the snap target and the face under the pen", "[sketch][fe
   REQUIRE(w->mesh.valid(fb.target_edge));
   CHECK(fb.target_point == 1);
   CHECK(fb.target == Vec3(0.05, 0, 0));
-  CHECK(w->mesh.polyline(fb.target_edge.index)[fb.target_point] == fb.target);
+  CHECK(w->mesh.polyline(EdgeIndex{fb.target_edge.index})[fb.target_point] == fb.target);
   REQUIRE(w->mesh.valid(fb.face));
   CHECK_FALSE(fb.closes_border);
 
@@ -183,7 +183,7 @@ TEST_CASE("a stroke's pauses at its ends are not drawn: no curve point lingers w
     return replay(log);
   };
   const auto diagonal = [](const World& w) -> std::span<const Vec3> {
-    for (uint32_t e = 0; e < w.mesh.edge_slots(); ++e)
+    for (EdgeIndex e{0}; e < w.mesh.edge_slots(); ++e)
       if (w.mesh.edge_alive(e)) {
         const auto line = w.mesh.polyline(e);
         if ((line.front() - line.back()).norm() > 0.12) return line;  // only the diagonal spans the square

@@ -58,7 +58,7 @@ TEST_CASE("a stroke across the border loop's hole closes the object, and its sur
   INFO(rejections(*w));
   CHECK(w->rejections.empty());
   CHECK(w->mesh.face_count() == 4);
-  for (uint32_t e = 0; e < w->mesh.edge_slots(); ++e)
+  for (EdgeIndex e{0}; e < w->mesh.edge_slots(); ++e)
     if (w->mesh.edge_alive(e)) CHECK_FALSE(w->mesh.is_border_edge(e));
   REQUIRE(w->surface.level > 0);
   const evaluate::Topology t = surface_topology(*w);
@@ -238,14 +238,14 @@ TEST_CASE("seen from the cameras, of two faces that hold both ends of a stroke, 
     CHECK(w->rejections.empty());
     REQUIRE(w->mesh.face_count() == 3);
     // Every face beside the new curve lies on the side it was bowed toward.
-    uint32_t bowed = kNone;
-    for (uint32_t e = 0; e < w->mesh.edge_slots(); ++e)
+    EdgeIndex bowed;
+    for (EdgeIndex e{0}; e < w->mesh.edge_slots(); ++e)
       if (w->mesh.edge_alive(e) && side * (w->mesh.polyline(e)[w->mesh.edges.point_count[e] / 2].x() - 0.05) > 0.02) bowed = e;
     REQUIRE(bowed != kNone);
     for (uint32_t f : w->mesh.edges.face[bowed]) {
       REQUIRE(f != kNone);
       Vec3 centre = Vec3::Zero();
-      const std::vector<Vec3> boundary = w->mesh.face_boundary(f);
+      const std::vector<Vec3> boundary = w->mesh.face_boundary(FaceIndex{f});
       for (const Vec3& p : boundary) centre += p;
       CHECK(side * (centre.x() / double(boundary.size()) - 0.05) > 0);
     }
@@ -275,7 +275,7 @@ TEST_CASE("seen along the surface, a stroke between two border points splits its
   CHECK(w->mesh.border_loop_count() == 1);
   // The corner's curve has a face on both sides: it split the right half, not the hole beyond the border.
   uint32_t corner = kNone;
-  for (uint32_t e = 0; e < w->mesh.edge_slots(); ++e)
+  for (EdgeIndex e{0}; e < w->mesh.edge_slots(); ++e)
     if (w->mesh.edge_alive(e) && (w->mesh.polyline(e)[w->mesh.edges.point_count[e] / 2] - Vec3(0.095, 0.005, 0)).norm() < 0.003) corner = e;
   REQUIRE(corner != kNone);
   CHECK(w->mesh.edges.face[corner][0] != kNone);

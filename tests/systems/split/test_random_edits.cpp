@@ -38,11 +38,11 @@ TEST_CASE("10,000 random edits keep every invariant", "[random]") {
       r = h.apply(m, random_split(m, rng, 8));
       s.splits += r.ok();
     } else if (dice < 70) {
-      std::vector<uint32_t> interior;
-      for (uint32_t e = 0; e < m.edge_slots(); ++e)
+      std::vector<EdgeIndex> interior;
+      for (EdgeIndex e{0}; e < m.edge_slots(); ++e)
         if (m.edge_alive(e) && !m.is_border_edge(e)) interior.push_back(e);
       EditCommand del = make(EditKind::DeleteCurve);
-      del.edge = interior.empty() ? 0 : interior[rng() % interior.size()];
+      del.edge = interior.empty() ? EdgeIndex{0} : interior[rng() % interior.size()];
       r = h.apply(m, del);
       s.deletes += r.ok();
     } else if (dice < 88) {

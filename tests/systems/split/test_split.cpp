@@ -26,10 +26,10 @@ void apply_undo_redo(Mesh& m, EditHistory& h, const EditCommand& cmd) {
 }
 
 // The square split in half by a vertical curve (through `h`); returns that curve's edge.
-uint32_t split_square(Mesh& m, EditHistory& h) {
+EdgeIndex split_square(Mesh& m, EditHistory& h) {
   REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok());
-  uint32_t middle = kNone;
-  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+  EdgeIndex middle;
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e)
     if (m.edge_alive(e) && !m.is_border_edge(e)) middle = e;
   REQUIRE(middle != kNone);
   return middle;
@@ -37,7 +37,7 @@ uint32_t split_square(Mesh& m, EditHistory& h) {
 
 size_t border_edges(const Mesh& m) {
   size_t n = 0;
-  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e)
     if (m.edge_alive(e) && m.is_border_edge(e)) ++n;
   return n;
 }
@@ -62,7 +62,7 @@ TEST_CASE("border polygon: four strokes and a snapping close make one face", "[s
 TEST_CASE("split edge-edge: two new vertices, four edge halves, one new edge", "[split]") {
   EditHistory h;
   Mesh m = square(&h);
-  const EdgeId bottom = m.edge_id(0), top = m.edge_id(2);
+  const EdgeId bottom = m.edge_id(EdgeIndex{0}), top = m.edge_id(EdgeIndex{2});
   auto cmd = split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}, 7));
   apply_undo_redo(m, h, cmd);
   CHECK(m.vertex_count() == 6);
@@ -73,8 +73,8 @@ TEST_CASE("split edge-edge: two new vertices, four edge halves, one new edge", "
   CHECK_FALSE(m.valid(bottom));  // the split edges are gone; their slots may be reused, with a new generation
   CHECK_FALSE(m.valid(top));
   // The new vertices sit on the old polylines' middle points and have valence 3.
-  uint32_t a = kNone, b = kNone;
-  for (uint32_t v = 0; v < m.vertex_slots(); ++v) {
+  VertexIndex a, b;
+  for (VertexIndex v{0}; v < m.vertex_slots(); ++v) {
     if (!m.vertex_alive(v)) continue;
     if (m.vertices.position[v] == Vec3(0.5, 0, 0)) a = v;
     if (m.vertices.position[v] == Vec3(0.5, 1, 0)) b = v;
@@ -101,7 +101,7 @@ TEST_CASE("split vertex-edge and edge-vertex", "[split]") {
     CHECK(m.vertex_count() == 5);
     CHECK(m.edge_count() == 6);
     CHECK(face_sizes(m) == std::vector<uint32_t>{3, 4});
-    CHECK(m.valence(0) == 3);
+    CHECK(m.valence(VertexIndex{0}) == 3);
   }
   SECTION("edge-vertex") {
     EditHistory h;
@@ -110,7 +110,7 @@ TEST_CASE("split vertex-edge and edge-vertex", "[split]") {
     CHECK(m.vertex_count() == 5);
     CHECK(m.edge_count() == 6);
     CHECK(face_sizes(m) == std::vector<uint32_t>{3, 4});
-    CHECK(m.valence(2) == 3);
+    CHECK(m.valence(VertexIndex{2}) == 3);
   }
 }
 
@@ -121,9 +121,9 @@ TEST_CASE("split vertex-vertex: no new vertex", "[split]") {
   CHECK(m.vertex_count() == 4);
   CHECK(m.edge_count() == 5);
   CHECK(face_sizes(m) == std::vector<uint32_t>{3, 3});
-  CHECK(m.valence(0) == 3);
-  CHECK(m.valence(2) == 3);
-  CHECK(m.valence(1) == 2);
+  CHECK(m.valence(VertexIndex{0}) == 3);
+  CHECK(m.valence(VertexIndex{2}) == 3);
+  CHECK(m.valence(VertexIndex{1}) == 2);
 }
 
 TEST_CASE("split between adjacent vertices makes a two-sided face", "[split]") {
@@ -137,17 +137,17 @@ TEST_CASE("splitting an interior edge updates the face on its other side", "[spl
   EditHistory h;
   Mesh m = square(&h);
   REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}, 5))).ok());
-  uint32_t middle = kNone, right = kNone;
-  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+  EdgeIndex middle, right;
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e) {
     if (!m.edge_alive(e)) continue;
     if (!m.is_border_edge(e)) middle = e;
     if (e == 1) right = e;
   }
   REQUIRE(middle != kNone);
-  uint32_t right_face = m.edges.face[right][0];
+  const FaceIndex right_face{m.edges.face[right][0]};
   uint32_t left_face = m.other_face(middle, right_face);
   REQUIRE(m.faces.edge_count[left_face] == 4);
-  apply_undo_redo(m, h, split(right_face, {middle, 2}, {right, 2}, line({0.5, 0.5, 0}, {1, 0.5, 0})));
+  apply_undo_redo(m, h, split(right_face, CurveEnd{middle, 2}, CurveEnd{right, 2}, line({0.5, 0.5, 0}, {1, 0.5, 0})));
   CHECK(m.vertex_count() == 8);
   CHECK(m.edge_count() == 10);
   CHECK(face_sizes(m) == std::vector<uint32_t>{4, 4, 5});
@@ -219,8 +219,8 @@ TEST_CASE("border rejections", "[split][reject]") {
 TEST_CASE("deleting a curve merges its faces and joins the edge splits it needed", "[split][delete]") {
   EditHistory h;
   Mesh m = square(&h);
-  std::vector<Vec3> bottom(m.polyline(0).begin(), m.polyline(0).end());
-  const uint32_t middle = split_square(m, h);
+  std::vector<Vec3> bottom(m.polyline(EdgeIndex{0}).begin(), m.polyline(EdgeIndex{0}).end());
+  const EdgeIndex middle{split_square(m, h)};
   EditCommand del = make(EditKind::DeleteCurve);
   del.edge = middle;
   apply_undo_redo(m, h, del);
@@ -228,7 +228,7 @@ TEST_CASE("deleting a curve merges its faces and joins the edge splits it needed
   CHECK(m.edge_count() == 4);
   CHECK(face_sizes(m) == std::vector<uint32_t>{4});
   // The bottom edge is whole again, with the same points.
-  uint32_t e = edge_between(m, 0, 1);
+  EdgeIndex e = edge_between(m, 0, 1);
   REQUIRE(e != kNone);
   auto joined = m.polyline(e);
   std::vector<Vec3> got(joined.begin(), joined.end());
@@ -241,15 +241,15 @@ TEST_CASE("deleting a curve keeps a vertex other curves still need", "[split][de
   Mesh m = square(&h);
   REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok());
   // A second curve from the bottom split vertex to the top-right corner.
-  uint32_t a = kNone;
-  for (uint32_t v = 0; v < m.vertex_slots(); ++v)
+  VertexIndex a;
+  for (VertexIndex v{0}; v < m.vertex_slots(); ++v)
     if (m.vertex_alive(v) && m.vertices.position[v] == Vec3(0.5, 0, 0)) a = v;
   uint32_t right_edge_half = edge_between(m, a, 1);
   uint32_t f = m.edges.face[right_edge_half][0] != kNone ? m.edges.face[right_edge_half][0] : m.edges.face[right_edge_half][1];
   uint32_t at_a = m.edges.vertex[right_edge_half][0] == a ? 0 : m.edges.point_count[right_edge_half] - 1;
   REQUIRE(h.apply(m, split(f, {right_edge_half, at_a}, {1, 4}, line({0.5, 0, 0}, {1, 1, 0}))).ok());
-  uint32_t middle = kNone;
-  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+  EdgeIndex middle;
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e)
     if (m.edge_alive(e) && !m.is_border_edge(e) && m.edges.point_count[e] == 5 &&
         m.polyline(e)[4] == Vec3(0.5, 1, 0))
       middle = e;
@@ -266,7 +266,7 @@ TEST_CASE("deleting a curve keeps a vertex other curves still need", "[split][de
 TEST_CASE("marking a curve sharp flips its flag, undoes and redoes bit for bit, the border is refused", "[split][sharp]") {
   EditHistory h;
   Mesh m = square(&h);
-  const uint32_t middle = split_square(m, h);
+  const EdgeIndex middle{split_square(m, h)};
   EditCommand sharp = make(EditKind::ToggleSharp);
   sharp.edge = middle;
   const size_t depth = h.undo_depth();
@@ -287,7 +287,7 @@ TEST_CASE("marking a curve sharp flips its flag, undoes and redoes bit for bit, 
   CHECK_FALSE(refused.ok());
   CHECK_THAT(refused.error, Catch::Contains("border"));
   EditCommand missing = make(EditKind::ToggleSharp);
-  missing.edge = 999;
+  missing.edge = EdgeIndex{999};
   CHECK_THAT(h.apply(m, missing).error, Catch::Contains("does not exist"));
   CHECK(m.same_pools(before));
   CHECK(h.undo_depth() == depth + 2);
@@ -298,7 +298,7 @@ TEST_CASE("compaction squeezes tombstones and keeps the network", "[pools]") {
   Mesh m = square(&h);
   REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok());
   EditCommand del = remove(kNone);
-  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e)
     if (m.edge_alive(e) && !m.is_border_edge(e)) del.edge = e;
   REQUIRE(h.apply(m, del).ok());  // leaves tombstones: the joined edges' slots
   REQUIRE(m.edges.free_list.size() > 0);
@@ -323,7 +323,7 @@ TEST_CASE("compaction squeezes tombstones and keeps the network", "[pools]") {
 TEST_CASE("handles carry generations", "[pools]") {
   EditHistory h;
   Mesh m = square(&h);
-  EdgeId bottom = m.edge_id(0);
+  EdgeId bottom = m.edge_id(EdgeIndex{0});
   CHECK(m.valid(bottom));
   REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok());
   CHECK_FALSE(m.valid(bottom));
@@ -398,7 +398,7 @@ TEST_CASE("a rejected edit leaves the stamps alone, undo stamps exactly what it 
   // The face and the closing edge (slot 3) are gone, and every edge that named the face is restored.
   CHECK(m.faces.changes.since(1) == std::vector<uint32_t>{0});
   CHECK(m.edges.changes.since(1) == std::vector<uint32_t>{0, 1, 2, 3});
-  CHECK_FALSE(m.edge_alive(3));
+  CHECK_FALSE(m.edge_alive(EdgeIndex{3}));
   // The closing edge's two ends lose it from their edge lists; the other corners are untouched.
   for (uint32_t v : m.vertices.changes.since(1)) CHECK((v == m.edges.vertex[2][1] || v == 0));
 }
@@ -409,8 +409,8 @@ TEST_CASE("compaction keeps the survivors' stamps and records its map", "[pools]
   m.begin_frame(1);
   REQUIRE(execute_edit(m, split(0, {0, 0}, {2, 0}, line({0, 0, 0}, {1, 1, 0}))).ok());
   m.begin_frame(2);
-  uint32_t curve = kNone;
-  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+  EdgeIndex curve;
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e)
     if (m.edge_alive(e) && m.edges.face[e][0] != kNone && m.edges.face[e][1] != kNone) curve = e;
   REQUIRE(curve != kNone);
   EditCommand del;
@@ -437,7 +437,7 @@ namespace {
 // 0.3 below the square: the square's far side.
 EditCommand across_hole(const Mesh& m) {
   EditCommand c = make(EditKind::SplitHole, {{0.5, 0, 0}, {0.5, 0.25, -0.25}, {0.5, 0.5, -0.3}, {0.5, 0.75, -0.25}, {0.5, 1, 0}});
-  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e) {
     if (!m.edge_alive(e)) continue;
     if (at(m, e, 2) == Vec3(0.5, 0, 0)) c.start = {e, 2};
     if (at(m, e, 2) == Vec3(0.5, 1, 0)) c.end = {e, 2};
@@ -450,14 +450,14 @@ int64_t euler_characteristic(const Mesh& m) {
 }
 
 // The live face of the highest slot with `sides` edges, or kNone.
-uint32_t face_with_sides(const Mesh& m, uint32_t sides) {
-  uint32_t found = kNone;
-  for (uint32_t f = 0; f < m.face_slots(); ++f)
+FaceIndex face_with_sides(const Mesh& m, uint32_t sides) {
+  FaceIndex found;
+  for (FaceIndex f{0}; f < m.face_slots(); ++f)
     if (m.face_alive(f) && m.faces.edge_count[f] == sides) found = f;
   return found;
 }
 
-EditCommand hole(uint32_t face) {
+EditCommand hole(FaceIndex face) {
   EditCommand c = make(EditKind::MakeHole);
   c.face = face;
   return c;
@@ -478,7 +478,7 @@ TEST_CASE("a curve across a border loop's hole closes the object: two new faces,
   CHECK(m.border_loop_count() == 0);
   CHECK(face_sizes(m) == std::vector<uint32_t>{4, 4, 6});
   // The new faces walk the old border against the square: each rim curve is the square's on one side.
-  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e)
     if (m.edge_alive(e)) CHECK(m.edges.face[e][0] != m.edges.face[e][1]);
 }
 
@@ -487,7 +487,7 @@ TEST_CASE("a hole and its undo: the face goes, its curves become border, undo br
   Mesh m = square(&h);
   REQUIRE(h.apply(m, across_hole(m)).ok());
   // The two faces under the square are apart from any border on a closed object.
-  const uint32_t under = face_with_sides(m, 4);
+  const FaceIndex under = face_with_sides(m, 4);
   REQUIRE(under != kNone);
   apply_undo_redo(m, h, hole(under));
   CHECK(m.face_count() == 2);
@@ -495,25 +495,25 @@ TEST_CASE("a hole and its undo: the face goes, its curves become border, undo br
   CHECK(euler_characteristic(m) == 1);  // a disc again
   CHECK(m.border_loop_count() == 1);
   // The other face under the square now lies beside the border: refused, nothing changes.
-  const uint32_t other = face_with_sides(m, 4);
+  const FaceIndex other = face_with_sides(m, 4);
   REQUIRE(other != kNone);
   const Mesh before = m;
   const Status beside = h.apply(m, hole(other));
   CHECK_FALSE(beside.ok());
   CHECK_THAT(beside.error, Catch::Matchers::Contains("beside the border"));
   CHECK(m.same_pools(before));
-  const Status missing = h.apply(m, hole(99));
+  const Status missing = h.apply(m, hole(FaceIndex{99}));
   CHECK_THAT(missing.error, Catch::Matchers::Contains("does not exist"));
   CHECK(m.same_pools(before));
   // The hole's rim can be crossed again: the object closes once more.
-  uint32_t rim_edge = kNone;
-  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+  EdgeIndex rim_edge;
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e)
     if (m.edge_alive(e) && m.is_border_edge(e) && m.edges.point_count[e] >= 3 && rim_edge == kNone) rim_edge = e;
   REQUIRE(rim_edge != kNone);
-  const std::vector<uint32_t> rim = m.border_loop(rim_edge);
+  const std::vector<OrientedEdge> rim = m.border_loop(rim_edge);
   REQUIRE(rim.size() == 4);
   EditCommand again = make(EditKind::SplitHole);
-  const uint32_t first = edge_of(rim[0]), third = edge_of(rim[2]);
+  const EdgeIndex first = edge_of(rim[0]), third = edge_of(rim[2]);
   again.start = {first, 1};
   again.end = {third, 1};
   again.points = line(at(m, first, 1), at(m, third, 1), 7);
@@ -528,11 +528,11 @@ TEST_CASE("a hole touching the border at a corner is refused: it would pinch the
   Mesh m = square(&h);
   REQUIRE(h.apply(m, across_hole(m)).ok());
   // The top split by a curve between the same two points as the one below: four faces meet at each end.
-  const uint32_t top = face_with_sides(m, 6);
+  const FaceIndex top = face_with_sides(m, 6);
   REQUIRE(top != kNone);
   CurveEnd a, b;
-  for (uint32_t oe : m.face_loop(top)) {
-    const uint32_t e = edge_of(oe);
+  for (OrientedEdge oe : m.face_loop(top)) {
+    const EdgeIndex e = edge_of(oe);
     for (uint32_t k : {uint32_t(0), m.edges.point_count[e] - 1}) {
       if (at(m, e, k) == Vec3(0.5, 0, 0)) a = {e, k};
       if (at(m, e, k) == Vec3(0.5, 1, 0)) b = {e, k};
@@ -546,8 +546,8 @@ TEST_CASE("a hole touching the border at a corner is refused: it would pinch the
   REQUIRE(m.face_count() == 4);
   // Hole one face below: the top face on the other side meets its rim only at the two corners.
   // Faces below hold a point with z < 0; of those, the one with corner (0, 0); of the top, the one with (1, 0).
-  uint32_t below_left = kNone, top_right = kNone;
-  for (uint32_t f = 0; f < m.face_slots(); ++f) {
+  FaceIndex below_left, top_right;
+  for (FaceIndex f{0}; f < m.face_slots(); ++f) {
     if (!m.face_alive(f)) continue;
     bool below = false, left = false, right = false;
     for (const Vec3& q : m.face_boundary(f)) {
@@ -589,8 +589,8 @@ TEST_CASE("a border drawn apart from the network starts a second part", "[split]
   CHECK(m.border_loop_count() == 2);
   // A curve from one part's rim to the other's would join two border loops: refused in words, nothing lost.
   EditCommand join = make(EditKind::SplitHole, line({0.5, 0, 0}, {3.5, 0, 0}));
-  join.start = {0, 2};
-  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+  join.start = {EdgeIndex{0}, 2};
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e)
     if (m.edge_alive(e) && at(m, e, 2) == Vec3(3.5, 0, 0)) join.end = {e, 2};
   REQUIRE(join.end.edge != kNone);
   const Mesh two = m;
@@ -599,8 +599,8 @@ TEST_CASE("a border drawn apart from the network starts a second part", "[split]
   CHECK(m.same_pools(two));
   // An inner curve is no rim.
   REQUIRE(h.apply(m, split(0, {0, 2}, {2, 2}, line({0.5, 0, 0}, {0.5, 1, 0}))).ok());
-  uint32_t inner = kNone;
-  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+  EdgeIndex inner;
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e)
     if (m.edge_alive(e) && !m.is_border_edge(e)) inner = e;
   EditCommand off_rim = join;
   off_rim.start = {inner, 2};
@@ -622,7 +622,7 @@ TEST_CASE("two curves between two border loops: a bridge with no face, then two 
   close.snap_distance = 0.01;
   REQUIRE(h.apply(m, close).ok());
   auto point_at = [&](const Vec3& p) {
-    for (uint32_t e = 0; e < m.edge_slots(); ++e)
+    for (EdgeIndex e{0}; e < m.edge_slots(); ++e)
       if (m.edge_alive(e))
         for (uint32_t k = 0; k < m.edges.point_count[e]; ++k)
           if (at(m, e, k) == p) return CurveEnd{e, k};
@@ -655,13 +655,13 @@ TEST_CASE("two curves between two border loops: a bridge with no face, then two 
   CHECK(m.same_pools(waiting));
   // A second curve from where the bridge ends would make a face that touches itself there.
   EditCommand from_bridge_end = bridge(1);
-  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e)
     if (m.edge_alive(e) && m.is_border_edge(e) && !m.is_loose_edge(e) && at(m, e, 0) == Vec3(0.5, 0, 0)) from_bridge_end.start = {e, 0};
   CHECK_THAT(h.apply(m, from_bridge_end).error, Catch::Matchers::Contains("touch itself"));
   CHECK(m.same_pools(waiting));
   // A waiting bridge can be deleted; its ends join the rims again.
   EditCommand del = remove(kNone);
-  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e)
     if (m.edge_alive(e) && (m.edges.flags[e] & kBridgeEdge)) del.edge = e;
   REQUIRE(h.apply(m, del).ok());
   CHECK(m.validate() == "");
@@ -676,7 +676,7 @@ TEST_CASE("two curves between two border loops: a bridge with no face, then two 
   CHECK(m.border_loop_count() == 0);
   CHECK(euler_characteristic(m) == 2);  // two discs and the band between them: a sphere
   // Both squares made holes: a tube open at both ends, as a lampshade.
-  uint32_t bottom = m.edges.face[point_at({0.25, 0, 0}).edge][0], top = m.edges.face[point_at({0.25, 0, 1}).edge][0];
+  const FaceIndex bottom{m.edges.face[point_at({0.25, 0, 0}).edge][0]}, top{m.edges.face[point_at({0.25, 0, 1}).edge][0]};
   REQUIRE(h.apply(m, hole(bottom)).ok());
   REQUIRE(h.apply(m, hole(top)).ok());
   CHECK(m.validate() == "");
@@ -691,7 +691,7 @@ namespace {
 
 // The polyline point at p exactly, as a curve end (the first found), or an end with no edge.
 CurveEnd point_at(const Mesh& m, const Vec3& p) {
-  for (uint32_t e = 0; e < m.edge_slots(); ++e)
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e)
     if (m.edge_alive(e))
       for (uint32_t k = 0; k < m.edges.point_count[e]; ++k)
         if (at(m, e, k) == p) return {e, k};
@@ -700,11 +700,11 @@ CurveEnd point_at(const Mesh& m, const Vec3& p) {
 
 // The square split in half, and a stroke from (0.25, 0) on the bottom across the middle curve at (0.5, 0.5) to
 // (0.75, 1) on the top.
-EditCommand across_middle(const Mesh& m, uint32_t middle) {
+EditCommand across_middle(const Mesh& m, EdgeIndex middle) {
   EditCommand c = make(EditKind::CrossCurves, {{0.25, 0, 0}, {0.375, 0.25, 0.1}, {0.5, 0.5, 0}, {0.625, 0.75, 0.1}, {0.75, 1, 0}});
   c.start = point_at(m, {0.25, 0, 0});
   c.end = point_at(m, {0.75, 1, 0});
-  c.face = m.edges.face[c.start.edge][0];
+  c.face = FaceIndex{m.edges.face[c.start.edge][0]};
   c.crossings.push_back({point_at(m, {0.5, 0.5, 0}), 2, m.other_face(middle, c.face)});
   return c;
 }
@@ -714,7 +714,7 @@ EditCommand across_middle(const Mesh& m, uint32_t middle) {
 TEST_CASE("a stroke across a curve: each piece splits its face, undo takes both back at once", "[split][crossing]") {
   EditHistory h;
   Mesh m = square(&h);
-  const uint32_t middle = split_square(m, h);
+  const EdgeIndex middle = split_square(m, h);
   const EditCommand cross = across_middle(m, middle);
   REQUIRE(cross.start.edge != kNone);
   REQUIRE(cross.end.edge != kNone);
@@ -730,7 +730,7 @@ TEST_CASE("a stroke across a curve: each piece splits its face, undo takes both 
 TEST_CASE("a stroke across curves is refused in words when a crossing is on the border, stays in one face, or repeats a cut", "[split][crossing][reject]") {
   EditHistory h;
   Mesh m = square(&h);
-  const uint32_t middle = split_square(m, h);
+  const EdgeIndex middle = split_square(m, h);
   const Mesh before = m;
   EditCommand border = across_middle(m, middle);
   border.crossings[0].at = point_at(m, {1, 0.5, 0});

@@ -37,21 +37,21 @@ Result<Mesh> network(const PolygonMesh& pm, uint32_t k, double noise = 0, uint64
 
 std::map<uint32_t, size_t> face_sizes(const Mesh& m) {
   std::map<uint32_t, size_t> sizes;
-  for (uint32_t f = 0; f < m.face_slots(); ++f)
+  for (FaceIndex f{0}; f < m.face_slots(); ++f)
     if (m.face_alive(f)) ++sizes[m.faces.edge_count[f]];
   return sizes;
 }
 
-bool on_border(const Mesh& m, uint32_t v) {
-  for (uint32_t e : m.vertex_edges(v))
+bool on_border(const Mesh& m, VertexIndex v) {
+  for (EdgeIndex e : m.vertex_edges(v))
     if (m.is_border_edge(e)) return true;
   return false;
 }
 
-bool on_triangle(const Mesh& m, uint32_t v) {
-  for (uint32_t e : m.vertex_edges(v))
+bool on_triangle(const Mesh& m, VertexIndex v) {
+  for (EdgeIndex e : m.vertex_edges(v))
     for (uint32_t f : m.edges.face[e])
-      if (f != kNone && m.face_loop(f).size() == 3) return true;
+      if (f != kNone && m.face_loop(FaceIndex{f}).size() == 3) return true;
   return false;
 }
 
@@ -100,7 +100,7 @@ TEST_CASE("torus: K=1 keeps every edge, K=2 every other loop", "[synth]") {
   CHECK(k2->vertex_count() == 8);
   CHECK(face_sizes(*k2) == std::map<uint32_t, size_t>{{4, 8}});
   // Every network edge of K=2 replaces two control edges: 2 * 8 + 1 points.
-  for (uint32_t e = 0; e < k2->edge_slots(); ++e) CHECK(k2->edges.point_count[e] == 17);
+  for (EdgeIndex e{0}; e < k2->edge_slots(); ++e) CHECK(k2->edges.point_count[e] == 17);
 }
 
 TEST_CASE("exact counts on every shared manifold mesh for K = 1, 2, 3", "[synth]") {
@@ -154,8 +154,8 @@ TEST_CASE("exact counts on every shared manifold mesh for K = 1, 2, 3", "[synth]
     const std::map<std::string, long> euler = {{"cube.obj", 2}, {"pyramid.obj", 2}, {"torus.obj", 0}, {"pawn.obj", 1}, {"rook.obj", 1}};
     CHECK(long(x.vertices) - long(x.edges) + long(x.faces) == euler.at(x.mesh));
     // Thesis figure 63: an interior vertex of valence 2 survives only as the third corner of a triangle.
-    for (uint32_t f = 0; f < m.face_slots(); ++f) CHECK(m.face_loop(f).size() >= 3);
-    for (uint32_t v = 0; v < m.vertex_slots(); ++v)
+    for (FaceIndex f{0}; f < m.face_slots(); ++f) CHECK(m.face_loop(f).size() >= 3);
+    for (VertexIndex v{0}; v < m.vertex_slots(); ++v)
       if (!on_border(m, v) && m.valence(v) < 3) CHECK(on_triangle(m, v));
   }
 }
@@ -173,14 +173,14 @@ TEST_CASE("a 4 x 4 grid unrefined by 2 keeps its border and middle lines", "[syn
   CHECK(m.face_count() == 4);
   CHECK(face_sizes(m) == std::map<uint32_t, size_t>{{6, 4}});
   size_t long_edges = 0;
-  for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < m.edge_slots(); ++e) {
     const bool border = m.is_border_edge(e);
     CHECK(m.edges.point_count[e] == (border ? 9u : 17u));
     long_edges += !border;
   }
   CHECK(long_edges == 4);
-  uint32_t centre = kNone;
-  for (uint32_t v = 0; v < m.vertex_slots(); ++v)
+  VertexIndex centre;
+  for (VertexIndex v{0}; v < m.vertex_slots(); ++v)
     if (m.vertices.position[v] == Vec3(2, 2, 0)) centre = v;
   REQUIRE(centre != kNone);
   CHECK(m.valence(centre) == 4);
@@ -209,7 +209,7 @@ TEST_CASE("a closed curve with no other vertex keeps two of its vertices", "[syn
   CHECK(face_sizes(*net) == std::map<uint32_t, size_t>{{3, 2}});
   // The four control edges, 8 points each, in chains of 2, 1 and 1 edges: 17 + 9 + 9 points.
   std::multiset<uint32_t> counts;
-  for (uint32_t e = 0; e < net->edge_slots(); ++e) counts.insert(net->edges.point_count[e]);
+  for (EdgeIndex e{0}; e < net->edge_slots(); ++e) counts.insert(net->edges.point_count[e]);
   CHECK(counts == std::multiset<uint32_t>{9, 9, 17});
 }
 
@@ -218,7 +218,7 @@ TEST_CASE("polylines sample the control edges linearly, at least 8 points per ed
   for (uint32_t samples : {8u, 12u}) {
     auto net = network(torus, 1, 0, 0, samples);
     REQUIRE(net.ok());
-    for (uint32_t e = 0; e < net->edge_slots(); ++e) {
+    for (EdgeIndex e{0}; e < net->edge_slots(); ++e) {
       auto line = net->polyline(e);
       REQUIRE(line.size() == samples + 1);
       const Vec3 a = line.front(), b = line.back();
@@ -231,7 +231,7 @@ TEST_CASE("polylines sample the control edges linearly, at least 8 points per ed
   // At K=2 every network edge runs through a collapsed control vertex at its middle sample.
   auto net = network(torus, 2);
   REQUIRE(net.ok());
-  for (uint32_t e = 0; e < net->edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < net->edge_slots(); ++e) {
     const Vec3 middle = net->polyline(e)[8];
     CHECK(std::find(torus.positions.begin(), torus.positions.end(), middle) != torus.positions.end());
   }
@@ -257,10 +257,10 @@ TEST_CASE("noise is seeded, reproducible, and moves only interior polyline point
 
   // Same topology and vertices; every interior point moved, ends stayed.
   REQUIRE(a->edge_slots() == clean->edge_slots());
-  for (uint32_t v = 0; v < a->vertex_slots(); ++v) CHECK(a->vertices.position[v] == clean->vertices.position[v]);
+  for (VertexIndex v{0}; v < a->vertex_slots(); ++v) CHECK(a->vertices.position[v] == clean->vertices.position[v]);
   double sum_sq = 0;
   size_t interior = 0, moved = 0;
-  for (uint32_t e = 0; e < a->edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < a->edge_slots(); ++e) {
     auto noisy = a->polyline(e), straight = clean->polyline(e);
     REQUIRE(noisy.size() == straight.size());
     CHECK(noisy.front() == straight.front());
@@ -300,7 +300,7 @@ TEST_CASE("correlated noise keeps its deviation and varies smoothly along each p
   auto statistics = [&](const Mesh& m) {
     double squares = 0, products = 0;
     size_t count = 0, pairs = 0;
-    for (uint32_t e = 0; e < m.edge_slots(); ++e) {
+    for (EdgeIndex e{0}; e < m.edge_slots(); ++e) {
       auto line = m.polyline(e), truth = clean->polyline(e);
       for (size_t i = 1; i + 1 < line.size(); ++i) {
         const Vec3 d = line[i] - truth[i];
@@ -441,14 +441,14 @@ TEST_CASE("limit sampling: every polyline point lies on the control mesh's Catmu
     for (const Vec3& p : truth->limit_positions) on_surface.push_back({p.x(), p.y(), p.z()});
     std::sort(on_surface.begin(), on_surface.end());
     size_t found = 0, total = 0;
-    for (uint32_t e = 0; e < net->edge_slots(); ++e)
+    for (EdgeIndex e{0}; e < net->edge_slots(); ++e)
       for (const Vec3& p : net->polyline(e)) {
         ++total;
         found += std::binary_search(on_surface.begin(), on_surface.end(), std::array<double, 3>{p.x(), p.y(), p.z()});
       }
     CHECK(found == total);
     // Network vertices are the control vertices' limit positions.
-    for (uint32_t v = 0; v < net->vertex_slots(); ++v) {
+    for (VertexIndex v{0}; v < net->vertex_slots(); ++v) {
       const Vec3& p = net->vertices.position[v];
       CHECK(std::binary_search(on_surface.begin(), on_surface.end(), std::array<double, 3>{p.x(), p.y(), p.z()}));
     }
@@ -480,7 +480,7 @@ TEST_CASE("creases: kept whatever K, marked sharp, and the limit curves along th
   CHECK(net->face_count() == 24);
   CHECK(net->edge_count() == 48);
   size_t sharp = 0;
-  for (uint32_t e = 0; e < net->edge_slots(); ++e) {
+  for (EdgeIndex e{0}; e < net->edge_slots(); ++e) {
     if (!(net->edges.flags[e] & kSharpEdge)) continue;
     ++sharp;
     for (const Vec3& p : net->polyline(e)) {
@@ -492,8 +492,8 @@ TEST_CASE("creases: kept whatever K, marked sharp, and the limit curves along th
   // Without the tags, K = 2 counts its loops from another line and drops the box's edges: the limit is round there.
   auto smooth = network_from_mesh(pm->view("box.obj"), UnrefineOptions{.unrefine = 2, .limit = true});
   REQUIRE(smooth.ok());
-  for (uint32_t e = 0; e < smooth->edge_slots(); ++e) CHECK_FALSE(smooth->edges.flags[e] & kSharpEdge);
+  for (EdgeIndex e{0}; e < smooth->edge_slots(); ++e) CHECK_FALSE(smooth->edges.flags[e] & kSharpEdge);
   size_t on_edges = 0;
-  for (uint32_t v = 0; v < smooth->vertex_slots(); ++v) on_edges += on_box_edge(smooth->vertices.position[v]);
+  for (VertexIndex v{0}; v < smooth->vertex_slots(); ++v) on_edges += on_box_edge(smooth->vertices.position[v]);
   CHECK(on_edges == 0);
 }
