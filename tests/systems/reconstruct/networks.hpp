@@ -1,5 +1,7 @@
 #pragma once
 // Hand-made curve networks for the reconstruction tests.
+#include <cmath>
+#include <cstring>
 #include <functional>
 #include <optional>
 #include <random>
@@ -12,6 +14,15 @@
 namespace fire::test {
 
 using Height = std::function<double(double, double)>;
+
+// The bumpy field the random-edit tests lay their grids over.
+inline double random_edit_height(double x, double y) { return 0.4 * std::sin(0.7 * x) * std::cos(0.6 * y); }
+
+// Equal bit for bit: what an incremental surface must be to a reconstruction from scratch.
+template <class T>
+bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
 
 // One face with n sides (n >= 2): corners on the unit circle at angles 2 pi k / n, each side the arc
 // of the circle between its corners lifted to z = 0.2 cos(2 angle), with `samples` points.

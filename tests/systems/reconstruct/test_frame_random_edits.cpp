@@ -6,7 +6,6 @@
 // which abandons it.
 #include <catch2/catch.hpp>
 #include <cmath>
-#include <cstring>
 #include <random>
 #include <set>
 
@@ -21,12 +20,6 @@ using namespace fire::test;
 
 namespace {
 
-double height(double x, double y) { return 0.4 * std::sin(0.7 * x) * std::cos(0.6 * y); }
-
-template <class T>
-bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
-}
 
 // Faces the refine stage may recompute after frame `f`: those stamped in it and those using an edge
 // stamped in it.
@@ -52,7 +45,7 @@ TEST_CASE("random edits through the frame: shown in the commit frame, settled wi
   const int operations = 2000;
 #endif
   std::mt19937_64 rng(20261201);
-  Mesh net = grid_network(4, 3, 9, height);
+  Mesh net = grid_network(4, 3, 9, random_edit_height);
   EditHistory history;
   const Options options{Method::fire, 1, 2, Planarity::least_squares};
   SurfaceBuild build;

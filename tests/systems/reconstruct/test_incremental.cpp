@@ -3,7 +3,6 @@
 #include <catch2/catch.hpp>
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <numbers>
 #include <span>
 
@@ -22,10 +21,6 @@ namespace {
 
 double height(double x, double y) { return 0.6 * std::sin(0.4 * x) * std::cos(0.5 * y) + 0.03 * x * y; }
 
-template <class T>
-bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
-}
 
 void check_equals_full_rebuild(const Mesh& net, const Options& options, const SurfaceMesh& incremental) {
   auto full = reconstruct_surface(net, options);

@@ -3,7 +3,6 @@
 // cannot take must be refused with a reason, never crash.
 #include <catch2/catch.hpp>
 #include <cmath>
-#include <cstring>
 #include <random>
 
 #include "networks.hpp"
@@ -16,12 +15,6 @@ using namespace fire::test;
 
 namespace {
 
-double height(double x, double y) { return 0.4 * std::sin(0.7 * x) * std::cos(0.6 * y); }
-
-template <class T>
-bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
-}
 
 bool finite(const SurfaceMesh& s) {
   for (const Vec3& p : s.positions)
@@ -35,7 +28,7 @@ bool finite(const SurfaceMesh& s) {
 
 TEST_CASE("random edits: incremental reconstruction equals a rebuild after every edit", "[reconstruct][incremental][random]") {
   std::mt19937_64 rng(20261214);
-  Mesh net = grid_network(4, 3, 9, height);
+  Mesh net = grid_network(4, 3, 9, random_edit_height);
   EditHistory history;
   const Options fire_options{Method::fire, 1, 2, Planarity::least_squares};
   const Options thesis_options{Method::thesis, 1, 2, Planarity::least_squares};
