@@ -1,5 +1,9 @@
 // The triangulation system's state in a snapshot: every field, so that a session reopened from it
-// triangulates the log's tail exactly as the run that wrote it did.
+// triangulates the log's tail exactly as the run that wrote it did. Each struct's fields are listed once,
+// in the order they lie on disk, and walked by Put to write a snapshot and by Get to read it back, so the
+// two directions cannot drift apart.
+#include <type_traits>
+
 #include "systems/triangulate/triangulate.hpp"
 
 namespace fire {
@@ -8,219 +12,185 @@ namespace {
 
 using tracking::CameraReport;
 
-void put(SnapshotWriter& out, const Vec2& p) {
-  out.put(p.x());
-  out.put(p.y());
-}
-bool get(SnapshotReader& in, Vec2& p) { return in.get(p.x()) && in.get(p.y()); }
+struct Put {
+  SnapshotWriter& out;
+  template <class T>
+  void operator()(const T& v) {
+    out.put(v);
+  }
+  void operator()(const Vec2& p) {
+    out.put(p.x());
+    out.put(p.y());
+  }
+  void operator()(const std::array<Vec2, kIrSlots>& blobs) {
+    for (const Vec2& p : blobs) (*this)(p);
+  }
+  // Counts are size_t in memory and u64 on disk, so a snapshot reads the same on any build.
+  template <class T>
+  void count(const T& n) {
+    out.put(uint64_t(n));
+  }
+  void flag(bool b) { out.put(uint8_t(b)); }
+  // A value held on disk as `Disk`.
+  template <class Disk, class T>
+  void as(const T& v) {
+    out.put(Disk(v));
+  }
+  // A sequence as its count and its elements, each walked by `one`.
+  template <class Seq, class One>
+  void sequence(const Seq& s, One one) {
+    count(s.size());
+    for (const auto& x : s) one(x);
+  }
+  template <class T>
+  void object(const T& x) {
+    x.save(out);
+  }
+  // What a read must find true; nothing to check when writing.
+  void check(bool) {}
+};
 
-void put(SnapshotWriter& out, const std::array<Vec2, kIrSlots>& blobs) {
-  for (const Vec2& p : blobs) put(out, p);
-}
-bool get(SnapshotReader& in, std::array<Vec2, kIrSlots>& blobs) {
-  for (Vec2& p : blobs)
-    if (!get(in, p)) return false;
-  return true;
+struct Get {
+  SnapshotReader& in;
+  template <class T>
+  void operator()(T& v) {
+    in.get(v);
+  }
+  void operator()(Vec2& p) {
+    in.get(p.x());
+    in.get(p.y());
+  }
+  void operator()(std::array<Vec2, kIrSlots>& blobs) {
+    for (Vec2& p : blobs) (*this)(p);
+  }
+  template <class T>
+  void count(T& n) {
+    uint64_t v = 0;
+    in.get(v);
+    n = T(v);
+  }
+  void flag(bool& b) {
+    uint8_t v = 0;
+    in.get(v);
+    if (v > 1) in.fail();
+    b = v != 0;
+  }
+  template <class Disk, class T>
+  void as(T& v) {
+    Disk d{};
+    in.get(d);
+    v = T(d);
+  }
+  template <class Seq, class One>
+  void sequence(Seq& s, One one) {
+    uint64_t n = 0;
+    in.get(n);
+    s.clear();
+    for (uint64_t k = 0; k < n && in.ok(); ++k) one(s.emplace_back());
+  }
+  template <class T>
+  void object(T& x) {
+    if (!x.load(in)) in.fail();
+  }
+  void check(bool holds) {
+    if (!holds) in.fail();
+  }
+};
+
+// Report and Window are the struct or the const struct, as Io writes or reads.
+template <class Io, class Report>
+void report_fields(Io& io, Report& r) {
+  io.template as<int32_t>(r.camera);
+  io(r.t_us);
+  io(r.line);
+  io(r.blob_count);
+  io(r.blobs);
+  io.check((r.camera == 0 || r.camera == 1) && r.blob_count <= kIrSlots);
 }
 
-// Counts are size_t in memory and u64 on disk, so a snapshot reads the same on any build.
-template <class T>
-void put_count(SnapshotWriter& out, T n) {
-  out.put(uint64_t(n));
-}
-template <class T>
-void get_count(SnapshotReader& in, T& n) {
-  uint64_t v = 0;
-  in.get(v);
-  n = T(v);
-}
-void put_flag(SnapshotWriter& out, bool b) { out.put(uint8_t(b)); }
-void get_flag(SnapshotReader& in, bool& b) {
-  uint8_t v = 0;
-  in.get(v);
-  if (v > 1) in.fail();
-  b = v != 0;
-}
-
-// A deque as a count and its elements, each written by `one`.
-template <class T, class Put>
-void put_deque(SnapshotWriter& out, const std::deque<T>& d, Put one) {
-  put_count(out, d.size());
-  for (const T& x : d) one(x);
-}
-template <class T, class Get>
-void get_deque(SnapshotReader& in, std::deque<T>& d, Get one) {
-  uint64_t n = 0;
-  in.get(n);
-  d.clear();
-  for (uint64_t k = 0; k < n && in.ok(); ++k) one(d.emplace_back());
-}
-
-void put_report(SnapshotWriter& out, const CameraReport& r) {
-  out.put(int32_t(r.camera));
-  out.put(r.t_us);
-  out.put(r.line);
-  out.put(r.blob_count);
-  put(out, r.blobs);
-}
-void get_report(SnapshotReader& in, CameraReport& r) {
-  int32_t camera = 0;
-  in.get(camera);
-  in.get(r.t_us);
-  in.get(r.line);
-  in.get(r.blob_count);
-  get(in, r.blobs);
-  if ((camera != 0 && camera != 1) || r.blob_count > kIrSlots) in.fail();
-  r.camera = camera;
-}
-
-void put_window(SnapshotWriter& out, const CameraWindow& c) {
-  const tracking::CameraFrames& f = c.frames;
-  out.put(f.t_us);
-  out.put(f.line);
-  out.put(f.t_frame_us);
-  out.put(f.blob_count);
-  put_count(out, f.blobs.size());
-  for (const auto& blobs : f.blobs) put(out, blobs);
-  put_count(out, c.links.size());
-  for (const auto& link : c.links) out.put(link);
-  out.put(c.first_index);
-  put_deque(out, c.waiting, [&](const CameraReport& r) { put_report(out, r); });
-  put_deque(out, c.gaps_us, [&](double g) { out.put(g); });
-  out.put(c.period_us);
-  out.put(c.origin_us);
-  const tracking::FrameNumbering& n = c.clock;
-  put_deque(out, n.trailing, [&](const std::array<double, 2>& t) { out.put(t); });
-  for (double m : {n.count, n.mean_n, n.mean_t, n.cnn, n.cnt}) out.put(m);
-  put_deque(out, n.residuals, [&](double r) { out.put(r); });
-  out.put(c.last_arrival_us);
-  out.put(c.reports);
-}
-
-void get_window(SnapshotReader& in, CameraWindow& c) {
-  tracking::CameraFrames& f = c.frames;
-  in.get(f.t_us);
-  in.get(f.line);
-  in.get(f.t_frame_us);
-  in.get(f.blob_count);
-  uint64_t n = 0;
-  in.get(n);
-  f.blobs.clear();
-  for (uint64_t k = 0; k < n && in.ok(); ++k) get(in, f.blobs.emplace_back());
+template <class Io, class Window>
+void window_fields(Io& io, Window& c) {
+  auto& f = c.frames;
+  io(f.t_us);
+  io(f.line);
+  io(f.t_frame_us);
+  io(f.blob_count);
+  io.sequence(f.blobs, [&](auto& blobs) { io(blobs); });
   const size_t frames = f.t_us.size();
-  if (f.line.size() != frames || f.t_frame_us.size() != frames || f.blob_count.size() != frames || f.blobs.size() != frames)
-    in.fail();
-  for (uint8_t count : f.blob_count)
-    if (count > kIrSlots) in.fail();
-  in.get(n);
-  c.links.clear();
-  for (uint64_t k = 0; k < n && in.ok(); ++k) in.get(c.links.emplace_back());
-  if (c.links.size() != frames) in.fail();
-  in.get(c.first_index);
-  get_deque(in, c.waiting, [&](CameraReport& r) { get_report(in, r); });
-  get_deque(in, c.gaps_us, [&](double& g) { in.get(g); });
-  in.get(c.period_us);
-  in.get(c.origin_us);
-  tracking::FrameNumbering& clock = c.clock;
-  get_deque(in, clock.trailing, [&](std::array<double, 2>& t) { in.get(t); });
-  for (double* m : {&clock.count, &clock.mean_n, &clock.mean_t, &clock.cnn, &clock.cnt}) in.get(*m);
-  get_deque(in, clock.residuals, [&](double& r) { in.get(r); });
-  in.get(c.last_arrival_us);
-  in.get(c.reports);
+  io.check(f.line.size() == frames && f.t_frame_us.size() == frames && f.blob_count.size() == frames && f.blobs.size() == frames);
+  for (uint8_t count : f.blob_count) io.check(count <= kIrSlots);
+  io.sequence(c.links, [&](auto& link) { io(link); });
+  io.check(c.links.size() == frames);
+  io(c.first_index);
+  io.sequence(c.waiting, [&](auto& r) { report_fields(io, r); });
+  io.sequence(c.gaps_us, [&](auto& g) { io(g); });
+  io(c.period_us);
+  io(c.origin_us);
+  auto& n = c.clock;
+  io.sequence(n.trailing, [&](auto& t) { io(t); });
+  for (auto* m : {&n.count, &n.mean_n, &n.mean_t, &n.cnn, &n.cnt}) io(*m);
+  io.sequence(n.residuals, [&](auto& r) { io(r); });
+  io(c.last_arrival_us);
+  io(c.reports);
+}
+
+template <class Io, class State>
+void state_fields(Io& io, State& s) {
+  io.object(s.decoder);
+  for (auto& c : s.cameras) window_fields(io, c);
+  io.count(s.out_of_order);
+  io.count(s.duplicated);
+  io.count(s.both_lost);
+  io.flag(s.lost_now);
+  io.count(s.stray_frames);
+  for (auto& n : s.silences) io.count(n);
+  for (auto& b : s.silent) io.flag(b);
+  io(s.next_cam0);
+  io(s.time_offset_us);
+  io.flag(s.time_offset_started);
+  io.sequence(s.moving, [&](auto& m) {
+    io(m.t_us);
+    io(m.normalized);
+  });
+  io(s.cam0_fixed);
+  io(s.offset_attempts);
+  io.template as<int32_t>(s.offset_estimates);
+  auto& e = s.last_estimate;
+  for (auto* v : {&e.offset_us, &e.cost_px, &e.cost_at_zero_px}) io(*v);
+  io.count(e.samples);
+  io.flag(e.observable);
+  auto& p = s.counts;
+  io(p.strokes);
+  for (auto* n : {&p.frames_seen_by_both, &p.rejected_reprojection, &p.rejected_jump, &p.ambiguous, &p.rejected_filter,
+                  &p.bridged_frames})
+    io.count(*n);
+  io.flag(s.down);
+  io.flag(s.stroke_open);
+  io.flag(s.filter.primed);
+  io(s.filter.t_us);
+  io(s.filter.value);
+  io(s.filter.derivative);
+  io(s.last_sample_t);
+  io(s.last_seen_t);
+  io(s.last_sample_t_us);
+  io(s.last_sample_line);
+  io(s.last_position);
+  for (auto& px : s.pen_px) io(px);
+  // The windows index into each other: camera 0's next report to triangulate lies within its window.
+  io.check(s.next_cam0 >= s.cameras[0].first_index && s.next_cam0 <= s.cameras[0].end_index());
 }
 
 }  // namespace
 
 void save_triangulate_state(SnapshotWriter& out, const TriangulateState& s) {
-  s.decoder.save(out);
-  for (const CameraWindow& c : s.cameras) put_window(out, c);
-  put_count(out, s.out_of_order);
-  put_count(out, s.duplicated);
-  put_count(out, s.both_lost);
-  put_flag(out, s.lost_now);
-  put_count(out, s.stray_frames);
-  for (size_t n : s.silences) put_count(out, n);
-  for (bool b : s.silent) put_flag(out, b);
-  out.put(s.next_cam0);
-  out.put(s.time_offset_us);
-  put_flag(out, s.time_offset_started);
-  put_deque(out, s.moving, [&](const tracking::MovingBlob& m) {
-    out.put(m.t_us);
-    put(out, m.normalized);
-  });
-  out.put(s.cam0_fixed);
-  out.put(s.offset_attempts);
-  out.put(int32_t(s.offset_estimates));
-  const tracking::TimeOffsetEstimate& e = s.last_estimate;
-  for (double v : {e.offset_us, e.cost_px, e.cost_at_zero_px}) out.put(v);
-  put_count(out, e.samples);
-  put_flag(out, e.observable);
-  const tracking::PenCounts& p = s.counts;
-  out.put(p.strokes);
-  for (size_t n : {p.frames_seen_by_both, p.rejected_reprojection, p.rejected_jump, p.ambiguous, p.rejected_filter,
-                   p.bridged_frames})
-    put_count(out, n);
-  put_flag(out, s.down);
-  put_flag(out, s.stroke_open);
-  put_flag(out, s.filter.primed);
-  out.put(s.filter.t_us);
-  out.put(s.filter.value);
-  out.put(s.filter.derivative);
-  out.put(s.last_sample_t);
-  out.put(s.last_seen_t);
-  out.put(s.last_sample_t_us);
-  out.put(s.last_sample_line);
-  out.put(s.last_position);
-  for (const Vec2& px : s.pen_px) put(out, px);
+  Put put{out};
+  state_fields(put, s);
 }
 
 bool load_triangulate_state(SnapshotReader& in, TriangulateState& s) {
   s = TriangulateState{};
-  if (!s.decoder.load(in)) return false;
-  for (CameraWindow& c : s.cameras) get_window(in, c);
-  get_count(in, s.out_of_order);
-  get_count(in, s.duplicated);
-  get_count(in, s.both_lost);
-  get_flag(in, s.lost_now);
-  get_count(in, s.stray_frames);
-  for (size_t& n : s.silences) get_count(in, n);
-  for (bool& b : s.silent) get_flag(in, b);
-  in.get(s.next_cam0);
-  in.get(s.time_offset_us);
-  get_flag(in, s.time_offset_started);
-  get_deque(in, s.moving, [&](tracking::MovingBlob& m) {
-    in.get(m.t_us);
-    get(in, m.normalized);
-  });
-  in.get(s.cam0_fixed);
-  in.get(s.offset_attempts);
-  int32_t estimates = 0;
-  in.get(estimates);
-  s.offset_estimates = estimates;
-  tracking::TimeOffsetEstimate& e = s.last_estimate;
-  for (double* v : {&e.offset_us, &e.cost_px, &e.cost_at_zero_px}) in.get(*v);
-  get_count(in, e.samples);
-  get_flag(in, e.observable);
-  tracking::PenCounts& p = s.counts;
-  in.get(p.strokes);
-  for (size_t* n : {&p.frames_seen_by_both, &p.rejected_reprojection, &p.rejected_jump, &p.ambiguous, &p.rejected_filter,
-                    &p.bridged_frames})
-    get_count(in, *n);
-  get_flag(in, s.down);
-  get_flag(in, s.stroke_open);
-  get_flag(in, s.filter.primed);
-  in.get(s.filter.t_us);
-  in.get(s.filter.value);
-  in.get(s.filter.derivative);
-  in.get(s.last_sample_t);
-  in.get(s.last_seen_t);
-  in.get(s.last_sample_t_us);
-  in.get(s.last_sample_line);
-  in.get(s.last_position);
-  for (Vec2& px : s.pen_px) get(in, px);
-  // The windows index into each other: camera 0's next report to triangulate lies within its window.
-  const CameraWindow& c0 = s.cameras[0];
-  if (s.next_cam0 < c0.first_index || s.next_cam0 > c0.end_index()) in.fail();
+  Get get{in};
+  state_fields(get, s);
   return in.ok();
 }
 
