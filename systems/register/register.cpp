@@ -7,26 +7,13 @@
 #include <optional>
 #include <string>
 
+#include "engine/snapshot_fields.hpp"
 #include "engine/text.hpp"
 
 namespace fire {
 namespace {
 
 constexpr uint8_t kMeasuredMarksRecord = 2;
-
-void put_transform(SnapshotWriter& out, const tracking::RigidTransform& T) {
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) out.put(T.R(r, c));
-  out.put(T.t);
-  out.put(T.rms_residual);
-}
-
-void get_transform(SnapshotReader& in, tracking::RigidTransform& T) {
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) in.get(T.R(r, c));
-  in.get(T.t);
-  in.get(T.rms_residual);
-}
 
 Vec3 mapped(const RegistrationState& s, const Vec3& p) { return s.transform ? Vec3(s.transform->R * p + s.transform->t) : p; }
 
@@ -448,129 +435,73 @@ std::vector<std::string> describe_registration(const RegistrationState& s) {
   return out;
 }
 
-void RegistrationState::save(SnapshotWriter& out) const {
-  out.put(uint8_t(transform.has_value()));
-  if (transform) put_transform(out, *transform);
-  out.put(uint64_t(touched.size()));
-  for (const MarkTouch& m : touched) {
-    out.put(m.mark);
-    out.put(m.measured);
-    out.put(m.model);
-  }
-  out.put(recent);
-  out.put(uint8_t(stroke_open));
-  out.put(uint8_t(stroke_released));
-  out.put(uint64_t(held.size()));
-  for (const InputEvent& e : held) {
-    out.put(e.t_us);
-    out.put(uint8_t(e.kind));
-    out.put(e.p);
-    out.put(e.snap);
-    out.put(e.line);
-  }
-  out.put(uint64_t(done.size()));
-  for (const Registration& r : done) {
-    out.put(r.line);
-    out.put(r.marks);
-    out.put(r.residual);
-  }
-  out.put(touches_dropped);
+namespace {
+
+template <class Io, class Transform>
+void transform_fields(Io& io, Transform& T) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) io(T.R(r, c));
+  io(T.t);
+  io(T.rms_residual);
+}
+
+// The state as it lies in a snapshot (engine/snapshot_fields.hpp); S is const when writing.
+template <class Io, class S>
+void state_fields(Io& io, S& s) {
+  io.optional(s.transform, [&](auto& T) { transform_fields(io, T); });
+  io.sequence(s.touched, [&](auto& m) {
+    io(m.mark);
+    io(m.measured);
+    io(m.model);
+  });
+  io(s.recent);
+  io.flag(s.stroke_open);
+  io.flag(s.stroke_released);
+  io.sequence(s.held, [&](auto& e) {
+    io(e.t_us);
+    io.template as<uint8_t>(e.kind);
+    io(e.p);
+    io(e.snap);
+    io(e.line);
+    io.check(e.kind == EventKind::Down || e.kind == EventKind::Pen);
+  });
+  io.sequence(s.done, [&](auto& r) {
+    io(r.line);
+    io(r.marks);
+    io(r.residual);
+  });
+  io(s.touches_dropped);
   // Since marks are measured by touch; older snapshots end above.
-  out.put(kMeasuredMarksRecord);
-  out.put(table);
-  out.put(uint64_t(measured.size()));
-  for (const MeasuredMark& m : measured) {
-    out.put(m.mark);
-    out.put(m.p);
-    out.put(m.line);
-  }
-  for (const Registration& r : done) out.put(uint8_t(r.measured_frame));
-  out.put(uint8_t(frame_transform.has_value()));
-  if (frame_transform) put_transform(out, *frame_transform);
-  out.put(uint64_t(rounds.size()));
-  for (const std::vector<MarkRest>& round : rounds) {
-    out.put(uint64_t(round.size()));
-    for (const MarkRest& m : round) {
-      out.put(m.mark);
-      out.put(m.rest);
-    }
-  }
+  io.since(kMeasuredMarksRecord, [&] {
+    io(s.table);
+    io.sequence(s.measured, [&](auto& m) {
+      io(m.mark);
+      io(m.p);
+      io(m.line);
+    });
+    for (auto& r : s.done) io.flag(r.measured_frame);
+    io.optional(s.frame_transform, [&](auto& T) { transform_fields(io, T); });
+    io.sequence(s.rounds, [&](auto& round) {
+      io.sequence(round, [&](auto& m) {
+        io(m.mark);
+        io(m.rest);
+        io.check(s.measured_mark(m.mark) != nullptr);
+      });
+    });
+  });
+}
+
+}  // namespace
+
+void RegistrationState::save(SnapshotWriter& out) const {
+  SnapshotPut put{out};
+  state_fields(put, *this);
 }
 
 bool RegistrationState::load(SnapshotReader& in) {
   *this = {};
-  uint8_t has = 0, open = 0, released = 0;
-  in.get(has);
-  if (has) get_transform(in, transform.emplace());
-  uint64_t n = 0;
-  in.get(n);
-  for (uint64_t k = 0; k < n && in.ok(); ++k) {
-    MarkTouch& m = touched.emplace_back();
-    in.get(m.mark);
-    in.get(m.measured);
-    in.get(m.model);
-  }
-  in.get(recent);
-  in.get(open);
-  in.get(released);
-  stroke_open = open;
-  stroke_released = released;
-  in.get(n);
-  for (uint64_t k = 0; k < n && in.ok(); ++k) {
-    InputEvent& e = held.emplace_back();
-    uint8_t kind = 0;
-    in.get(e.t_us);
-    in.get(kind);
-    in.get(e.p);
-    in.get(e.snap);
-    in.get(e.line);
-    if (kind != uint8_t(EventKind::Down) && kind != uint8_t(EventKind::Pen)) in.fail();
-    e.kind = EventKind(kind);
-  }
-  in.get(n);
-  for (uint64_t k = 0; k < n && in.ok(); ++k) {
-    Registration& r = done.emplace_back();
-    in.get(r.line);
-    in.get(r.marks);
-    in.get(r.residual);
-  }
-  in.get(touches_dropped);
-  if (in.ok() && !in.at_end()) {
-    uint8_t record = 0;
-    in.get(record);
-    if (record != kMeasuredMarksRecord) in.fail();
-    in.get(table);
-    in.get(n);
-    for (uint64_t k = 0; k < n && in.ok(); ++k) {
-      MeasuredMark& m = measured.emplace_back();
-      in.get(m.mark);
-      in.get(m.p);
-      in.get(m.line);
-    }
-    for (Registration& r : done) {
-      uint8_t flag = 0;
-      in.get(flag);
-      if (flag > 1) in.fail();
-      r.measured_frame = flag != 0;
-    }
-    uint8_t has_frame = 0;
-    in.get(has_frame);
-    if (has_frame > 1) in.fail();
-    if (has_frame) get_transform(in, frame_transform.emplace());
-    in.get(n);
-    for (uint64_t k = 0; k < n && in.ok(); ++k) {
-      std::vector<MarkRest>& round = rounds.emplace_back();
-      uint64_t count = 0;
-      in.get(count);
-      for (uint64_t j = 0; j < count && in.ok(); ++j) {
-        MarkRest& m = round.emplace_back();
-        in.get(m.mark);
-        in.get(m.rest);
-        if (in.ok() && !measured_mark(m.mark)) in.fail();
-      }
-    }
-  }
-  if (has > 1 || open > 1 || released > 1) in.fail();
+  SnapshotGet get{in};
+  state_fields(get, *this);
   return in.ok();
 }
 

@@ -1,101 +1,12 @@
 // The triangulation system's state in a snapshot: every field, so that a session reopened from it
-// triangulates the log's tail exactly as the run that wrote it did. Each struct's fields are listed once,
-// in the order they lie on disk, and walked by Put to write a snapshot and by Get to read it back, so the
-// two directions cannot drift apart.
-#include <type_traits>
-
+// triangulates the log's tail exactly as the run that wrote it did: each struct's fields listed once
+// (engine/snapshot_fields.hpp).
+#include "engine/snapshot_fields.hpp"
 #include "systems/triangulate/triangulate.hpp"
 
 namespace fire {
 
 namespace {
-
-using tracking::CameraReport;
-
-struct Put {
-  SnapshotWriter& out;
-  template <class T>
-  void operator()(const T& v) {
-    out.put(v);
-  }
-  void operator()(const Vec2& p) {
-    out.put(p.x());
-    out.put(p.y());
-  }
-  void operator()(const std::array<Vec2, kIrSlots>& blobs) {
-    for (const Vec2& p : blobs) (*this)(p);
-  }
-  // Counts are size_t in memory and u64 on disk, so a snapshot reads the same on any build.
-  template <class T>
-  void count(const T& n) {
-    out.put(uint64_t(n));
-  }
-  void flag(bool b) { out.put(uint8_t(b)); }
-  // A value held on disk as `Disk`.
-  template <class Disk, class T>
-  void as(const T& v) {
-    out.put(Disk(v));
-  }
-  // A sequence as its count and its elements, each walked by `one`.
-  template <class Seq, class One>
-  void sequence(const Seq& s, One one) {
-    count(s.size());
-    for (const auto& x : s) one(x);
-  }
-  template <class T>
-  void object(const T& x) {
-    x.save(out);
-  }
-  // What a read must find true; nothing to check when writing.
-  void check(bool) {}
-};
-
-struct Get {
-  SnapshotReader& in;
-  template <class T>
-  void operator()(T& v) {
-    in.get(v);
-  }
-  void operator()(Vec2& p) {
-    in.get(p.x());
-    in.get(p.y());
-  }
-  void operator()(std::array<Vec2, kIrSlots>& blobs) {
-    for (Vec2& p : blobs) (*this)(p);
-  }
-  template <class T>
-  void count(T& n) {
-    uint64_t v = 0;
-    in.get(v);
-    n = T(v);
-  }
-  void flag(bool& b) {
-    uint8_t v = 0;
-    in.get(v);
-    if (v > 1) in.fail();
-    b = v != 0;
-  }
-  template <class Disk, class T>
-  void as(T& v) {
-    Disk d{};
-    in.get(d);
-    v = T(d);
-  }
-  template <class Seq, class One>
-  void sequence(Seq& s, One one) {
-    uint64_t n = 0;
-    in.get(n);
-    s.clear();
-    for (uint64_t k = 0; k < n && in.ok(); ++k) one(s.emplace_back());
-  }
-  template <class T>
-  void object(T& x) {
-    if (!x.load(in)) in.fail();
-  }
-  void check(bool holds) {
-    if (!holds) in.fail();
-  }
-};
 
 // Report and Window are the struct or the const struct, as Io writes or reads.
 template <class Io, class Report>
@@ -183,13 +94,13 @@ void state_fields(Io& io, State& s) {
 }  // namespace
 
 void save_triangulate_state(SnapshotWriter& out, const TriangulateState& s) {
-  Put put{out};
+  SnapshotPut put{out};
   state_fields(put, s);
 }
 
 bool load_triangulate_state(SnapshotReader& in, TriangulateState& s) {
   s = TriangulateState{};
-  Get get{in};
+  SnapshotGet get{in};
   state_fields(get, s);
   return in.ok();
 }
