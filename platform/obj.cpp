@@ -17,7 +17,7 @@ Result<PolygonMesh> parse_obj(std::string_view text, const std::string& source) 
   auto fail = [&](size_t line, const std::string& why) {
     return Result<PolygonMesh>::failure(source + ":" + std::to_string(line) + ": " + why);
   };
-  LengthUnit unit = LengthUnit::m;
+  LengthUnit unit = LengthUnit::Metre;
   size_t pos = 0, line_no = 0;
   while (pos < text.size()) {
     size_t end = text.find('\n', pos);
@@ -67,7 +67,7 @@ Result<PolygonMesh> parse_obj(std::string_view text, const std::string& source) 
   }
   if (mesh.positions.empty()) return Result<PolygonMesh>::failure(source + ": no vertices (empty or not an OBJ file)");
   if (mesh.face_count() == 0) return Result<PolygonMesh>::failure(source + ": no faces");
-  if (unit != LengthUnit::m)
+  if (unit != LengthUnit::Metre)
     for (Vec3& p : mesh.positions) p /= units_per_metre(unit);
   return mesh;
 }

@@ -312,7 +312,7 @@ std::vector<std::string_view> split_fields(std::string_view line) {
 // The unit a FIRE file names after `key` in `text` (a header line or comment): metres when it names none.
 Result<LengthUnit> named_unit(std::string_view text, std::string_view key, const std::string& source) {
   const size_t at = text.find(key);
-  if (at == std::string_view::npos) return LengthUnit::m;
+  if (at == std::string_view::npos) return LengthUnit::Metre;
   size_t begin = at + key.size();
   while (begin < text.size() && text[begin] == ' ') ++begin;
   size_t end = begin;
@@ -324,7 +324,7 @@ Result<LengthUnit> named_unit(std::string_view text, std::string_view key, const
 
 // Divided by the exact count of units in a metre, the one rounding a reader adds to the writer's.
 Result<SurfaceMesh> in_metres(SurfaceMesh s, LengthUnit unit) {
-  if (unit != LengthUnit::m)
+  if (unit != LengthUnit::Metre)
     for (Vec3& p : s.positions) p /= units_per_metre(unit);
   return s;
 }
@@ -371,7 +371,7 @@ Result<SurfaceMesh> decode_ply(std::string_view bytes, const std::string& source
   // Only the layout encode_ply writes is read: same lines in the same order, comments aside.
   std::string canonical;
   size_t vertex_count = 0, face_count = 0;
-  LengthUnit unit = LengthUnit::m;
+  LengthUnit unit = LengthUnit::Metre;
   size_t pos = 0;
   while (pos < header.size()) {
     const size_t end = header.find('\n', pos);
@@ -511,7 +511,7 @@ Result<SurfaceMesh> decode_stl(std::string_view bytes, const std::string& source
   if (count == 0) return fail("no triangles");
   // Only FIRE's own header is read for a unit: other writers fill it with anything.
   auto unit = bytes.starts_with("FIRE ") ? named_unit(bytes.substr(0, kStlHeaderBytes), "units:", source)
-                                         : Result<LengthUnit>(LengthUnit::m);
+                                         : Result<LengthUnit>(LengthUnit::Metre);
   if (!unit) return Result<SurfaceMesh>::failure(unit.error());
   SurfaceMesh s;
   s.positions.reserve(3 * size_t{count});
@@ -717,57 +717,57 @@ Result<SurfaceMesh> decode_glb(std::string_view bytes, const std::string& source
 
 double units_per_metre(LengthUnit unit) {
   switch (unit) {
-    case LengthUnit::mm: return 1000;
-    case LengthUnit::cm: return 100;
-    case LengthUnit::m: return 1;
+    case LengthUnit::Millimetre: return 1000;
+    case LengthUnit::Centimetre: return 100;
+    case LengthUnit::Metre: return 1;
   }
   return 1;
 }
 
 const char* unit_name(LengthUnit unit) {
   switch (unit) {
-    case LengthUnit::mm: return "mm";
-    case LengthUnit::cm: return "cm";
-    case LengthUnit::m: return "m";
+    case LengthUnit::Millimetre: return "mm";
+    case LengthUnit::Centimetre: return "cm";
+    case LengthUnit::Metre: return "m";
   }
   return "m";
 }
 
 Result<LengthUnit> length_unit_of(std::string_view name) {
-  for (LengthUnit u : {LengthUnit::mm, LengthUnit::cm, LengthUnit::m})
+  for (LengthUnit u : {LengthUnit::Millimetre, LengthUnit::Centimetre, LengthUnit::Metre})
     if (name == unit_name(u)) return u;
   return Result<LengthUnit>::failure("unknown length unit '" + std::string(name.substr(0, 32)) + "' (mm, cm or m)");
 }
 
 Result<SurfaceFormat> surface_format_of(const std::string& path) {
   const std::string ext = file_extension(path);
-  if (ext == "obj") return SurfaceFormat::obj;
-  if (ext == "ply") return SurfaceFormat::ply;
-  if (ext == "stl") return SurfaceFormat::stl;
-  if (ext == "glb") return SurfaceFormat::glb;
+  if (ext == "obj") return SurfaceFormat::Obj;
+  if (ext == "ply") return SurfaceFormat::Ply;
+  if (ext == "stl") return SurfaceFormat::Stl;
+  if (ext == "glb") return SurfaceFormat::Glb;
   return Result<SurfaceFormat>::failure(path + ": unknown surface format '" + ext +
                                         "' (the extension must be .obj, .ply, .stl or .glb)");
 }
 
 Result<std::string> encode_surface(const SurfaceMesh& metres, SurfaceFormat format, const std::string& source,
                                    LengthUnit unit) {
-  if (format == SurfaceFormat::glb) unit = LengthUnit::m;
+  if (format == SurfaceFormat::Glb) unit = LengthUnit::Metre;
   SurfaceMesh scaled;
-  if (unit != LengthUnit::m) {
+  if (unit != LengthUnit::Metre) {
     scaled = metres;
     for (Vec3& p : scaled.positions) p *= units_per_metre(unit);
   }
-  const SurfaceMesh& surface = unit == LengthUnit::m ? metres : scaled;
-  if (Status st = check_surface(surface, format != SurfaceFormat::obj); !st)
-    return Result<std::string>::failure(source + ": cannot export" + (unit == LengthUnit::m ? "" : std::string(" in ") + unit_name(unit)) +
+  const SurfaceMesh& surface = unit == LengthUnit::Metre ? metres : scaled;
+  if (Status st = check_surface(surface, format != SurfaceFormat::Obj); !st)
+    return Result<std::string>::failure(source + ": cannot export" + (unit == LengthUnit::Metre ? "" : std::string(" in ") + unit_name(unit)) +
                                         ": " + st.error);
   const std::vector<Vec3> normals = export_normals(surface);
   Result<std::string> bytes = std::string();
   switch (format) {
-    case SurfaceFormat::obj: bytes = encode_obj(surface, normals, unit); break;
-    case SurfaceFormat::ply: bytes = encode_ply(surface, normals, unit); break;
-    case SurfaceFormat::stl: bytes = encode_stl(surface, unit); break;
-    case SurfaceFormat::glb: bytes = encode_glb(surface, normals); break;
+    case SurfaceFormat::Obj: bytes = encode_obj(surface, normals, unit); break;
+    case SurfaceFormat::Ply: bytes = encode_ply(surface, normals, unit); break;
+    case SurfaceFormat::Stl: bytes = encode_stl(surface, unit); break;
+    case SurfaceFormat::Glb: bytes = encode_glb(surface, normals); break;
   }
   if (!bytes) return Result<std::string>::failure(source + ": cannot export: " + bytes.error());
   return bytes;
@@ -783,10 +783,10 @@ Status write_surface(const SurfaceMesh& surface, const std::string& path, Length
 
 Result<SurfaceMesh> decode_surface(std::string_view bytes, SurfaceFormat format, const std::string& source) {
   switch (format) {
-    case SurfaceFormat::obj: return decode_obj(bytes, source);
-    case SurfaceFormat::ply: return decode_ply(bytes, source);
-    case SurfaceFormat::stl: return decode_stl(bytes, source);
-    case SurfaceFormat::glb: return decode_glb(bytes, source);
+    case SurfaceFormat::Obj: return decode_obj(bytes, source);
+    case SurfaceFormat::Ply: return decode_ply(bytes, source);
+    case SurfaceFormat::Stl: return decode_stl(bytes, source);
+    case SurfaceFormat::Glb: return decode_glb(bytes, source);
   }
   return Result<SurfaceMesh>::failure(source + ": unknown surface format");
 }

@@ -13,7 +13,7 @@
 
 namespace fire {
 
-enum class SurfaceFormat { obj, ply, stl, glb };
+enum class SurfaceFormat { Obj, Ply, Stl, Glb };
 
 // The length unit of a mesh export. FIRE works in metres; OBJ, PLY and STL are written in the unit asked,
 // millimetres by default (what slicers and CAD importers assume of a file without one), and +Z up, each
@@ -21,8 +21,8 @@ enum class SurfaceFormat { obj, ply, stl, glb };
 // binary STL its 80-byte header. The readers here honour that and give metres back, so a file without it
 // is taken as metres (FIRE's files before units, the reference meshes). glB is always metres and +Y up, as
 // glTF 2.0 requires, whatever unit is asked.
-enum class LengthUnit : uint8_t { mm, cm, m };
-inline constexpr LengthUnit kDefaultExportUnit = LengthUnit::mm;
+enum class LengthUnit : uint8_t { Millimetre, Centimetre, Metre };
+inline constexpr LengthUnit kDefaultExportUnit = LengthUnit::Millimetre;
 double units_per_metre(LengthUnit unit);  // exact: 1000, 100 or 1
 const char* unit_name(LengthUnit unit);
 // "mm", "cm" or "m"; an error names the word and the units known.

@@ -75,10 +75,12 @@ std::vector<uint32_t> perm_offset;
 
 volatile double sink;
 
-enum Variant { S1, S2, S3, S4, S5, S6, S3_FRESH, S4_FRESH, FIRE_POOL, OPENMESH, OPENMESH_FRESH, kVariants };
+enum class Variant : uint8_t { S1, S2, S3, S4, S5, S6, S3Fresh, S4Fresh, FirePool, OpenMesh, OpenMeshFresh };
+constexpr int kVariants = 11;
 const char* const kVariantNames[kVariants] = {
     "s1", "s2", "s3", "s4", "s5", "s6", "s3_fresh", "s4_fresh", "fire", "openmesh", "openmesh_fresh"};
-enum Op { SEQ_READ, SEQ_WRITE, RAND_READ, RAND_WRITE, kOps };
+enum class Op : uint8_t { SeqRead, SeqWrite, RandRead, RandWrite };
+constexpr int kOps = 4;
 const char* const kOpNames[kOps] = {"seq_read", "seq_write", "rand_read", "rand_write"};
 
 void junk_between(std::mt19937& rng) {
@@ -105,44 +107,44 @@ void point_into(VEC* vecs, double*& coords, size_t n) {
 void setup(Variant v, size_t n) {
   std::mt19937 rng(2026);
   switch (v) {
-    case S1:
+    case Variant::S1:
       for (size_t i = 0; i < n; i++) init_point(&s1[3 * i], i);
       break;
-    case S2:
+    case Variant::S2:
       s2 = static_cast<double*>(std::malloc(sizeof(double) * 3 * n));
       for (size_t i = 0; i < n; i++) init_point(&s2[3 * i], i);
       break;
-    case S3:
-    case S3_FRESH:
+    case Variant::S3:
+    case Variant::S3Fresh:
       for (size_t i = 0; i < n; i++) {
         s3[i] = v_get(3);
-        if (v == S3) junk_between(rng);
+        if (v == Variant::S3) junk_between(rng);
         init_point(s3[i]->ve, i);
       }
       break;
-    case S4:
-    case S4_FRESH:
+    case Variant::S4:
+    case Variant::S4Fresh:
       s4 = static_cast<VEC**>(std::malloc(sizeof(VEC*) * n));
       for (size_t i = 0; i < n; i++) {
         s4[i] = v_get(3);
-        if (v == S4) junk_between(rng);
+        if (v == Variant::S4) junk_between(rng);
         init_point(s4[i]->ve, i);
       }
       break;
-    case S5: point_into(s5, s5_p, n); break;
-    case S6:
+    case Variant::S5: point_into(s5, s5_p, n); break;
+    case Variant::S6:
       s6 = static_cast<VEC*>(std::malloc(sizeof(VEC) * n));
       point_into(s6, s6_p, n);
       break;
-    case FIRE_POOL:
+    case Variant::FirePool:
       for (size_t i = 0; i < n; i++) {
         double p[3];
         init_point(p, i);
         pool.push_back(fire::Vec3(p[0], p[1], p[2]));
       }
       break;
-    case OPENMESH:
-    case OPENMESH_FRESH: {
+    case Variant::OpenMesh:
+    case Variant::OpenMeshFresh: {
       // A chain of edges, each holding its polyline, grown point by point as a sketch grows it.
       om = new OMesh;
       om->add_property(om_poly, "polyline");
@@ -156,35 +158,34 @@ void setup(Variant v, size_t n) {
           double p[3];
           init_point(p, e * kPointsPerEdge + o);
           poly.push_back(OpenMesh::Vec3d(p[0], p[1], p[2]));
-          if (v == OPENMESH) junk_between(rng);
+          if (v == Variant::OpenMesh) junk_between(rng);
         }
       }
       break;
     }
-    case kVariants: break;
   }
 }
 
 void teardown(Variant v, size_t n) {
   switch (v) {
-    case S3:
-    case S3_FRESH:
+    case Variant::S3:
+    case Variant::S3Fresh:
       for (size_t i = 0; i < n; i++) v_free(s3[i]);
       break;
-    case S4:
-    case S4_FRESH:
+    case Variant::S4:
+    case Variant::S4Fresh:
       for (size_t i = 0; i < n; i++) v_free(s4[i]);
       std::free(s4);
       break;
-    case S2: std::free(s2); break;
-    case S5: std::free(s5_p); break;
-    case S6:
+    case Variant::S2: std::free(s2); break;
+    case Variant::S5: std::free(s5_p); break;
+    case Variant::S6:
       std::free(s6);
       std::free(s6_p);
       break;
-    case FIRE_POOL: pool = fire::Column<fire::Vec3>(); break;
-    case OPENMESH:
-    case OPENMESH_FRESH:
+    case Variant::FirePool: pool = fire::Column<fire::Vec3>(); break;
+    case Variant::OpenMesh:
+    case Variant::OpenMeshFresh:
       delete om;
       om = nullptr;
       break;
@@ -197,12 +198,12 @@ void teardown(Variant v, size_t n) {
 // Address of point i's first coordinate, to report how far apart consecutive points lie.
 const double* point_address(Variant v, size_t i) {
   switch (v) {
-    case S3:
-    case S3_FRESH: return s3[i]->ve;
-    case S4:
-    case S4_FRESH: return s4[i]->ve;
-    case OPENMESH:
-    case OPENMESH_FRESH:
+    case Variant::S3:
+    case Variant::S3Fresh: return s3[i]->ve;
+    case Variant::S4:
+    case Variant::S4Fresh: return s4[i]->ve;
+    case Variant::OpenMesh:
+    case Variant::OpenMeshFresh:
       return om->property(om_poly, OpenMesh::EdgeHandle(int(i / kPointsPerEdge)))[i % kPointsPerEdge].data();
     default: return nullptr;
   }
@@ -258,15 +259,14 @@ const double* point_address(Variant v, size_t i) {
   double NAME(Op op, bool cached, size_t first, size_t m, int iters, double base) { \
     double acc = 0;                                                                 \
     switch (op) {                                                                   \
-      case SEQ_READ:                                                                \
+      case Op::SeqRead:                                                                \
         if (cached) SEQ(READ_CACHED_BODY(PTR)) else SEQ(READ_BODY(X)) break;        \
-      case SEQ_WRITE:                                                               \
+      case Op::SeqWrite:                                                               \
         if (cached) SEQ(WRITE_CACHED_BODY(PTR)) else SEQ(WRITE_BODY(W)) break;      \
-      case RAND_READ:                                                               \
+      case Op::RandRead:                                                               \
         if (cached) RAND(READ_CACHED_BODY(PTR)) else RAND(READ_BODY(X)) break;      \
-      case RAND_WRITE:                                                              \
+      case Op::RandWrite:                                                              \
         if (cached) RAND(WRITE_CACHED_BODY(PTR)) else RAND(WRITE_BODY(W)) break;    \
-      case kOps: break;                                                             \
     }                                                                               \
     return acc;                                                                     \
   }
@@ -300,13 +300,12 @@ LAYOUT_FN(run_s6, FOR_SEQ, FOR_RAND, S6_X, S6_W, s6[i].ve)
 double run_fire(Op op, bool cached, size_t first, size_t m, int iters, double base) {
   double acc = 0;
   switch (op) {
-    case SEQ_READ:
+    case Op::SeqRead:
       if (cached) FOR_SEQ(READ_CACHED_BODY(pool[i].data())) else FOR_SEQ(READ_BODY(FIRE_X)) break;
-    case SEQ_WRITE: FOR_SEQ(WRITE_BODY(FIRE_W)) break;
-    case RAND_READ:
+    case Op::SeqWrite: FOR_SEQ(WRITE_BODY(FIRE_W)) break;
+    case Op::RandRead:
       if (cached) FOR_RAND(READ_CACHED_BODY(pool[i].data())) else FOR_RAND(READ_BODY(FIRE_X)) break;
-    case RAND_WRITE: FOR_RAND(WRITE_BODY(FIRE_W)) break;
-    case kOps: break;
+    case Op::RandWrite: FOR_RAND(WRITE_BODY(FIRE_W)) break;
   }
   return acc;
 }
@@ -317,24 +316,23 @@ LAYOUT_FN(run_openmesh, FOR_EDGE_SEQ, FOR_EDGE_RAND, OM_X, OM_W,
 
 double run(Variant v, Op op, bool cached, size_t first, size_t m, int iters, double base) {
   switch (v) {
-    case S1: return run_s1(op, cached, first, m, iters, base);
-    case S2: return run_s2(op, cached, first, m, iters, base);
-    case S3:
-    case S3_FRESH: return run_s3(op, cached, first, m, iters, base);
-    case S4:
-    case S4_FRESH: return run_s4(op, cached, first, m, iters, base);
-    case S5: return run_s5(op, cached, first, m, iters, base);
-    case S6: return run_s6(op, cached, first, m, iters, base);
-    case FIRE_POOL: return run_fire(op, cached, first, m, iters, base);
-    case OPENMESH:
-    case OPENMESH_FRESH: return run_openmesh(op, cached, first, m, iters, base);
-    case kVariants: break;
+    case Variant::S1: return run_s1(op, cached, first, m, iters, base);
+    case Variant::S2: return run_s2(op, cached, first, m, iters, base);
+    case Variant::S3:
+    case Variant::S3Fresh: return run_s3(op, cached, first, m, iters, base);
+    case Variant::S4:
+    case Variant::S4Fresh: return run_s4(op, cached, first, m, iters, base);
+    case Variant::S5: return run_s5(op, cached, first, m, iters, base);
+    case Variant::S6: return run_s6(op, cached, first, m, iters, base);
+    case Variant::FirePool: return run_fire(op, cached, first, m, iters, base);
+    case Variant::OpenMesh:
+    case Variant::OpenMeshFresh: return run_openmesh(op, cached, first, m, iters, base);
   }
   return 0;
 }
 
 // CPU time of this thread, so time spent waiting for a core on the shared machine is not counted.
-double thread_seconds() {
+double thread_s() {
   timespec ts;
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
@@ -355,7 +353,7 @@ void make_perm(size_t n) {
 
 // Points in a sample's window: about ops / iters, whole OpenMesh edges, at most n.
 size_t window(size_t n, Op op, int iters) {
-  const size_t ops = op == RAND_READ || op == RAND_WRITE ? kRandomOps : kSequentialOps;
+  const size_t ops = op == Op::RandRead || op == Op::RandWrite ? kRandomOps : kSequentialOps;
   const size_t m = ops / size_t(iters) / kPointsPerEdge * kPointsPerEdge;
   return std::clamp<size_t>(m, kPointsPerEdge, n);
 }
@@ -394,11 +392,11 @@ void sweep(const std::vector<std::pair<size_t, int>>& runs, int repeat) {
     last_n = n;
     double reference = 0;
     for (int vi = 0; vi < kVariants; vi++) {
-      const Variant v = Variant(vi);
+      const auto v = static_cast<Variant>(vi);
       setup(v, n);
-      const double check = run(v, SEQ_READ, false, 0, n, 1, 0);
+      const double check = run(v, Op::SeqRead, false, 0, n, 1, 0);
       if (vi == 0) reference = check;
-      if (check != reference) die(std::string(kVariantNames[v]) + " holds other points than s1");
+      if (check != reference) die(std::string(kVariantNames[vi]) + " holds other points than s1");
       if (point_address(v, 0) != nullptr) {
         std::vector<double> gaps;
         for (size_t i = 1; i < std::min<size_t>(n, 100'000); i++)
@@ -408,7 +406,7 @@ void sweep(const std::vector<std::pair<size_t, int>>& runs, int repeat) {
         const double contiguous =
             double(std::count_if(gaps.begin(), gaps.end(), [](double g) { return g == 3 * sizeof(double); })) /
             double(gaps.size());
-        std::printf("gap,%s,%s,,,%zu,,%.0f;%.3f\n", FIRE_LAYOUTS_OPT, kVariantNames[v], n, gaps[gaps.size() / 2],
+        std::printf("gap,%s,%s,,,%zu,,%.0f;%.3f\n", FIRE_LAYOUTS_OPT, kVariantNames[vi], n, gaps[gaps.size() / 2],
                     contiguous);
       }
       double best[kOps][2];
@@ -418,20 +416,20 @@ void sweep(const std::vector<std::pair<size_t, int>>& runs, int repeat) {
       for (int r = 0; r < repeat; r++)
         for (int op = 0; op < kOps; op++)
           for (int c = 0; c < 2; c++) {
-            const size_t m = window(n, Op(op), iters);
+            const size_t m = window(n, static_cast<Op>(op), iters);
             const size_t first = window_start(n, m, sample++);
             const size_t passes = std::max<size_t>(1, kMinOpsPerSample / (m * size_t(iters)));
-            const double t0 = thread_seconds();
+            const double t0 = thread_s();
             double acc = 0;
-            for (size_t p = 0; p < passes; p++) acc += run(v, Op(op), c == 1, first, m, iters, base += 1);
-            const double t = thread_seconds() - t0;
+            for (size_t p = 0; p < passes; p++) acc += run(v, static_cast<Op>(op), c == 1, first, m, iters, base += 1);
+            const double t = thread_s() - t0;
             sink = acc;
             best[op][c] = std::min(best[op][c], t * 1e9 / double(passes * m * size_t(iters)));
           }
       for (int op = 0; op < kOps; op++)
         for (int c = 0; c < 2; c++) {
-          const bool same = v == FIRE_POOL && c == 1 && (op == SEQ_WRITE || op == RAND_WRITE);
-          std::printf("time,%s,%s,%s,%s,%zu,%d,%.4f\n", FIRE_LAYOUTS_OPT, kVariantNames[v], kOpNames[op],
+          const bool same = v == Variant::FirePool && c == 1 && (static_cast<Op>(op) == Op::SeqWrite || static_cast<Op>(op) == Op::RandWrite);
+          std::printf("time,%s,%s,%s,%s,%zu,%d,%.4f\n", FIRE_LAYOUTS_OPT, kVariantNames[vi], kOpNames[op],
                       c ? (same ? "set" : "yes") : "no", n, iters, best[op][c]);
         }
       std::fflush(stdout);
@@ -459,13 +457,13 @@ int main(int argc, char** argv) {
     for (long it : parse_list(argv[3])) runs.emplace_back(size_t(std::atol(argv[2])), int(it));
     sweep(runs, std::atoi(argv[4]));
   } else if (mode == "once" && argc == 7) {
-    const Variant v = Variant(find(kVariantNames, kVariants, argv[2]));
+    const auto v = static_cast<Variant>(find(kVariantNames, kVariants, argv[2]));
     const size_t n = size_t(std::atol(argv[3]));
     if (n == 0 || n > kMaxPoints || n % kPointsPerEdge != 0) die("n must be a multiple of 100 up to 10^7");
     make_perm(n);
     setup(v, n);
     if (std::strcmp(argv[5], "none") != 0) {
-      const Op op = Op(find(kOpNames, kOps, argv[5]));
+      const auto op = static_cast<Op>(find(kOpNames, kOps, argv[5]));
       const int iters = std::atoi(argv[4]);
       sink = run(v, op, std::strcmp(argv[6], "yes") == 0, 0, window(n, op, iters), iters, 1);
     }

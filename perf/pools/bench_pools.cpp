@@ -46,7 +46,7 @@ double median(std::vector<double> t) {
 }
 
 template <class F>
-double median_seconds(F&& run) {
+double median_s(F&& run) {
   std::vector<double> t;
   for (int r = 0; r < kRepetitions; ++r) {
     const double t0 = cpu_now();
@@ -155,7 +155,7 @@ int main() {
   const size_t before_points = built.points.size(), before_face_edges = built.face_edges.size();
   const size_t bytes_before = built.pool_bytes();
   Mesh mesh = built;
-  const double t_compact = median_seconds([&] {
+  const double t_compact = median_s([&] {
     Mesh copy = built;
     copy.compact();
   });
@@ -214,30 +214,30 @@ int main() {
     double total() const { return x + y + z; }
   };
   double sum_pool = 0, sum_edges = 0, sum_random = 0, sum_om_edges = 0, sum_om_random = 0;
-  const double t_pool = median_seconds([&] {
+  const double t_pool = median_s([&] {
     Sum s;
     for (const Vec3& p : mesh.points.values()) s.x += p.x(), s.y += p.y(), s.z += p.z();
     sum_pool = s.total();
   });
-  const double t_edges = median_seconds([&] {
+  const double t_edges = median_s([&] {
     Sum s;
     for (EdgeIndex e{0}; e < mesh.edge_slots(); ++e)
       for (const Vec3& p : mesh.polyline(e)) s.x += p.x(), s.y += p.y(), s.z += p.z();
     sum_edges = s.total();
   });
-  const double t_random = median_seconds([&] {
+  const double t_random = median_s([&] {
     Sum s;
     const Vec3* pts = mesh.points.values().data();
     for (uint32_t i : order) s.x += pts[i].x(), s.y += pts[i].y(), s.z += pts[i].z();
     sum_random = s.total();
   });
-  const double t_om_edges = median_seconds([&] {
+  const double t_om_edges = median_s([&] {
     Sum s;
     for (auto e : om.edges())
       for (const auto& p : om.property(polyline, e)) s.x += p[0], s.y += p[1], s.z += p[2];
     sum_om_edges = s.total();
   });
-  const double t_om_random = median_seconds([&] {
+  const double t_om_random = median_s([&] {
     Sum s;
     for (const auto& [e, i] : om_order) {
       const auto& p = om.property(polyline, e)[i];

@@ -84,7 +84,7 @@ struct Measurement {
 // Strokes drawn after the idle run, and pen samples per stroke: 0.5 mm apart across a 2 cm cell.
 constexpr int kStrokes = 6, kSamples = 41;
 // Seconds of each idle run with parts of the scene hidden.
-constexpr int kToggleSeconds = 3;
+constexpr int kToggleS = 3;
 
 // CPU time of the whole process (the app thread and lavapipe's), which waiting for a core on a shared
 // machine does not inflate as it does the wall time.
@@ -167,7 +167,7 @@ Measurement run(const Config& c, double seconds) {
     frame();  // the first frame recorded without them
     const auto from = WallClock::now();
     size_t frames = 0;
-    for (; WallClock::now() - from < std::chrono::seconds(kToggleSeconds); ++frames)
+    for (; WallClock::now() - from < std::chrono::seconds(kToggleS); ++frames)
       if (!frame()) {
         r.problem = "a frame was not shown: " + app.status().error;
         return r;
@@ -289,7 +289,7 @@ int main(int argc, char** argv) {
   }
   std::printf("\nIdle fps with parts of the scene hidden (the app's keys 1 and 2; %d s each; left: the clear, "
               "the resolve if multisampled, HUD, present):\n\n| network | L | all | surface hidden | curves hidden | both hidden |\n"
-              "|---|---|---|---|---|---|\n", kToggleSeconds);
+              "|---|---|---|---|---|---|\n", kToggleS);
   for (const Measurement& r : results)
     std::printf("| %s | %u | %.1f | %.1f | %.1f | %.1f |\n", r.name.c_str(), r.config.levels,
                 double(r.frames) / r.seconds, r.toggle_fps[0], r.toggle_fps[1], r.toggle_fps[2]);

@@ -48,7 +48,7 @@ double cpu_now() {
 // Each run's best time over the repetitions, the runs taking turns within each repetition, so that a
 // change in the machine's load falls on all of them alike.
 template <class... F>
-std::array<double, sizeof...(F)> best_seconds(F&&... run) {
+std::array<double, sizeof...(F)> best_s(F&&... run) {
   std::array<double, sizeof...(F)> best;
   best.fill(1e300);
   for (int r = 0; r < kRepetitions; ++r) {
@@ -192,21 +192,21 @@ int main() {
     SnapIndex incremental;
     const double t_draw = cpu_now();
     Mesh mesh = draw_network(target, &incremental);
-    const double draw_seconds = cpu_now() - t_draw;
+    const double draw_s = cpu_now() - t_draw;
     if (auto why = incremental.validate(mesh); !why.empty()) die("incremental index: " + why);
     SnapIndex bulk;
     std::vector<uint32_t> all(mesh.edge_slots());
     for (uint32_t e = 0; e < all.size(); ++e) all[e] = e;
     const double t_bulk = cpu_now();
     bulk.update(mesh, all);
-    const double bulk_seconds = cpu_now() - t_bulk;
+    const double bulk_s = cpu_now() - t_bulk;
 
     Cloud cloud;
     for (EdgeIndex e{0}; e < mesh.edge_slots(); ++e)
       if (mesh.edge_alive(e)) cloud.pts.insert(cloud.pts.end(), mesh.polyline(e).begin(), mesh.polyline(e).end());
     const double t_nano = cpu_now();
     Static tree(3, cloud);
-    const double nano_build_seconds = cpu_now() - t_nano;
+    const double nano_build_s = cpu_now() - t_nano;
     const size_t n = cloud.pts.size();
 
     const double side = side_for(target);
@@ -224,7 +224,7 @@ int main() {
     }
     std::printf("# %zu points, %zu edges; drawn with incremental sync in %.2f s; bulk index %.1f ms, nanoflann static %.1f ms;"
                 " tree height %u incremental, %u bulk\n",
-                n, mesh.edge_count(), draw_seconds, 1e3 * bulk_seconds, 1e3 * nano_build_seconds, incremental.height(),
+                n, mesh.edge_count(), draw_s, 1e3 * bulk_s, 1e3 * nano_build_s, incremental.height(),
                 bulk.height());
     for (const Row& row : rows) {
       // The same answers first (distances: equally near points may differ in which one is named).
@@ -242,7 +242,7 @@ int main() {
           g_sink = sink;
         };
       };
-      const auto [inc, blk, nano] = best_seconds(ours(incremental), ours(bulk), [&] {
+      const auto [inc, blk, nano] = best_s(ours(incremental), ours(bulk), [&] {
         for (const Vec3& q : row.queries) sink += nano_query(tree, q, row.radius);
         g_sink = sink;
       });

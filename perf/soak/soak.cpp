@@ -101,7 +101,7 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  const reconstruct::Options options{reconstruct::Method::fire, 1, s.levels, reconstruct::Planarity::least_squares};
+  const reconstruct::Options options{reconstruct::Method::Fire, 1, s.levels, reconstruct::Planarity::LeastSquares};
   std::mt19937_64 rng(s.seed);
   Mesh mesh;
   EditHistory history;

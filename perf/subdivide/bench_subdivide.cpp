@@ -58,7 +58,7 @@ struct Variant {
   }
 };
 
-enum class Order { interleaved, warm };
+enum class Order { Interleaved, Warm };
 
 // before_each runs untimed before every repetition (it moves the points in part b).
 void time_variants(Order order, int repetitions, std::vector<Variant*> variants,
@@ -69,7 +69,7 @@ void time_variants(Order order, int repetitions, std::vector<Variant*> variants,
     variant->run();
     variant->times.push_back(thread_ms() - start);
   };
-  if (order == Order::interleaved) {
+  if (order == Order::Interleaved) {
     for (int i = 0; i < repetitions; ++i)
       for (Variant* variant : variants) once(variant);
   } else {
@@ -260,7 +260,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: bench_subdivide [DATA_DIR] [REPETITIONS >= 1] [interleaved|warm]\n");
     return 1;
   }
-  const Order order = order_name == "warm" ? Order::warm : Order::interleaved;
+  const Order order = order_name == "warm" ? Order::Warm : Order::Interleaved;
   // glibc's adaptive mmap and trim thresholds otherwise make whether a from-scratch build pays page
   // faults depend on what ran before it; keep freed memory for both libraries alike.
   mallopt(M_MMAP_THRESHOLD, 256 << 20);
@@ -282,7 +282,7 @@ int main(int argc, char** argv) {
   }
   fire::reconstruct::ReconstructionState state;
   fire::SurfaceMesh surface;
-  const fire::reconstruct::Options thesis{.method = fire::reconstruct::Method::thesis, .coons_steps = 1};
+  const fire::reconstruct::Options thesis{.method = fire::reconstruct::Method::Thesis, .coons_steps = 1};
   if (fire::Status built = fire::reconstruct::reconstruct_update(*network, thesis, state, surface); !built) {
     std::fprintf(stderr, "bench_subdivide: %s\n", built.error.c_str());
     return 1;

@@ -7,8 +7,8 @@ namespace fire::cad {
 
 Result<CadFormat> cad_format_of(const std::string& path) {
   const std::string ext = file_extension(path);
-  if (ext == "step" || ext == "stp") return CadFormat::step;
-  if (ext == "igs" || ext == "iges") return CadFormat::iges;
+  if (ext == "step" || ext == "stp") return CadFormat::Step;
+  if (ext == "igs" || ext == "iges") return CadFormat::Iges;
   return Result<CadFormat>::failure(path + ": not a CAD file name (.step, .stp, .igs or .iges)");
 }
 

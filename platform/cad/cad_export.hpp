@@ -15,7 +15,7 @@
 
 namespace fire::cad {
 
-enum class CadFormat : uint8_t { step, iges };
+enum class CadFormat : uint8_t { Step, Iges };
 // By the path's extension, .step / .stp or .igs / .iges in any case; anything else is an error naming the path.
 Result<CadFormat> cad_format_of(const std::string& path);
 

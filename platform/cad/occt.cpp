@@ -73,9 +73,9 @@ void initialize_occt() {
 // OpenCASCADE's names of the units (STEP, IGES and its own "cascade" unit take the same).
 const char* occt_unit(LengthUnit unit) {
   switch (unit) {
-    case LengthUnit::mm: return "MM";
-    case LengthUnit::cm: return "CM";
-    case LengthUnit::m: return "M";
+    case LengthUnit::Millimetre: return "MM";
+    case LengthUnit::Centimetre: return "CM";
+    case LengthUnit::Metre: return "M";
   }
   return "MM";
 }
@@ -246,10 +246,10 @@ Result<CadWritten> write_cad(const BsplinePatches& patches, const std::string& p
   try {
     // The shape in millimetres, OpenCASCADE's own unit, which its writers convert to the file's.
     Interface_Static::SetCVal("xstep.cascade.unit", "MM");
-    Result<Built> built = build_shape(patches, units_per_metre(LengthUnit::mm), path);
+    Result<Built> built = build_shape(patches, units_per_metre(LengthUnit::Millimetre), path);
     if (!built) return Result<CadWritten>::failure(built.error());
-    built->written.sewing_tolerance *= units_per_metre(unit) / units_per_metre(LengthUnit::mm);
-    const Status s = *format == CadFormat::step ? write_step(built->shape, path, unit)
+    built->written.sewing_tolerance *= units_per_metre(unit) / units_per_metre(LengthUnit::Millimetre);
+    const Status s = *format == CadFormat::Step ? write_step(built->shape, path, unit)
                                                 : write_iges(built->shape, path, unit);
     if (!s) return Result<CadWritten>::failure(s.error);
     return built->written;
@@ -273,7 +273,7 @@ Result<CadShapeInfo> read_cad(const std::string& path, uint32_t samples_per_side
     // Shapes come out in OpenCASCADE's own unit, set to millimetres here, and are scaled to the file's.
     Interface_Static::SetCVal("xstep.cascade.unit", "MM");
     std::string file_unit;
-    if (*format == CadFormat::step) {
+    if (*format == CadFormat::Step) {
       STEPControl_Reader reader;
       if (reader.ReadFile(path.c_str()) != IFSelect_RetDone) return R::failure(path + ": not a STEP file OpenCASCADE can read");
       TColStd_SequenceOfAsciiString lengths, angles, solid_angles;

@@ -6,11 +6,11 @@
 namespace fire::render {
 
 Result<View> parse_view(const std::string& name) {
-  if (name == "iso") return View::iso;
-  if (name == "front") return View::front;
-  if (name == "top") return View::top;
-  if (name == "side") return View::side;
-  if (name == "bottom") return View::bottom;
+  if (name == "iso") return View::Iso;
+  if (name == "front") return View::Front;
+  if (name == "top") return View::Top;
+  if (name == "side") return View::Side;
+  if (name == "bottom") return View::Bottom;
   return Result<View>::failure("--view must be iso, front, top, side or bottom, not '" + name + "'");
 }
 
@@ -20,11 +20,11 @@ Camera frame_box(const Box& box, View view, uint32_t width, uint32_t height) {
   const float radius = std::max(glm::length(hi - lo) * 0.5f, 1e-6f);
   glm::vec3 back{0.0f, -1.0f, 0.0f}, up{0.0f, 0.0f, 1.0f};  // from the centre towards the eye
   switch (view) {
-    case View::iso: back = glm::normalize(glm::vec3(1.0f, -1.0f, 0.8f)); break;
-    case View::front: break;
-    case View::side: back = {1.0f, 0.0f, 0.0f}; break;
-    case View::top: back = {0.0f, 0.0f, 1.0f}, up = {0.0f, 1.0f, 0.0f}; break;
-    case View::bottom: back = {0.0f, 0.0f, -1.0f}, up = {0.0f, 1.0f, 0.0f}; break;
+    case View::Iso: back = glm::normalize(glm::vec3(1.0f, -1.0f, 0.8f)); break;
+    case View::Front: break;
+    case View::Side: back = {1.0f, 0.0f, 0.0f}; break;
+    case View::Top: back = {0.0f, 0.0f, 1.0f}, up = {0.0f, 1.0f, 0.0f}; break;
+    case View::Bottom: back = {0.0f, 0.0f, -1.0f}, up = {0.0f, 1.0f, 0.0f}; break;
   }
   const glm::vec3 right = glm::normalize(glm::cross(up, back));
   const glm::vec3 true_up = glm::cross(back, right);

@@ -8,7 +8,7 @@
 
 namespace fire::render {
 
-enum class View { iso, front, top, side, bottom };
+enum class View { Iso, Front, Top, Side, Bottom };
 
 // "iso", "front", "top", "side", "bottom" (from below: what rests on the table); a failure otherwise.
 Result<View> parse_view(const std::string& name);

@@ -222,7 +222,7 @@ Status Presenter::record_capture(VkCommandBuffer cmd, VkImage image) {
 Result<Presented> Presenter::frame(Renderer& renderer, const Camera& camera, const DrawOptions& options,
                               const Overlay& overlay, Image* capture) {
   VkDevice device = context_.device();
-  if (!swapchain_ || extent_.width == 0 || extent_.height == 0) return Presented::swapchain_stale;
+  if (!swapchain_ || extent_.width == 0 || extent_.height == 0) return Presented::SwapchainStale;
   if (capture && !can_capture_) return Result<Presented>::failure("the window's images cannot be read back for a screenshot");
   if (renderer.color_format() != format_.format)
     return Result<Presented>::failure("the renderer draws in another format than the window's images (RenderSettings::color_format)");
@@ -232,7 +232,7 @@ Result<Presented> Presenter::frame(Renderer& renderer, const Camera& camera, con
 
   uint32_t index = 0;
   const VkResult acquired = vkAcquireNextImageKHR(device, swapchain_, kWaitNs, acquired_, VK_NULL_HANDLE, &index);
-  if (acquired == VK_ERROR_OUT_OF_DATE_KHR) return Presented::swapchain_stale;
+  if (acquired == VK_ERROR_OUT_OF_DATE_KHR) return Presented::SwapchainStale;
   if (acquired != VK_SUCCESS && acquired != VK_SUBOPTIMAL_KHR)
     return Result<Presented>::failure(vk_failure("vkAcquireNextImageKHR", acquired));
 
@@ -298,7 +298,7 @@ Result<Presented> Presenter::frame(Renderer& renderer, const Camera& camera, con
     for (size_t i = 3; i < capture->rgba.size(); i += 4) capture->rgba[i] = 255;  // what the window shows is opaque
   }
   // Shown, but the swapchain no longer matches the window: the caller resizes before the next frame.
-  return acquired == VK_SUCCESS && presented == VK_SUCCESS ? Presented::shown : Presented::swapchain_stale;
+  return acquired == VK_SUCCESS && presented == VK_SUCCESS ? Presented::Shown : Presented::SwapchainStale;
 }
 
 }  // namespace fire::render

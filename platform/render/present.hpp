@@ -17,7 +17,7 @@
 namespace fire::render {
 
 // What Presenter::frame did with a frame it drew.
-enum class Presented { shown, swapchain_stale };
+enum class Presented { Shown, SwapchainStale };
 
 class Presenter {
  public:

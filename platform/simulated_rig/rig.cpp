@@ -168,7 +168,7 @@ SimulatedSession run_session(const RigOptions& o, Scenario scenario, const Simul
   SimulationStats& stats = session.stats;
   stats.duration_s = duration_s;
 
-  Random clock_rng(o.seed, stream_of(scenario, kClockStream));
+  Random clock_rng(o.seed, stream_of(scenario, Stream::Clock));
   std::array<Clock, 2> clocks;
   for (int d = 0; d < 2; ++d) {
     const double rate = o.rate_hz * (1.0 + (d == 0 ? -0.5 : 0.5) * o.drift_ppm * 1e-6);
@@ -191,7 +191,7 @@ SimulatedSession run_session(const RigOptions& o, Scenario scenario, const Simul
                clocks[d].jitter_s * 1e6});
 
   // The stray reflection: a fixed spot in one camera's image, present in whole seconds.
-  Random stray_rng(o.seed, stream_of(scenario, kStrayStream));
+  Random stray_rng(o.seed, stream_of(scenario, Stream::Stray));
   const Vec2 stray_px(stray_rng.uniform(100, 924), stray_rng.uniform(100, 668));
   std::vector<char> stray_on(static_cast<size_t>(std::ceil(duration_s)) + 1);
   for (char& on : stray_on) on = stray_rng.uniform() < o.stray;
@@ -200,9 +200,9 @@ SimulatedSession run_session(const RigOptions& o, Scenario scenario, const Simul
   for (int d = 0; d < 2; ++d) {
     const Camera& cam = rig.cameras[d];
     const Vec3 centre = cam.centre();
-    Random noise(o.seed, stream_of(scenario, d == 0 ? kNoiseStream0 : kNoiseStream1));
-    Random timing(o.seed, stream_of(scenario, d == 0 ? kTimingStream0 : kTimingStream1));
-    Random occlusion_rng(o.seed, stream_of(scenario, d == 0 ? kOcclusionStream0 : kOcclusionStream1));
+    Random noise(o.seed, stream_of(scenario, d == 0 ? Stream::Noise0 : Stream::Noise1));
+    Random timing(o.seed, stream_of(scenario, d == 0 ? Stream::Timing0 : Stream::Timing1));
+    Random occlusion_rng(o.seed, stream_of(scenario, d == 0 ? Stream::Occlusion0 : Stream::Occlusion1));
     const std::vector<Interval> hand = occlusion_intervals(occlusion_rng, o.occlusion_per_s, duration_s);
     SlotTracker slots;
     const Clock& clock = clocks[d];
@@ -266,7 +266,7 @@ SimulatedSession run_session(const RigOptions& o, Scenario scenario, const Simul
   }
   // Bluetooth delivers a remote's reports in order, so a late one holds back those behind it; and now and
   // then one is held until the next and both arrive at once. Reports are in exposure order per device.
-  Random burst_rng(o.seed, stream_of(scenario, kBurstStream));
+  Random burst_rng(o.seed, stream_of(scenario, Stream::Burst));
   for (int d = 0; d < 2; ++d) {
     std::vector<PendingReport*> own;
     for (PendingReport& r : reports)
@@ -309,7 +309,7 @@ std::vector<InputEvent> common_header(const char* scenario, const RigOptions& o)
 
 Result<SimulatedRig> make_simulated_rig(const RigOptions& o) {
   if (Status s = check_rig(o); !s) return Result<SimulatedRig>::failure(s.error);
-  Random rng(o.rig_seed, kRigStream);
+  Random rng(o.rig_seed, static_cast<uint64_t>(Stream::Rig));
   SimulatedRig rig;
   const Vec3 target(0, 0, o.target_distance_m);
   for (int d = 0; d < 2; ++d) {

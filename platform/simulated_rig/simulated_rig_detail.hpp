@@ -37,10 +37,11 @@ class Random {
 
 // Each scenario draws from its own streams, so a wand and a sketch session with the same seed
 // share the rig (drawn from rig_seed) but no noise.
-enum Scenario : uint64_t { kWandScenario = 1, kSketchScenario = 2, kDrawingScenario = 3 };
-enum Stream : uint64_t { kRigStream, kClockStream, kStrayStream, kMotionStream, kNoiseStream0, kNoiseStream1,
-                         kTimingStream0, kTimingStream1, kOcclusionStream0, kOcclusionStream1, kBurstStream };
-inline uint64_t stream_of(Scenario scenario, Stream s) { return 64 * scenario + s; }
+enum class Scenario : uint64_t { Wand = 1, Sketch = 2, Drawing = 3 };
+enum class Stream : uint64_t { Rig, Clock, Stray, Motion, Noise0, Noise1, Timing0, Timing1, Occlusion0, Occlusion1, Burst };
+inline uint64_t stream_of(Scenario scenario, Stream s) {
+  return 64 * static_cast<uint64_t>(scenario) + static_cast<uint64_t>(s);
+}
 
 // The same pinhole-plus-radial model as Camera::project, written out here so that the simulator
 // does not test the calibration with the calibration's own code.

@@ -196,7 +196,7 @@ Result<SimulatedSession> simulate_sketch(const RigOptions& o, const SketchOption
   const Occluded occluded = [&](double, const Vec3& light, const Vec3& centre) {
     return segment_blocked(placed->triangles, light, centre);
   };
-  Result<SimulatedSession> session = run_session(o, kSketchScenario, *rig, duration, scene, occluded, std::move(header));
+  Result<SimulatedSession> session = run_session(o, Scenario::Sketch, *rig, duration, scene, occluded, std::move(header));
   if (session) session->stats.strokes = static_cast<int>(strokes.size());
   return session;
 }

@@ -15,7 +15,7 @@ Result<SimulatedSession> simulate_wand(const RigOptions& o, const WandOptions& w
   // box in front of the rig, directions kept away from the line of sight (where its two LEDs
   // would merge) and turning less than 90 degrees per key, as a hand waves.
   constexpr double kKeyInterval = 0.5;
-  Random motion(o.seed, stream_of(kWandScenario, kMotionStream));
+  Random motion(o.seed, stream_of(Scenario::Wand, Stream::Motion));
   const size_t keys = static_cast<size_t>(w.duration_s / kKeyInterval) + 4;
   std::vector<Vec3> centres, directions;
   for (size_t i = 0; i < keys; ++i) {
@@ -39,7 +39,7 @@ Result<SimulatedSession> simulate_wand(const RigOptions& o, const WandOptions& w
   };
   std::vector<InputEvent> header = common_header("wand", o);
   add_meta(header, "wand_length_m", format_double(w.length_m));
-  return run_session(o, kWandScenario, *rig, w.duration_s, scene, {}, std::move(header));
+  return run_session(o, Scenario::Wand, *rig, w.duration_s, scene, {}, std::move(header));
 }
 
 }  // namespace fire::simulation

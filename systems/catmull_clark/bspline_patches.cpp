@@ -50,21 +50,21 @@ bool regular_grid(const Level& level, std::span<const Vec3> points, uint32_t f, 
     // f's sector at v: ring faces lo .. hi counted from f's, and the ring edges lo .. last between them.
     int lo = 0, hi = 0, last = 0;
     switch (level.vertex_rules[v]) {
-      case VertexRule::smooth:
+      case VertexRule::Smooth:
         if (n != 4) return false;
         hi = 3, last = 3;
         break;
-      case VertexRule::crease:
+      case VertexRule::Crease:
         while (hi < int(n) && !sharp(hi + 1)) ++hi;
         while (lo > -int(n) && !sharp(lo)) --lo;
         if (hi - lo != 1) return false;
         last = hi + 1;
         break;
-      case VertexRule::corner:
+      case VertexRule::Corner:
         if (!sharp(0) || !sharp(1)) return false;
         last = 1;
         break;
-      case VertexRule::dart:
+      case VertexRule::Dart:
         return false;
     }
     if (!put(at, v)) return false;

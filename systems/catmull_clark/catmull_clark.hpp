@@ -36,7 +36,7 @@ namespace fire::catmull_clark {
 // The rule that moves a vertex, from its count of infinitely sharp incident edges (boundary edges
 // included): 0 smooth, 1 dart (moves like smooth), 2 crease, more than 2 corner. A boundary vertex with
 // a single face and a vertex with no face are corners.
-enum class VertexRule : uint8_t { smooth, dart, crease, corner };
+enum class VertexRule : uint8_t { Smooth, Dart, Crease, Corner };
 
 // The base mesh as plain arrays: face f uses face_vertices[face_offsets[f] .. face_offsets[f+1]),
 // counter-clockwise seen from outside; sharp_edges holds vertex index pairs (a0, b0, a1, b1, ...) of

@@ -54,10 +54,10 @@ inline void finish_vertex(const Level& p, uint32_t v, const double* in, double* 
   double* q = out + 3 * size_t{v};
   const uint32_t r0 = p.ring_offsets[v], r1 = p.ring_offsets[v + 1];
   switch (p.vertex_rules[v]) {
-    case VertexRule::corner:
+    case VertexRule::Corner:
       store(q, load(self));
       break;
-    case VertexRule::crease: {
+    case VertexRule::Crease: {
       P3 sum{{0, 0}, 0};
       for (uint32_t r = r0; r < r1; ++r)
         if (p.edge_sharp[p.ring_edges[r]]) sum += load(in + 3 * size_t{p.ring_neighbors[r]});

@@ -158,15 +158,15 @@ Status build_limit_stencils(const Refinement& refinement, LimitStencils& limit) 
       src[row.face(i)] = level.face_vertices[b + ((corner + 2) & 3u)];
     }
     switch (level.vertex_rules[v]) {
-      case VertexRule::smooth:
-      case VertexRule::dart:
+      case VertexRule::Smooth:
+      case VertexRule::Dart:
         if (n == 2)
           corner_masks(row);
         else
           smooth_masks(row);
         break;
-      case VertexRule::crease: crease_masks(row, sharp[0], sharp[1]); break;
-      case VertexRule::corner: corner_masks(row); break;
+      case VertexRule::Crease: crease_masks(row, sharp[0], sharp[1]); break;
+      case VertexRule::Corner: corner_masks(row); break;
     }
   }
   return Status::success();

@@ -63,7 +63,7 @@ uint32_t face_size(const Level& level, uint32_t f) { return level.face_offsets[f
 // Smooth, valence 4, and its four faces are quads.
 bool regular_vertex(const Level& base, uint32_t v) {
   const uint32_t r0 = base.ring_offsets[v], r1 = base.ring_offsets[v + 1];
-  if (base.vertex_rules[v] != VertexRule::smooth || r1 - r0 != 4) return false;
+  if (base.vertex_rules[v] != VertexRule::Smooth || r1 - r0 != 4) return false;
   for (uint32_t r = r0; r < r1; ++r)
     if (base.ring_corners[r] == kNone || face_size(base, base.corner_face(base.ring_corners[r])) != 4) return false;
   return true;

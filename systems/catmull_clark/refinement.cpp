@@ -185,7 +185,7 @@ Result<Level> build_base_level(const BaseTopology& base) {
     level.ring_offsets[v] = static_cast<uint32_t>(level.ring_edges.size());
     const uint32_t face_total = vertex_offsets[v + 1] - vertex_offsets[v];
     if (face_total == 0) {
-      level.vertex_rules[v] = VertexRule::corner;
+      level.vertex_rules[v] = VertexRule::Corner;
       continue;
     }
     uint32_t start = vertex_corners[vertex_offsets[v]];
@@ -223,14 +223,14 @@ Result<Level> build_base_level(const BaseTopology& base) {
                                     std::to_string(face_total) + " faces do not form a single fan");
     const bool given = !base.border_corners.empty();
     if (boundary && given) {
-      level.vertex_rules[v] = base.border_corners[v] || sharp_count > 2 ? VertexRule::corner : VertexRule::crease;
+      level.vertex_rules[v] = base.border_corners[v] || sharp_count > 2 ? VertexRule::Corner : VertexRule::Crease;
     } else if (boundary && visited == 1) {
-      level.vertex_rules[v] = VertexRule::corner;
+      level.vertex_rules[v] = VertexRule::Corner;
     } else {
-      level.vertex_rules[v] = sharp_count == 0   ? VertexRule::smooth
-                              : sharp_count == 1 ? VertexRule::dart
-                              : sharp_count == 2 ? VertexRule::crease
-                                                 : VertexRule::corner;
+      level.vertex_rules[v] = sharp_count == 0   ? VertexRule::Smooth
+                              : sharp_count == 1 ? VertexRule::Dart
+                              : sharp_count == 2 ? VertexRule::Crease
+                                                 : VertexRule::Corner;
     }
   }
   level.ring_offsets[vertex_count] = static_cast<uint32_t>(level.ring_edges.size());
@@ -383,7 +383,7 @@ class ChildBuilder {
         const uint32_t c_prev = j == 0 ? b + n - 1 : b + j - 1;
         set_slot(R + b + j, c_prev, edge_point0 + p_.face_edges[c_prev], 4 * (b + j) + role_position(quad, j, 2));
       }
-      c_.vertex_rules[V_ + f] = VertexRule::smooth;
+      c_.vertex_rules[V_ + f] = VertexRule::Smooth;
     }
     // Edge points: per parent face of the edge (in edge-face order), the child quad of the corner
     // after the edge, then the one of the corner where the edge leaves.
@@ -404,7 +404,7 @@ class ChildBuilder {
         const uint32_t end = p_.face_vertices[p_.edge_corners[2 * e]];
         set_slot(slot, half_edge(e, end), end, kNone);
       }
-      c_.vertex_rules[edge_point0 + e] = p_.edge_sharp[e] ? VertexRule::crease : VertexRule::smooth;
+      c_.vertex_rules[edge_point0 + e] = p_.edge_sharp[e] ? VertexRule::Crease : VertexRule::Smooth;
     }
   }
 

@@ -13,8 +13,8 @@ class RowWriter {
 
   uint32_t vertex_row_size(uint32_t v) const {
     switch (p_.vertex_rules[v]) {
-      case VertexRule::corner: return 1;
-      case VertexRule::crease: return 3;
+      case VertexRule::Corner: return 1;
+      case VertexRule::Crease: return 3;
       default: break;
     }
     const uint32_t r0 = p_.ring_offsets[v], r1 = p_.ring_offsets[v + 1];
@@ -31,8 +31,8 @@ class RowWriter {
     const uint32_t r0 = p_.ring_offsets[v], n = p_.ring_offsets[v + 1] - r0;
     src[0] = v;
     switch (p_.vertex_rules[v]) {
-      case VertexRule::corner: w[0] = 1.0; return;
-      case VertexRule::crease: {
+      case VertexRule::Corner: w[0] = 1.0; return;
+      case VertexRule::Crease: {
         w[0] = 0.75;
         uint32_t k = 1;
         for (uint32_t r = r0; k < 3; ++r) {

@@ -45,7 +45,7 @@ class LocalMesh {
 
   VertexRef add_interior(const Vec3& p) {
     interior.push_back(p);
-    return {RefKind::interior, static_cast<uint32_t>(interior.size() - 1), 0};
+    return {RefKind::Interior, static_cast<uint32_t>(interior.size() - 1), 0};
   }
   uint32_t add_edge(LocalEdge edge) {
     edges.push_back(std::move(edge));
@@ -73,7 +73,7 @@ class LocalMesh {
     VertexRef mid;
     if (const EdgeSplits* s = edges[e].splits) {
       const uint32_t k = edges[e].node;
-      mid = {RefKind::edge_point, edges[e].network_edge, s->first_leaf(k) + s->leaves_below(k) / 2};
+      mid = {RefKind::EdgePoint, edges[e].network_edge, s->first_leaf(k) + s->leaves_below(k) / 2};
       first.splits = second.splits = s;
       first.network_edge = second.network_edge = edges[e].network_edge;
       first.node = 2 * k;
@@ -134,7 +134,7 @@ class LocalMesh {
     if (!edge.splits || edge.node >= edge.splits->leaf_count()) return;
     const uint32_t first = edge.splits->first_leaf(edge.node), span = edge.splits->leaves_below(edge.node);
     for (uint32_t i = 1; i < span; ++i)
-      out.push_back({RefKind::edge_point, edge.network_edge, (oe & 1) ? first + span - i : first + i});
+      out.push_back({RefKind::EdgePoint, edge.network_edge, (oe & 1) ? first + span - i : first + i});
   }
   VertexRef mid(uint32_t oe) const { return edges[oe >> 1].mid; }
   Vec3 mid_position(uint32_t oe) const { return edges[oe >> 1].mid_point; }
@@ -146,10 +146,10 @@ class LocalMesh {
 
 // Which rule makes the centre and the spokes of a face.
 enum class Rule : uint8_t {
-  thesis_coons,   // thesis 6.2: Coons point x(1/2,1/2) and spokes x(1/2, j/2^R) with nearest samples
-  thesis_centroid,  // thesis 6.2 footnote: triangles use the centroid of the edge midpoints, straight spokes
-  fire_sided,     // FIRE first step: the n-sided patch (n >= 3) or the ruled surface of a 2-sided face
-  fire_coons,     // FIRE later steps: bilinear Coons with linear sampling
+  ThesisCoons,     // thesis 6.2: Coons point x(1/2,1/2) and spokes x(1/2, j/2^R) with nearest samples
+  ThesisCentroid,  // thesis 6.2 footnote: triangles use the centroid of the edge midpoints, straight spokes
+  FireSided,       // FIRE first step: the n-sided patch (n >= 3) or the ruled surface of a 2-sided face
+  FireCoons,       // FIRE later steps: bilinear Coons with linear sampling
 };
 
 struct Refiner {
@@ -158,7 +158,7 @@ struct Refiner {
 
   uint32_t spoke_segments(Rule rule, uint32_t remaining, const Vec3& from, const Vec3& to) const {
     const uint32_t needed = 1u << (remaining - 1);  // enough samples for the steps still to come
-    if (rule == Rule::thesis_coons || rule == Rule::thesis_centroid) return needed;
+    if (rule == Rule::ThesisCoons || rule == Rule::ThesisCentroid) return needed;
     const double dense = spacing > 0 ? std::round((to - from).norm() / spacing) : 1.0;
     return std::max(needed, static_cast<uint32_t>(std::clamp(dense, 1.0, 256.0)));
   }
@@ -190,12 +190,12 @@ struct Refiner {
     // Domain of the rule: centre, the end of each spoke and the evaluation.
     Eigen::Vector2d centre(0.5, 0.5);
     std::vector<Eigen::Vector2d> ends(n);
-    const bool sided = rule == Rule::fire_sided && n >= 3;
+    const bool sided = rule == Rule::FireSided && n >= 3;
     if (sided) {
       centre = Eigen::Vector2d::Zero();
       for (uint32_t k = 0; k < n; ++k)
         ends[k] = domain_corner(n, k) + (domain_corner(n, k + 1) - domain_corner(n, k)) * t[k];
-    } else if (rule == Rule::thesis_coons) {
+    } else if (rule == Rule::ThesisCoons) {
       ends = {Eigen::Vector2d(0.5, 0), Eigen::Vector2d(1, 0.5), Eigen::Vector2d(0.5, 1), Eigen::Vector2d(0, 0.5)};
     } else if (n == 2) {
       ends = {Eigen::Vector2d(t[0], 0), Eigen::Vector2d(1 - t[1], 1)};
@@ -203,14 +203,14 @@ struct Refiner {
       ends = {Eigen::Vector2d(t[0], 0), Eigen::Vector2d(1, t[1]), Eigen::Vector2d(1 - t[2], 1),
               Eigen::Vector2d(0, 1 - t[3])};
     }
-    const Sampling sampling = rule == Rule::thesis_coons ? Sampling::nearest : Sampling::linear;
+    const Sampling sampling = rule == Rule::ThesisCoons ? Sampling::Nearest : Sampling::Linear;
     auto evaluate = [&](const Eigen::Vector2d& p) -> Vec3 {
       if (sided) return sided_patch_point(sides, p);
       return coons_point(quad_sides, p.x(), p.y(), sampling);
     };
 
     Vec3 c;
-    if (rule == Rule::thesis_centroid) {
+    if (rule == Rule::ThesisCentroid) {
       c = Vec3::Zero();
       for (const Vec3& m : mids) c += m;
       c /= double(n);
@@ -220,7 +220,7 @@ struct Refiner {
     std::vector<std::vector<Vec3>> spokes(n);
     for (uint32_t k = 0; k < n; ++k) {
       const uint32_t segments = spoke_segments(rule, remaining, c, mids[k]);
-      if (rule == Rule::thesis_centroid) {
+      if (rule == Rule::ThesisCentroid) {
         spokes[k] = straight_polyline(c, mids[k], segments);
         continue;
       }
@@ -268,8 +268,8 @@ FacePatch build_face_patch(std::span<const FaceSide> sides, const FaceSettings& 
   const uint32_t count = static_cast<uint32_t>(sides.size());
   auto add_side = [&](const FaceSide& side) {
     LocalEdge edge;
-    edge.from = {RefKind::network_vertex, side.from, 0};
-    edge.to = {RefKind::network_vertex, side.to, 0};
+    edge.from = {RefKind::NetworkVertex, side.from, 0};
+    edge.to = {RefKind::NetworkVertex, side.to, 0};
     edge.splits = side.splits;
     edge.network_edge = side.network_edge;
     edge.node = 1;
@@ -303,7 +303,7 @@ FacePatch build_face_patch(std::span<const FaceSide> sides, const FaceSettings& 
   FacePatch patch;
   const uint32_t steps = settings.coons_steps;
   std::vector<std::vector<uint32_t>> faces;
-  if (settings.method == Method::thesis && n >= 3) {
+  if (settings.method == Method::Thesis && n >= 3) {
     if (n > 4) {
       std::vector<Vec3> corners(n);
       for (uint32_t k = 0; k < n; ++k) corners[k] = mesh.tail_position(loop[k]);
@@ -340,18 +340,18 @@ FacePatch build_face_patch(std::span<const FaceSide> sides, const FaceSettings& 
     for (uint32_t step = 0; step < steps; ++step) {
       std::vector<std::vector<uint32_t>> refined;
       for (const auto& f : faces) {
-        const Rule rule = f.size() == 3 ? Rule::thesis_centroid : Rule::thesis_coons;
+        const Rule rule = f.size() == 3 ? Rule::ThesisCentroid : Rule::ThesisCoons;
         for (auto& q : refiner.refine(f, rule, steps - step)) refined.push_back(std::move(q));
       }
       faces = std::move(refined);
     }
   } else {
     patch.first_stage_sizes.push_back(n);
-    faces = refiner.refine(loop, Rule::fire_sided, steps);
+    faces = refiner.refine(loop, Rule::FireSided, steps);
     for (uint32_t step = 1; step < steps; ++step) {
       std::vector<std::vector<uint32_t>> refined;
       for (const auto& f : faces)
-        for (auto& q : refiner.refine(f, Rule::fire_coons, steps - step)) refined.push_back(std::move(q));
+        for (auto& q : refiner.refine(f, Rule::FireCoons, steps - step)) refined.push_back(std::move(q));
       faces = std::move(refined);
     }
   }

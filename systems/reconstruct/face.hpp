@@ -14,14 +14,14 @@
 
 namespace fire::reconstruct {
 
-enum class Method : uint8_t { thesis, fire };
+enum class Method : uint8_t { Thesis, Fire };
 
 // A base-mesh vertex before global numbering: a network vertex (index = vertex slot), a split point of a
 // network edge (index = edge slot, sub = 1 .. 2^N - 1 along the edge's stored direction), or a vertex made
 // inside a face (index = its position in FacePatch::interior).
-enum class RefKind : uint8_t { network_vertex, edge_point, interior };
+enum class RefKind : uint8_t { NetworkVertex, EdgePoint, Interior };
 struct VertexRef {
-  RefKind kind = RefKind::network_vertex;
+  RefKind kind = RefKind::NetworkVertex;
   uint32_t index = 0;
   uint32_t sub = 0;
   friend bool operator==(const VertexRef&, const VertexRef&) = default;
@@ -44,9 +44,9 @@ struct EdgeSplits {
 EdgeSplits split_network_edge(std::span<const Vec3> line, uint32_t depth);
 
 struct FaceSettings {
-  Method method = Method::fire;
+  Method method = Method::Fire;
   uint32_t coons_steps = 1;
-  Planarity planarity = Planarity::least_squares;
+  Planarity planarity = Planarity::LeastSquares;
 };
 
 // What one network face contributes to the base mesh. Its faces (PolygonFaces) are the base faces, corners in

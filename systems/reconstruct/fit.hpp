@@ -56,7 +56,7 @@ struct FitWeights {
   double ridge = 1e-9;  // same scale, towards the initial base points
   // How the targets read a polyline between its samples (fit_targets: smooth for exact curves, linear
   // for noisy ones).
-  Sampling targets = Sampling::smooth;
+  Sampling targets = Sampling::Smooth;
   // Where the face split leaves thin base quads, the umbrella measures connectivity, not shape: on a
   // sliver it pulls the points across the thin side and the surface folds (the demo dome). There the
   // umbrella of the change from the initial base points (the transfinite patches, which do not fold)

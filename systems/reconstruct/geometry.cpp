@@ -35,11 +35,11 @@ Vec3 sample_polyline(std::span<const Vec3> line, std::span<const double> params,
   size_t hi = static_cast<size_t>(std::lower_bound(params.begin(), params.end(), t) - params.begin());
   hi = std::clamp<size_t>(hi, 1, line.size() - 1);
   const size_t lo = hi - 1;
-  if (mode == Sampling::nearest) return (t - params[lo] <= params[hi] - t) ? line[lo] : line[hi];
+  if (mode == Sampling::Nearest) return (t - params[lo] <= params[hi] - t) ? line[lo] : line[hi];
   const double span = params[hi] - params[lo];
   if (!(span > 0)) return line[lo];
   const double w = (t - params[lo]) / span;
-  if (mode == Sampling::linear || line.size() < 3) return line[lo] * (1.0 - w) + line[hi] * w;
+  if (mode == Sampling::Linear || line.size() < 3) return line[lo] * (1.0 - w) + line[hi] * w;
   // The derivative at sample i of the parabola through it and its two nearest samples.
   auto tangent = [&](size_t i) -> Vec3 {
     const size_t a = std::clamp<size_t>(i, 1, line.size() - 2) - 1;
@@ -153,16 +153,16 @@ double hough_spread(const std::array<Vec3, 4>& q, const Vec3& c) {
 double planarity_error(const std::array<Vec3, 4>& q, Planarity measure) {
   const Vec3 c = centroid(q);
   switch (measure) {
-    case Planarity::least_squares:
+    case Planarity::LeastSquares:
       return squared_distances_to_plane(q, c, least_squares_normal(q, c));
-    case Planarity::mean_normal: {
+    case Planarity::MeanNormal: {
       Vec3 mean = Vec3::Zero();
       for (const Vec3& n : triangle_normals(q))
         if (n.norm() > 0) mean += n.normalized();
       if (!(mean.norm() > 1e-12)) return squared_distances_to_plane(q, c, least_squares_normal(q, c));
       return squared_distances_to_plane(q, c, mean.normalized());
     }
-    case Planarity::hough:
+    case Planarity::Hough:
       return hough_spread(q, c);
   }
   return 0;
@@ -256,8 +256,8 @@ Vec3 sided_patch_point(std::span<const Side> sides, const Eigen::Vector2d& p) {
   for (uint32_t i = 0; i < n; ++i) {
     if (blend[i] == 0) continue;
     const double si = s[i], di = d[i];
-    const Vec3 ribbon = sides[prev(i)].at(1.0 - di, Sampling::linear) * (1.0 - si) +
-                        sides[next(i)].at(di, Sampling::linear) * si + sides[i].at(si, Sampling::linear) -
+    const Vec3 ribbon = sides[prev(i)].at(1.0 - di, Sampling::Linear) * (1.0 - si) +
+                        sides[next(i)].at(di, Sampling::Linear) * si + sides[i].at(si, Sampling::Linear) -
                         sides[i].start() * (1.0 - si) - sides[next(i)].start() * si;
     sum += ribbon * (blend[i] / blend_sum);
   }

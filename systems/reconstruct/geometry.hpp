@@ -20,7 +20,7 @@ double polyline_length(std::span<const Vec3> line);
 // parameter is closest, ties to the lower index), `linear` interpolates along the arc, `smooth` along the
 // cubic Hermite curve through the samples whose tangent at each is the derivative, in the arc parameter,
 // of the parabola through it and its two nearest samples (at the ends, the first or last three).
-enum class Sampling : uint8_t { nearest, linear, smooth };
+enum class Sampling : uint8_t { Nearest, Linear, Smooth };
 
 // The point at parameter t in [0, 1]; `params` are arc_parameters(line).
 Vec3 sample_polyline(std::span<const Vec3> line, std::span<const double> params, double t, Sampling mode);
@@ -39,11 +39,11 @@ std::vector<Vec3> straight_polyline(const Vec3& a, const Vec3& b, uint32_t segme
 // ---- triquadrification (thesis 6.1)
 
 enum class Planarity : uint8_t {
-  least_squares,  // 6.1.1: squared distances to the plane through the centroid whose normal is the
+  LeastSquares,   // 6.1.1: squared distances to the plane through the centroid whose normal is the
                   // singular vector of the covariance's smallest singular value
-  mean_normal,    // 6.1.2: squared distances to the plane through the centroid normal to the mean of
+  MeanNormal,     // 6.1.2: squared distances to the plane through the centroid normal to the mean of
                   // the four triangles' unit normals
-  hough,          // 6.1.3: spread of the four triangles' planes in the (theta, phi, rho) Hough space
+  Hough,          // 6.1.3: spread of the four triangles' planes in the (theta, phi, rho) Hough space
 };
 
 // How far four points are from lying in a plane, by `measure`; 0 for coplanar points.

@@ -69,7 +69,7 @@ struct ReconstructionCache {
   bool fit_built = false;
   std::vector<double> fit_shape;
   double fit_fairness = 0;  // the fairness it was built with (fit_fairness of the network's noise)
-  Sampling fit_targets = Sampling::smooth;  // and the reading of the polylines (exact or noisy curves)
+  Sampling fit_targets = Sampling::Smooth;  // and the reading of the polylines (exact or noisy curves)
   double noise = 0;         // noise_estimate of the network at the last refine (fire)
   bool fit_waiting = false;
   // The fit of `base` in progress (fire), between the frame that took the base and the one it ends in.
@@ -133,7 +133,7 @@ Vec3 leaving_direction(const Mesh& net, uint32_t e, uint32_t v, double deviation
     line.erase(line.begin(), line.begin() + static_cast<std::ptrdiff_t>(rest_end));
   }
   const std::vector<double> params = arc_parameters(line);
-  Vec3 d = sample_polyline(line, params, kTangentReach, Sampling::linear) - line.front();
+  Vec3 d = sample_polyline(line, params, kTangentReach, Sampling::Linear) - line.front();
   const double reach = kCornerReachNoises * deviation;
   for (size_t i = 1; d.norm() < reach && i < line.size() && params[i] <= 0.5; ++i)
     if ((line[i] - line.front()).norm() >= reach) d = line[i] - line.front();
@@ -141,7 +141,7 @@ Vec3 leaving_direction(const Mesh& net, uint32_t e, uint32_t v, double deviation
 }
 
 // How many degrees a curve turns passing through a vertex, from the directions its two sides leave it in.
-double turn_degrees(const Vec3& leaving, const Vec3& other_leaving) {
+double turn_deg(const Vec3& leaving, const Vec3& other_leaving) {
   return 180.0 - std::acos(std::clamp(leaving.dot(other_leaving), -1.0, 1.0)) * 180.0 / std::numbers::pi;
 }
 
@@ -158,7 +158,7 @@ bool border_corner(const Mesh& net, uint32_t v, double threshold_deg, double dev
     }
   if (count != 2) return true;
   auto turn = [&](double rest_deviation) {
-    return turn_degrees(leaving_direction(net, border[0], v, rest_deviation),
+    return turn_deg(leaving_direction(net, border[0], v, rest_deviation),
                         leaving_direction(net, border[1], v, rest_deviation));
   };
   return !(std::min(turn(0), deviation > 0 ? turn(deviation) : 180.0) <= threshold_deg);
@@ -258,7 +258,7 @@ double fit_fairness(const Options& options, double noise) {
   return std::max(fairness, std::min(kNoisyFairness * beyond * beyond, kNoisiestFairness));
 }
 
-Sampling fit_targets(double noise) { return noise > kExactCurveNoise ? Sampling::linear : Sampling::smooth; }
+Sampling fit_targets(double noise) { return noise > kExactCurveNoise ? Sampling::Linear : Sampling::Smooth; }
 
 double worst_quad_aspect(const BaseMesh& base) {
   double worst = 0;
@@ -298,7 +298,7 @@ Status check_reconstruction_input(const Mesh& net, const Options& options) {
   for (FaceIndex f{0}; f < net.face_slots(); ++f) {
     if (!net.face_alive(f)) continue;
     auto loop = net.face_loop(f);
-    if (options.method == Method::thesis && loop.size() < 3)
+    if (options.method == Method::Thesis && loop.size() < 3)
       return Status::failure("face " + std::to_string(f) + " has " + std::to_string(loop.size()) +
                              " edges; the thesis method needs at least 3 (use --method fire)");
     for (size_t i = 0; i < loop.size(); ++i)
@@ -507,7 +507,7 @@ bool joined_half(const std::vector<FaceSide>& face, size_t k) {
 // one step less than the faces' Coons steps, and a face that did not join it would have to split it.
 void plan_faces(const Mesh& net, const Options& options, const Sides& sides, double straight_turn,
                 std::vector<std::vector<FaceSide>>& all) {
-  if (options.method != Method::fire) return;
+  if (options.method != Method::Fire) return;
   std::vector<std::pair<double, uint32_t>> corners;  // (turn, the side the corner ends)
   for (std::vector<FaceSide>& face : all) {
     const uint32_t n = static_cast<uint32_t>(face.size());
@@ -519,7 +519,7 @@ void plan_faces(const Mesh& net, const Options& options, const Sides& sides, dou
       if (in.from == in.to || out.from == out.to || in.network_edge == out.network_edge) continue;
       if (std::max(in.length, out.length) > kLongSideRatio * std::min(in.length, out.length)) continue;
       const uint32_t v = in.reversed ? in.from : in.to;
-      const double turn = turn_degrees(leaving_direction(net, end_member(sides, in, v), v),
+      const double turn = turn_deg(leaving_direction(net, end_member(sides, in, v), v),
                                        leaving_direction(net, end_member(sides, out, v), v));
       if (turn <= straight_turn) corners.emplace_back(turn, k);
     }
@@ -557,7 +557,7 @@ void plan_faces(const Mesh& net, const Options& options, const Sides& sides, dou
 // kLongSideRatio of the mean side of every face it borders (at most kMaxSideDoublings).
 std::vector<uint32_t> side_depths(const Mesh& net, const Options& options, const std::vector<std::vector<FaceSide>>& all) {
   std::vector<uint32_t> depth(net.edge_slots(), options.coons_steps);
-  if (options.method != Method::fire) return depth;
+  if (options.method != Method::Fire) return depth;
   for (const std::vector<FaceSide>& face : all)
     for (size_t k = 0; k < face.size(); ++k)
       if (joined_half(face, k)) depth[face[k].network_edge] = options.coons_steps - 1;
@@ -590,7 +590,7 @@ void update_elements(const Mesh& net, const Options& options, ReconstructionCach
   c.face_valid.resize(net.face_slots(), 0);
   c.stats = {};
   c.face_joins.resize(net.face_slots());
-  build_sides(net, options.method == Method::fire && deviation > 0, c.sides);
+  build_sides(net, options.method == Method::Fire && deviation > 0, c.sides);
   const Sides& sides = c.sides;
   std::vector<std::vector<FaceSide>> all_sides = face_sides(net, sides, c);
   plan_faces(net, options, sides, straight_turn, all_sides);
@@ -691,7 +691,7 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
       vertex_id[v] = base.vertex_count();
       base.positions.push_back(net.vertices.position[v]);
       base.vertex_drawn.push_back(1);
-      if (options.method == Method::fire)
+      if (options.method == Method::Fire)
         base.border_corners.push_back(border_corner(net, v, corner_turn, deviation) ? 1 : 0);
     }
   for (EdgeIndex e{0}; e < net.edge_slots(); ++e) {
@@ -710,9 +710,9 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
   }
   auto id = [&](const VertexRef& r, uint32_t face) -> uint32_t {
     switch (r.kind) {
-      case RefKind::network_vertex: return vertex_id[r.index];
-      case RefKind::edge_point: return edge_first[r.index] + r.sub - 1;
-      case RefKind::interior: return face_first[face] + r.index;
+      case RefKind::NetworkVertex: return vertex_id[r.index];
+      case RefKind::EdgePoint: return edge_first[r.index] + r.sub - 1;
+      case RefKind::Interior: return face_first[face] + r.index;
     }
     return kNone;
   };
@@ -758,7 +758,7 @@ BaseMesh assemble(const Mesh& net, const Options& options, const ReconstructionC
       base.curve_drawn.push_back(0);
     }
   }
-  if (options.method == Method::fire) base.border_corners.resize(base.vertex_count(), 0);
+  if (options.method == Method::Fire) base.border_corners.resize(base.vertex_count(), 0);
   return base;
 }
 
@@ -840,7 +840,7 @@ Result<Refined> run_refine(const Mesh& net, const Options& options, Reconstructi
   // An unchanged network passed the check when it was last built (a failed one empties the cache).
   if (!everything && !c.pending_subdivide && !net.written_after(c.seen)) {
     c.stats = {};
-    return Refined::unchanged;
+    return Refined::Unchanged;
   }
   if (auto s = check_reconstruction_input(net, options); !s) return Result<Refined>::failure(s.error);
   c.built = false;
@@ -848,19 +848,19 @@ Result<Refined> run_refine(const Mesh& net, const Options& options, Reconstructi
   c.run = {};  // a fit of the previous base mesh is abandoned; subdivide starts one from the new
   // Noise turns a curve's first stretch too: a border turn within the spread of the curves' directions
   // where they meet is the noise's, not a corner (the pawn's border at 4 % correlated noise).
-  const double spread = options.method == Method::fire ? tangent_spread_deg(net) : 0.0;
+  const double spread = options.method == Method::Fire ? tangent_spread_deg(net) : 0.0;
   FitWeights weights;
   double deviation = 0;
-  if (options.method == Method::fire) {
+  if (options.method == Method::Fire) {
     const double mean_length = mean_curve_length(net);
     c.noise = options.fairness_from_noise ? fit_noise(noise_estimate(net, mean_length), spread) : 0;
     weights = fit_weights(options, c.noise);
     deviation = curve_noise_deviation(options, c.noise, spread, mean_length);
   }
   update_elements(net, options, c, everything, deviation, kStraightCornerTurn - spread);
-  c.base = assemble(net, options, c, kBorderCornerTurnDegrees + spread, deviation);
+  c.base = assemble(net, options, c, kBorderCornerTurnDeg + spread, deviation);
   c.rebuild_topology = c.rebuild_topology || everything || !same_topology(c, c.base);
-  if (options.method == Method::fire && c.fit_built &&
+  if (options.method == Method::Fire && c.fit_built &&
       (weights.fairness != c.fit_fairness || weights.targets != c.fit_targets ||
        shape_weights(c.base, weights) != c.fit_shape))
     c.fit_built = false;
@@ -868,7 +868,7 @@ Result<Refined> run_refine(const Mesh& net, const Options& options, Reconstructi
   c.seen = net.frame();
   c.compactions_seen = net.last_compaction().count;
   c.built = true;
-  return Refined::assembled;
+  return Refined::Assembled;
 }
 
 void evaluate_surface(ReconstructionCache& c, std::span<const Vec3> base_points, SurfaceMesh& surface) {
@@ -895,17 +895,17 @@ Result<SurfaceWrite> run_subdivide(const Options& options, ReconstructionCache& 
       c.rebuild_topology = false;
     }
     c.pending_subdivide = false;
-    if (options.method == Method::thesis) {
+    if (options.method == Method::Thesis) {
       evaluate_surface(c, c.base.positions, surface);
       c.settled_points = c.base.positions;
-      return SurfaceWrite::settled;
+      return SurfaceWrite::Settled;
     }
     // The fit starts from the base mesh's points, the transfinite patches': their surface is shown until
     // it ends. In the frame, that is all this call does: topology and limit stencils were its work.
     c.fit_waiting = true;
     if (!whole) {
       evaluate_surface(c, c.base.positions, surface);
-      return SurfaceWrite::provisional;
+      return SurfaceWrite::Provisional;
     }
   }
   if (c.fit_waiting) {
@@ -915,9 +915,9 @@ Result<SurfaceWrite> run_subdivide(const Options& options, ReconstructionCache& 
       if (auto s = build_fit(options, c); !s) return Result<SurfaceWrite>::failure(s.error);
     c.run = FitRun(c.fit, c.base);
     c.fit_waiting = false;
-    if (factorized && !whole) return SurfaceWrite::none;
+    if (factorized && !whole) return SurfaceWrite::None;
   }
-  if (!c.run.running() || !c.run.advance(fit_solves)) return SurfaceWrite::none;
+  if (!c.run.running() || !c.run.advance(fit_solves)) return SurfaceWrite::None;
   // Only the provisional surface and the settled one are written, not the fit's iterates between: each
   // write costs an evaluation and moves every vertex (a whole upload), and the iterates are no better a
   // preview (phase 2 creeps, and the fit keeps phase 2's or phase 3's solution only at its end).
@@ -926,7 +926,7 @@ Result<SurfaceWrite> run_subdivide(const Options& options, ReconstructionCache& 
   evaluate_surface(c, c.run.points(), surface);
   c.settled_points = c.run.points();
   c.run = {};
-  return SurfaceWrite::settled;
+  return SurfaceWrite::Settled;
 }
 
 }  // namespace

@@ -42,7 +42,7 @@ inline constexpr uint32_t kMaxCoonsSteps = 5;
 // too), the turn measured between the directions in which its two border curves leave it, each towards
 // its point kTangentReach of the curve's length away. Elsewhere the border runs smoothly through it
 // (thesis: a vertex where a curve merely goes on is no corner).
-inline constexpr double kBorderCornerTurnDegrees = 30.0;
+inline constexpr double kBorderCornerTurnDeg = 30.0;
 inline constexpr double kTangentReach = 0.15;
 // A noisy curve's border turn is read past the pen's rest at the vertex. Where two border strokes meet, the pen
 // rests between them, and a tracked pen drifts a millimetre while it rests: the curve's first dozens of samples
@@ -72,10 +72,10 @@ inline constexpr uint32_t kMaxSurfaceLevels = 6;
 inline constexpr uint32_t kWholeFit = UINT32_MAX;
 
 struct Options {
-  Method method = Method::fire;
+  Method method = Method::Fire;
   uint32_t coons_steps = 1;                        // N, 1 .. kMaxCoonsSteps
   uint32_t levels = 3;                             // L, 1 .. kMaxSurfaceLevels
-  Planarity planarity = Planarity::least_squares;  // the thesis's triquadrification measure
+  Planarity planarity = Planarity::LeastSquares;  // the thesis's triquadrification measure
   // FIRE: weight of the fit's fairness term (systems/reconstruct/fit.hpp), 0 to 1. It chooses the face
   // interiors the curves leave open; larger is smoother, smaller follows exactly representable data
   // more closely. With fairness_from_noise, the weight for exact curves: noisy ones raise it
@@ -264,19 +264,19 @@ Status reconstruct_update(const Mesh& net, const Options& options, Reconstructio
 
 // What a refine_update call did with the base mesh.
 enum class Refined : uint8_t {
-  unchanged,  // nothing changed since the last call: nothing was done
-  assembled,  // the base mesh was assembled anew and may differ from the last one
+  Unchanged,  // nothing changed since the last call: nothing was done
+  Assembled,  // the base mesh was assembled anew and may differ from the last one
 };
 
 // What a subdivide_update call wrote into its `surface`.
 enum class SurfaceWrite : uint8_t {
-  none,         // nothing new: `surface` is left as it was
-  provisional,  // the new base mesh's surface from its initial points (the transfinite patches); a fit runs
-  settled,      // the final surface, equal to a rebuild's bit for bit
+  None,         // nothing new: `surface` is left as it was
+  Provisional,  // the new base mesh's surface from its initial points (the transfinite patches); a fit runs
+  Settled,      // the final surface, equal to a rebuild's bit for bit
 };
 
 // reconstruct_update in the two halves the frame runs as systems. refine_update recomputes the changed
-// edges and faces and assembles the base mesh; it returns Refined::unchanged, doing nothing, when nothing
+// edges and faces and assembles the base mesh; it returns Refined::Unchanged, doing nothing, when nothing
 // changed since its last call (a new base mesh abandons a fit still running). subdivide_update then, for a new base
 // mesh, rebuilds topology and limit stencils where needed and evaluates into `surface` the new base
 // mesh's provisional surface (fire, unless the whole fit runs in the same call: kWholeFit). The next call

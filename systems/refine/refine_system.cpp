@@ -15,7 +15,7 @@ void refine_system(const Mesh& mesh, const reconstruct::Options& options, recons
     build.problem = changed.error();
     return;
   }
-  if (*changed == reconstruct::Refined::assembled) {
+  if (*changed == reconstruct::Refined::Assembled) {
     build.problem.clear();
     ++build.updates;
   }

@@ -21,13 +21,13 @@ void subdivide_system(const reconstruct::Options& options, const FrameTime& fram
     build.problem = wrote.error();
     return;
   }
-  if (*wrote == reconstruct::SurfaceWrite::none) return;
+  if (*wrote == reconstruct::SurfaceWrite::None) return;
   if (!assign_quads(mesh, frame.index, surface)) {
     build.problem = "internal error: the subdivided surface has a face that is not a quad";
     return;
   }
   surface.level = options.levels;
-  surface.settled = *wrote == reconstruct::SurfaceWrite::settled;
+  surface.settled = *wrote == reconstruct::SurfaceWrite::Settled;
   // Each base face of n corners has n * 4^(L-1) consecutive last-level quads, in base face order, so a
   // network face's quads are one range: its patch.
   const reconstruct::BaseMesh& base = build.state.base();

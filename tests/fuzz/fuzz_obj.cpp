@@ -44,7 +44,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   surface.positions = mesh->positions;
   surface.face_offsets = mesh->face_offsets;
   surface.face_vertices = mesh->face_vertices;
-  const Result<std::string> written = encode_surface(surface, SurfaceFormat::obj, fuzz::kSource, LengthUnit::m);
+  const Result<std::string> written = encode_surface(surface, SurfaceFormat::Obj, fuzz::kSource, LengthUnit::Metre);
   FUZZ_CHECK(written.ok(), "a parsed mesh can be written");
   const Result<PolygonMesh> again = parse_obj(*written, fuzz::kSource);
   FUZZ_CHECK(again.ok(), "a written mesh parses");

@@ -1,6 +1,6 @@
-// PLY surface reader (decode_surface with SurfaceFormat::ply); properties in fuzz_surface.hpp.
+// PLY surface reader (decode_surface with SurfaceFormat::Ply); properties in fuzz_surface.hpp.
 #include "tests/fuzz/fuzz_surface.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  return fire::fuzz::fuzz_surface(data, size, fire::SurfaceFormat::ply);
+  return fire::fuzz::fuzz_surface(data, size, fire::SurfaceFormat::Ply);
 }

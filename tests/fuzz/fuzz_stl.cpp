@@ -1,6 +1,6 @@
-// STL surface reader (decode_surface with SurfaceFormat::stl); properties in fuzz_surface.hpp.
+// STL surface reader (decode_surface with SurfaceFormat::Stl); properties in fuzz_surface.hpp.
 #include "tests/fuzz/fuzz_surface.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  return fire::fuzz::fuzz_surface(data, size, fire::SurfaceFormat::stl);
+  return fire::fuzz::fuzz_surface(data, size, fire::SurfaceFormat::Stl);
 }

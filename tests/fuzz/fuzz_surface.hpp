@@ -37,7 +37,7 @@ inline int fuzz_surface(const uint8_t* data, size_t size, SurfaceFormat format) 
     return 0;
   }
   check_surface_invariants(*surface);
-  const Result<std::string> written = encode_surface(*surface, format, kSource, LengthUnit::m);
+  const Result<std::string> written = encode_surface(*surface, format, kSource, LengthUnit::Metre);
   FUZZ_CHECK(written.ok(), "a decoded surface can be written in its format");
   const Result<SurfaceMesh> again = decode_surface(*written, format, kSource);
   FUZZ_CHECK(again.ok(), "a written surface decodes");

@@ -271,10 +271,10 @@ void report(const char* what, int runs, size_t lost, const std::string& covered,
 
 TEST_CASE("a session's settings keep every surface option, and one out of range is refused by name", "[session]") {
   World w;
-  w.surface_options.method = reconstruct::Method::thesis;
+  w.surface_options.method = reconstruct::Method::Thesis;
   w.surface_options.coons_steps = 3;
   w.surface_options.levels = 2;
-  w.surface_options.planarity = reconstruct::Planarity::hough;
+  w.surface_options.planarity = reconstruct::Planarity::Hough;
   w.surface_options.fairness = 0.25;
   w.surface_options.fairness_from_noise = false;
   const std::string text = settings_json(w);

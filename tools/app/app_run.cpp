@@ -164,7 +164,7 @@ int run_app(const AppOptions& a) {
     if (auto format = surface_format_of(a.export_path); !format)
       return fail("--export: " + format.error() + ", or .step, .stp, .igs or .iges for CAD");
   if (a.reference_levels < 0 || a.reference_levels > 5) return fail("--reference-levels must be 0 to 5");
-  if (!(a.snap_pixels > 0) || a.snap_pixels > 200) return fail("--snap-pixels must be above 0 and at most 200");
+  if (!(a.snap_px > 0) || a.snap_px > 200) return fail("--snap-pixels must be above 0 and at most 200");
   // The reference as drawn on: its Catmull-Clark limit surface (a control mesh), or its faces as fans (level 0).
   evaluate::TriangleMesh reference;
   if (!a.reference_path.empty()) {
@@ -309,7 +309,7 @@ int run_app(const AppOptions& a) {
     e.kind = kind;
     app.log_event(std::move(e));
   };
-  MousePen pen(app, reference.triangles.empty() ? nullptr : &reference_bvh, a.snap_pixels);
+  MousePen pen(app, reference.triangles.empty() ? nullptr : &reference_bvh, a.snap_px);
   bool dragging = false, panning = false, drawing = false;
   glm::vec2 cursor(0.0f);
   uint64_t display_frame = 0;

@@ -20,7 +20,7 @@ struct AppOptions {
   reconstruct::Options surface;
   bool surface_given = false;  // a surface option given on the command line
   int reference_levels = 3;
-  double snap_pixels = 12;
+  double snap_px = 12;
   bool live = false;
   AppLiveOptions live_options;
 };

@@ -139,8 +139,8 @@ bool AppWindow::display(const render::Orbit& orbit, render::Image* capture) {
     return false;
   }
   if (status_ = hud_->status(); !status_) return false;
-  if (*shown == render::Presented::swapchain_stale) status_ = presenter_->resize(width_, height_);
-  return *shown == render::Presented::shown;
+  if (*shown == render::Presented::SwapchainStale) status_ = presenter_->resize(width_, height_);
+  return *shown == render::Presented::Shown;
 }
 
 }  // namespace fire::app

@@ -75,7 +75,7 @@ Result<SimulatedBlobs> simulated_wand(uint64_t seed, const LiveWandOptions& o) {
   rig.seed = seed;
   rig.rig_seed = seed;
   simulation::WandOptions wand;
-  wand.duration_s = o.max_seconds;
+  wand.duration_s = o.max_s;
   wand.length_m = o.wand_length_m;
   auto session = simulation::simulate_wand(rig, wand);
   if (!session) return Result<SimulatedBlobs>::failure("--fake-rig: " + session.error());
@@ -159,7 +159,7 @@ Result<std::vector<InputEvent>> record_live_wand(const LiveWandOptions& o) {
       next_progress_ns += 1'000'000'000;
     }
     if (coverage.enough(o)) stop = "both cameras have seen enough of the wand";
-    else if (double(now - start_ns) * 1e-9 >= o.max_seconds) stop = "time is up (--max-seconds)";
+    else if (double(now - start_ns) * 1e-9 >= o.max_s) stop = "time is up (--max-seconds)";
     else if (key_pressed()) stop = "stopped by a key";
     if (!live.status()) return R::failure(live.status().error);
   }

@@ -14,7 +14,7 @@ namespace fire::app {
 struct LiveWandOptions {
   std::string session_dir;  // a new session folder: the reports are recorded there as they arrive
   double wand_length_m = 0.3;  // logged as `meta wand_length_m`, which the offline command reads back
-  double max_seconds = 120;    // stops after this long
+  double max_s = 120;    // stops after this long
   double coverage = 0.5;       // stops once each camera's wand blobs have covered this share of its image...
   size_t samples = 1500;       // ... in at least this many reports showing both LEDs
   // Test and simulation hook: no hardware; two fake remotes (platform/wiimote/fake_remote.hpp) on a fake

@@ -8,8 +8,8 @@
 
 namespace fire::app {
 
-MousePen::MousePen(AppWindow& app, const evaluate::TriangleBvh* reference, double snap_pixels)
-    : app_(app), reference_(reference), snap_pixels_(snap_pixels) {}
+MousePen::MousePen(AppWindow& app, const evaluate::TriangleBvh* reference, double snap_px)
+    : app_(app), reference_(reference), snap_px_(snap_px) {}
 
 std::pair<Vec3, Vec3> MousePen::cursor_ray(glm::vec2 pixel) const {
   const render::Camera& camera = app_.camera();
@@ -79,7 +79,7 @@ bool MousePen::sample(glm::vec2 pixel) {
   e.kind = EventKind::Pen;
   e.p = *hit;
   const glm::vec3 p(float(hit->x()), float(hit->y()), float(hit->z()));
-  e.snap = snap_pixels_ * double(render::pixel_size_at(app_.camera(), p, app_.height()));
+  e.snap = snap_px_ * double(render::pixel_size_at(app_.camera(), p, app_.height()));
   app_.log_event(std::move(e));
   return true;
 }

@@ -68,7 +68,7 @@ std::string settings_json(const World& w) {
   j["snap_distance"] = w.sketch_settings.snap_distance;
   j["close_samples"] = w.sketch_settings.close_samples;
   j["surface"] = w.build_surface;
-  j["method"] = w.surface_options.method == reconstruct::Method::fire ? "fire" : "thesis";
+  j["method"] = w.surface_options.method == reconstruct::Method::Fire ? "fire" : "thesis";
   j["coons_steps"] = w.surface_options.coons_steps;
   j["levels"] = w.surface_options.levels;
   j["planarity"] = static_cast<int>(w.surface_options.planarity);
@@ -98,10 +98,10 @@ Status apply_settings_json(std::string_view text, const std::string& source, Wor
   const uint64_t close = j["close_samples"], coons = j["coons_steps"], levels = j["levels"], planarity = j["planarity"];
   const std::string method = j["method"];
   if (!(snap > 0) || close < 2 || close > 1'000'000 || (method != "fire" && method != "thesis") ||
-      coons > UINT32_MAX || levels > UINT32_MAX || planarity > static_cast<uint64_t>(reconstruct::Planarity::hough))
+      coons > UINT32_MAX || levels > UINT32_MAX || planarity > static_cast<uint64_t>(reconstruct::Planarity::Hough))
     return fail("a setting is out of range");
   reconstruct::Options surface = w.surface_options;
-  surface.method = method == "fire" ? reconstruct::Method::fire : reconstruct::Method::thesis;
+  surface.method = method == "fire" ? reconstruct::Method::Fire : reconstruct::Method::Thesis;
   surface.coons_steps = static_cast<uint32_t>(coons);
   surface.levels = static_cast<uint32_t>(levels);
   surface.planarity = static_cast<reconstruct::Planarity>(planarity);

@@ -63,7 +63,7 @@ void add_app_commands(CLI::App& app, Registry& registry) {
                   "the reference as its Catmull-Clark limit surface at this level (so strokes lie on the surface "
                   "fire eval measures against); 0: its faces as they are")
       ->capture_default_str();
-  cmd->add_option("--snap-pixels", o.snap_pixels,
+  cmd->add_option("--snap-pixels", o.snap_px,
                   "snap radius of the mouse pen in screen pixels, converted to model units at each sample")
       ->capture_default_str();
   cmd->add_option("-o,--output", o.out_path, "where Ctrl+S saves the network (default: INPUT-app.fnet beside the "

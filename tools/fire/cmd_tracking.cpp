@@ -212,7 +212,7 @@ int run_simulate_drawing(const SimulateArgs& a) {
   placed_object.sharp_edges = tags->sharp_edges;
   placed_object.border_corners = tags->border_corners;
   const Result<std::string> object =
-      encode_cage_obj(placed_object, LengthUnit::m, options.mesh_name + " scaled to " + format_double(options.height_m) +
+      encode_cage_obj(placed_object, LengthUnit::Metre, options.mesh_name + " scaled to " + format_double(options.height_m) +
                                                         " m along +z, its base's centre at the origin (metres, the object's frame)");
   if (!object) return fail(command, mesh_path + ": " + object.error());
   // Nothing is written unless everything can be: the log last, so a log never comes without its marks.
@@ -327,7 +327,7 @@ int run_calibrate(const CalibrateArgs& a) {
   if (a.live && a.live_options.session_dir.empty())
     return fail(command, "--live records the remotes' reports into a new session folder: give --session DIR");
   // Bounded: the fake rig simulates the whole stretch before it starts.
-  if (a.live && !(a.live_options.max_seconds > 0 && a.live_options.max_seconds <= 3600))
+  if (a.live && !(a.live_options.max_s > 0 && a.live_options.max_s <= 3600))
     return fail(command, "--max-seconds must be more than 0 and at most 3600");
   std::vector<std::string> notes;
   Result<InputLog> log = wand_log(a, notes);
@@ -616,7 +616,7 @@ void add_tracking_commands(CLI::App& app, Registry& registry) {
               "camera's progress on stderr; stops when both have seen enough of it (--coverage, --samples), on Enter, or "
               "after --max-seconds; then calibrates from the recorded reports as fire calibrate DIR would");
   c->add_option("--session", cal->live_options.session_dir, "--live: the new session folder to record into");
-  c->add_option("--max-seconds", cal->live_options.max_seconds, "--live: stop after this long")->capture_default_str();
+  c->add_option("--max-seconds", cal->live_options.max_s, "--live: stop after this long")->capture_default_str();
   c->add_option("--coverage", cal->live_options.coverage,
                 "--live: share of each camera's image (an 8 x 6 grid) the wand's LEDs must have crossed")
       ->check(CLI::Range(0.0, 1.0))

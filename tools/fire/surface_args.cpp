@@ -30,12 +30,12 @@ bool surface_options_given(const CLI::App& cmd) {
 Result<reconstruct::Options> surface_options(const SurfaceArgs& a, const CLI::App& cmd) {
   using R = Result<reconstruct::Options>;
   reconstruct::Options options;
-  if (a.method == "fire") options.method = reconstruct::Method::fire;
-  else if (a.method == "thesis") options.method = reconstruct::Method::thesis;
+  if (a.method == "fire") options.method = reconstruct::Method::Fire;
+  else if (a.method == "thesis") options.method = reconstruct::Method::Thesis;
   else return R::failure("--method must be thesis or fire, not '" + a.method + "'");
-  if (a.planarity == "least-squares") options.planarity = reconstruct::Planarity::least_squares;
-  else if (a.planarity == "mean-normal") options.planarity = reconstruct::Planarity::mean_normal;
-  else if (a.planarity == "hough") options.planarity = reconstruct::Planarity::hough;
+  if (a.planarity == "least-squares") options.planarity = reconstruct::Planarity::LeastSquares;
+  else if (a.planarity == "mean-normal") options.planarity = reconstruct::Planarity::MeanNormal;
+  else if (a.planarity == "hough") options.planarity = reconstruct::Planarity::Hough;
   else return R::failure("--planarity must be least-squares, mean-normal or hough, not '" + a.planarity + "'");
   options.coons_steps = a.coons_steps;
   options.levels = a.levels;
@@ -55,9 +55,9 @@ void add_units_option(CLI::App& cmd, std::string& units) {
 Result<LengthUnit> export_unit(const std::string& units, const CLI::App& cmd, const std::vector<std::string>& paths) {
   auto unit = length_unit_of(units);
   if (!unit) return Result<LengthUnit>::failure("--units: " + unit.error());
-  if (cmd.count("--units") > 0 && *unit != LengthUnit::m)
+  if (cmd.count("--units") > 0 && *unit != LengthUnit::Metre)
     for (const std::string& path : paths)
-      if (auto format = surface_format_of(path); format && *format == SurfaceFormat::glb)
+      if (auto format = surface_format_of(path); format && *format == SurfaceFormat::Glb)
         return Result<LengthUnit>::failure("--units " + units + " cannot apply to " + path +
                                            ": a glTF file is in metres by its specification");
   return unit;

@@ -381,7 +381,7 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
     // share fewer than 3 marks off one line, the person sticks more on where both show them.
     int from = -1;
     for (const PlanStep& step : plan) {
-      if (step.kind != PlanStep::Register) continue;
+      if (step.kind != PlanStep::Kind::Register) continue;
       if (from >= 0 && from != step.pose) add_shared_marks(*rig, poses[size_t(from)], poses[size_t(step.pose)], net, top, marks);
       from = step.pose;
     }
@@ -435,7 +435,7 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
   for (const PlanStep& step : plan) {
     const Pose& placed = poses[static_cast<size_t>(step.pose)];
     switch (step.kind) {
-      case PlanStep::Register: {
+      case PlanStep::Kind::Register: {
         const std::vector<uint32_t>& seen_here = marks_seen[static_cast<size_t>(step.pose)];
         auto is_measured = [&](uint32_t m) { return std::find(measured.begin(), measured.end(), m) != measured.end(); };
         if (!first && d.measure_marks) {
@@ -493,7 +493,7 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
         if (!to_measure.empty()) travel_to(pen, 0.3);
         break;
       }
-      case PlanStep::Stroke: {
+      case PlanStep::Kind::Stroke: {
         std::vector<Vec3> world;
         for (const Vec3& p : step.points) world.push_back(placed(p));
         Polyline path = make_polyline(std::move(world));
@@ -508,15 +508,15 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
         ++stats.strokes;
         break;
       }
-      case PlanStep::Undo:
+      case PlanStep::Kind::Undo:
         travel_to(pen, kUndoWait_s);
         command(t, CommandKind::Undo);
         ++stats.undos;
         break;
-      case PlanStep::Hole:
-      case PlanStep::Sharp: {
+      case PlanStep::Kind::Hole:
+      case PlanStep::Kind::Sharp: {
         // The pen touches the face to open or the curve to mark sharp, unlit, and the pad's button is pressed.
-        const bool hole = step.kind == PlanStep::Hole;
+        const bool hole = step.kind == PlanStep::Kind::Hole;
         travel_to(placed(step.points.front()), kTravel_s);
         hold(d.mark_hold_s);
         command(t - 0.2, hole ? CommandKind::Hole : CommandKind::Sharp, 0, step.points.front());
@@ -550,7 +550,7 @@ Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOpti
                                   std::to_string(stats.curves_drawn) + "/" + std::to_string(stats.curves_total) +
                                   " speed_m_s=" + format_double(d.speed_m_s));
   SimulatedDrawing out;
-  out.session = run_session(o, kDrawingScenario, *rig, duration, scene, occluded, std::move(header), commands);
+  out.session = run_session(o, Scenario::Drawing, *rig, duration, scene, occluded, std::move(header), commands);
   out.session.stats.strokes = stats.strokes;
   out.marks = marks;
   out.drawing = stats;

@@ -579,8 +579,8 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
                                format_mm(kShortestStroke) + " a tracked pen draws");
       }
     for (size_t k = 0; k < best_strokes.size(); ++k) {
-      if (steps.empty() || best->second[k] != steps.back().pose) steps.push_back({PlanStep::Register, best->second[k], {}});
-      steps.push_back({PlanStep::Stroke, best->second[k], chain_points(net, best_strokes[k])});
+      if (steps.empty() || best->second[k] != steps.back().pose) steps.push_back({PlanStep::Kind::Register, best->second[k], {}});
+      steps.push_back({PlanStep::Kind::Stroke, best->second[k], chain_points(net, best_strokes[k])});
     }
     plan.border_strokes += static_cast<int>(border.size());
     for (const Chain& c : border) drawing.draw(c);
@@ -734,7 +734,7 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
       const std::vector<Vec3> rim = chain_points(net, g.caps[cap - g.faces]);
       Vec3 centre = Vec3::Zero();
       for (const Vec3& p : rim) centre += p;
-      steps.push_back({PlanStep::Hole, pose, {centre / static_cast<double>(rim.size())}});
+      steps.push_back({PlanStep::Kind::Hole, pose, {centre / static_cast<double>(rim.size())}});
       drawing.surface[cap] = 0;
       drawing.opened[cap] = 1;
       ++plan.holes;
@@ -824,7 +824,7 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
       candidates = chains(kMaxLegsStuck);
       pick = choose(candidates);
     }
-    const auto strokes = std::count_if(steps.begin(), steps.end(), [](const PlanStep& s) { return s.kind == PlanStep::Stroke; });
+    const auto strokes = std::count_if(steps.begin(), steps.end(), [](const PlanStep& s) { return s.kind == PlanStep::Kind::Stroke; });
     if (max_strokes > 0 && strokes >= max_strokes) break;
     if (!pick && next_part < parts->size()) {
       // This part is done as far as it can be: the next one starts with its border, apart from the rest.
@@ -869,9 +869,9 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
     }
     const std::vector<Vec3> points = chain_points(net, pick->chain);
     for (const Piece& piece : pick->pieces) {
-      if (piece.pose != pose) steps.push_back({PlanStep::Register, piece.pose, {}});
+      if (piece.pose != pose) steps.push_back({PlanStep::Kind::Register, piece.pose, {}});
       pose = piece.pose;
-      steps.push_back({PlanStep::Stroke, pose, {points.begin() + static_cast<std::ptrdiff_t>(piece.first), points.begin() + static_cast<std::ptrdiff_t>(piece.last) + 1}});
+      steps.push_back({PlanStep::Kind::Stroke, pose, {points.begin() + static_cast<std::ptrdiff_t>(piece.first), points.begin() + static_cast<std::ptrdiff_t>(piece.last) + 1}});
     }
     plan.pieces += static_cast<int>(pick->pieces.size()) - 1;
     const uint32_t from = drawing.loop[chain_start(net, pick->chain)], to = drawing.loop[chain_end(net, pick->chain)];
@@ -889,7 +889,7 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
     drawing.end_vertex[chain_start(net, pick->chain)] = drawing.end_vertex[chain_end(net, pick->chain)] = 1;
     if (++splits == undo_after) {
       PlanStep again = steps.back();
-      steps.push_back({PlanStep::Undo, pose, {}});
+      steps.push_back({PlanStep::Kind::Undo, pose, {}});
       steps.push_back(std::move(again));
     }
   }
@@ -914,7 +914,7 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
   for (uint32_t k : longest)
     if (k != kNoLoop) {
       const std::vector<Vec3>& points = net.curves[k].points;
-      steps.push_back({PlanStep::Sharp, steps.back().pose, {points[points.size() / 2]}});
+      steps.push_back({PlanStep::Kind::Sharp, steps.back().pose, {points[points.size() / 2]}});
       ++plan.sharp;
     }
   plan.curves_drawn = static_cast<size_t>(std::count(drawing.curve.begin(), drawing.curve.end(), 1));

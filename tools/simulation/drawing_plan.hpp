@@ -23,7 +23,7 @@ namespace fire::simulation {
 std::vector<Vec3> chain_points(const DrawingNetwork& net, const Chain& chain);
 
 struct PlanStep {
-  enum Kind { Register, Stroke, Undo, Hole, Sharp } kind;
+  enum class Kind { Register, Stroke, Undo, Hole, Sharp } kind;
   int pose = 0;
   // Stroke: the pen's path (object frame); Hole: one point, where the pen touches the face; Sharp: one point, where
   // it touches the curve.

@@ -125,7 +125,7 @@ double largest_surface_difference(const cad::CadShapeInfo& info, const fire::Bsp
 // Writes and reads back each format: valid, one face per patch, in `units`, the box the patches span, the
 // surfaces equal to the patches.
 std::vector<cad::CadShapeInfo> round_trip(const fire::BsplinePatches& patches, const std::string& stem,
-                                          fire::LengthUnit units = fire::LengthUnit::mm,
+                                          fire::LengthUnit units = fire::LengthUnit::Millimetre,
                                           const std::vector<std::string>& extensions = {".step", ".igs"}) {
   const double scale = fire::units_per_metre(units);
   const Box box = control_box(patches);
@@ -213,7 +213,7 @@ TEST_CASE("the pawn read back from STEP lies on FIRE's limit surface within the 
 TEST_CASE("the egg, a closed object, is one solid in both formats, in mm or cm", "[cad]") {
   fire::test::TempDir dir;
   const sd::BsplineConversion c = patches_of(cage_of("egg"));
-  for (const fire::LengthUnit units : {fire::LengthUnit::mm, fire::LengthUnit::cm}) {
+  for (const fire::LengthUnit units : {fire::LengthUnit::Millimetre, fire::LengthUnit::Centimetre}) {
     // round_trip checks the unit the file states and the box in it: 1000 or 100 times the metres.
     for (const cad::CadShapeInfo& info :
          round_trip(c.patches, (dir.path / ("egg-" + std::string(fire::unit_name(units)))).string(), units)) {
@@ -233,7 +233,7 @@ TEST_CASE("the rook, with its triangles and extraordinary vertices of valence 3 
   const sd::BsplineConversion c = patches_of(cage_of("rook"));
   REQUIRE(c.fit_level >= 2);
   for (const cad::CadShapeInfo& info :
-       round_trip(c.patches, (dir.path / "rook").string(), fire::LengthUnit::mm, {".step"})) {
+       round_trip(c.patches, (dir.path / "rook").string(), fire::LengthUnit::Millimetre, {".step"})) {
     CHECK(info.shells == 1);
     CHECK(info.solids == 0);
   }
@@ -306,10 +306,10 @@ TEST_CASE("without OpenCASCADE, asking for STEP says FIRE was built without it",
 #endif
 
 TEST_CASE("CAD formats are known by their extensions, in any case", "[cad]") {
-  CHECK(*cad::cad_format_of("a/b.STP") == cad::CadFormat::step);
-  CHECK(*cad::cad_format_of("b.step") == cad::CadFormat::step);
-  CHECK(*cad::cad_format_of("b.iges") == cad::CadFormat::iges);
-  CHECK(*cad::cad_format_of("b.Igs") == cad::CadFormat::iges);
+  CHECK(*cad::cad_format_of("a/b.STP") == cad::CadFormat::Step);
+  CHECK(*cad::cad_format_of("b.step") == cad::CadFormat::Step);
+  CHECK(*cad::cad_format_of("b.iges") == cad::CadFormat::Iges);
+  CHECK(*cad::cad_format_of("b.Igs") == cad::CadFormat::Iges);
   auto stl = cad::cad_format_of("b.stl");
   REQUIRE_FALSE(stl.ok());
   CHECK(contains(stl.error(), "b.stl"));

@@ -127,8 +127,8 @@ TEST_CASE("the demo network renders as expected from two views, with the surface
   INFO(renderer.error());
   REQUIRE(renderer);
   const Scene scene = demo_scene();
-  for (View view : {View::iso, View::top}) {
-    const std::string name = view == View::iso ? "sketch_iso.png" : "sketch_top.png";
+  for (View view : {View::Iso, View::Top}) {
+    const std::string name = view == View::Iso ? "sketch_iso.png" : "sketch_top.png";
     SECTION(name) {
       const Image image = render_scene(*context, **renderer, scene, view);
       check_expected(image, name);
@@ -174,7 +174,7 @@ TEST_CASE("the demo network renders as expected from two views, with the surface
       const double coverage = double(covered) / double(inside);
       INFO("coverage " << coverage << ", curve pixels " << curve << " (" << curve_inside << " inside), marker pixels "
                        << marker);
-      CHECK(coverage > (view == View::top ? 0.9 : 0.45));
+      CHECK(coverage > (view == View::Top ? 0.9 : 0.45));
       CHECK(coverage <= 1.0);
       // Curves are visible over the surface, not only along its border.
       CHECK(curve > kWidth * kHeight / 100);
@@ -195,7 +195,7 @@ TEST_CASE("a pending piece of a stroke is drawn in the stroke's colour, not as a
       for (uint32_t x = 0; x < kWidth; ++x) n += near(image.pixel(x, y), Palette::stroke, 30);
     return n;
   };
-  CHECK(stroke_pixels(render_scene(*context, **renderer, scene, View::top)) == 0);
+  CHECK(stroke_pixels(render_scene(*context, **renderer, scene, View::Top)) == 0);
   // From the middle of a curve a fifth of the object's width outwards, as a stroke that ended off the network.
   Mesh& net = scene.network;
   EdgeIndex curve{0};
@@ -210,7 +210,7 @@ TEST_CASE("a pending piece of a stroke is drawn in the stroke's colour, not as a
   const EdgeIndex e = net.add_edge(net.add_vertex(from), net.add_vertex(to), piece);
   net.set_edge_flag(e, kPendingEdge, true);
   REQUIRE(net.validate() == "");
-  const Image image = render_scene(*context, **renderer, scene, View::top);
+  const Image image = render_scene(*context, **renderer, scene, View::Top);
   const size_t pending = stroke_pixels(image);
   INFO("pixels in the stroke's colour " << pending);
   CHECK(pending > 30);
@@ -303,7 +303,7 @@ TEST_CASE("uploads copy only what changed and the image equals a fresh upload's"
   CHECK(r.last_upload().surface_vertices <= 4);
   CHECK(r.last_upload().bytes == 24ull * r.last_upload().surface_vertices);
 
-  const Camera camera = frame_box(box_of(scene), View::iso, kWidth, kHeight);
+  const Camera camera = frame_box(box_of(scene), View::Iso, kWidth, kHeight);
   REQUIRE(r.draw(camera));
   const Image after_edits = r.image();
   auto fresh = Renderer::create(*context, {kWidth, kHeight});
@@ -343,7 +343,7 @@ TEST_CASE("samples per pixel: by device, by setting or by FIRE_SAMPLES, 4x draws
   RenderSettings one_sample{kWidth, kHeight, 1};
   auto one = Renderer::create(*context, one_sample);
   REQUIRE(one);
-  const Image a = render_scene(*context, **one, scene, View::iso), b = render_scene(*context, **four, scene, View::iso);
+  const Image a = render_scene(*context, **one, scene, View::Iso), b = render_scene(*context, **four, scene, View::Iso);
   size_t differing = 0;
   for (size_t i = 0; i < a.rgba.size(); i += 4)
     for (int k = 0; k < 3; ++k)
@@ -363,7 +363,7 @@ TEST_CASE("drawn in a window's B8G8R8A8_SRGB, the image reads back as the RGBA o
   auto bgra = Renderer::create(*context, {kWidth, kHeight, 1, VK_FORMAT_B8G8R8A8_SRGB});
   REQUIRE(rgba);
   REQUIRE(bgra);
-  CHECK(render_scene(*context, **bgra, scene, View::iso).rgba == render_scene(*context, **rgba, scene, View::iso).rgba);
+  CHECK(render_scene(*context, **bgra, scene, View::Iso).rgba == render_scene(*context, **rgba, scene, View::Iso).rgba);
   CHECK_FALSE(Renderer::create(*context, {kWidth, kHeight, 1, VK_FORMAT_R8G8B8A8_UNORM}));
 }
 
@@ -375,7 +375,7 @@ TEST_CASE("a provisional surface is tinted, a settled one is neutral grey") {
   scene.network = Mesh{};  // the surface alone
   auto mean_tint = [&](bool settled) {
     scene.surface.settled = settled;
-    const Image image = render_scene(*context, **renderer, scene, View::top);
+    const Image image = render_scene(*context, **renderer, scene, View::Top);
     double blue_minus_red = 0;
     size_t n = 0;
     for (uint32_t y = 0; y < kHeight; ++y)
@@ -399,7 +399,7 @@ TEST_CASE("the pen's feedback: the face under the pen tinted, the snap target an
   REQUIRE(renderer);
   Renderer& r = **renderer;
   Scene scene = demo_scene();
-  const Camera camera = frame_box(box_of(scene), View::top, kWidth, kHeight);
+  const Camera camera = frame_box(box_of(scene), View::Top, kWidth, kHeight);
   auto draw = [&](const Mesh& network, const PenFeedback& feedback) {
     REQUIRE(r.upload(network, scene.surface));
     REQUIRE(r.set_pen_feedback(network, feedback));
@@ -471,8 +471,8 @@ TEST_CASE("a still frame is not drawn again: its layer is copied and the stroke 
   REQUIRE(renderer);
   Renderer& r = **renderer;
   Scene scene = demo_scene();
-  const Camera camera = frame_box(box_of(scene), View::iso, kWidth, kHeight);
-  const Camera elsewhere = frame_box(box_of(scene), View::top, kWidth, kHeight);
+  const Camera camera = frame_box(box_of(scene), View::Iso, kWidth, kHeight);
+  const Camera elsewhere = frame_box(box_of(scene), View::Top, kWidth, kHeight);
   const Mesh& net = scene.network;
   FaceIndex face{0};
   while (!net.face_alive(face)) ++face;
@@ -548,7 +548,7 @@ TEST_CASE("framing keeps every corner of the box inside the image") {
   Box box;
   box.add(Vec3(-1, -2, 0));
   box.add(Vec3(3, 1, 0.5));
-  for (View view : {View::iso, View::front, View::top, View::side, View::bottom}) {
+  for (View view : {View::Iso, View::Front, View::Top, View::Side, View::Bottom}) {
     const Camera camera = frame_box(box, view, 640, 360);
     for (int c = 0; c < 8; ++c) {
       const Vec3 p((c & 1) ? 3 : -1, (c & 2) ? 1 : -2, (c & 4) ? 0.5 : 0);
@@ -560,8 +560,8 @@ TEST_CASE("framing keeps every corner of the box inside the image") {
     }
   }
   // Top and bottom look from above and from below.
-  CHECK(frame_box(box, View::top, 640, 360).eye.z > 0.5f);
-  CHECK(frame_box(box, View::bottom, 640, 360).eye.z < 0.0f);
+  CHECK(frame_box(box, View::Top, 640, 360).eye.z > 0.5f);
+  CHECK(frame_box(box, View::Bottom, 640, 360).eye.z < 0.0f);
 }
 
 TEST_CASE("the app's orbit camera: a ray through a pixel lands on it, pixel sizes, pan, zoom and pitch") {

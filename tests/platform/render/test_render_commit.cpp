@@ -153,7 +153,7 @@ TEST_CASE("a one-curve commit copies the triangles of the patches it changed and
         for (const Vec3& p : w.surface.positions) box.add(p);
         return box;
       }(),
-      View::iso, r.width(), r.height());
+      View::Iso, r.width(), r.height());
   REQUIRE(r.draw(camera));
   const Image incremental = r.image();
   auto fresh = Renderer::create(**context, {320, 180});

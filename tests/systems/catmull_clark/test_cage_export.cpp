@@ -106,7 +106,7 @@ TEST_CASE("the exported USDA cage's OpenSubdiv limit is FIRE's surface", "[cage]
     const Cage cage = pawn_cage(crease);
     CHECK(!cage.border_corners.empty());
     CHECK((cage.sharp_edges.size() > 0) == crease);
-    auto text = fire::encode_cage_usda(cage, fire::LengthUnit::mm);
+    auto text = fire::encode_cage_usda(cage, fire::LengthUnit::Millimetre);
     REQUIRE(text.ok());
     CHECK(text->find("metersPerUnit = 0.001") != std::string::npos);
     CHECK(text->find("interpolateBoundary = \"edgeOnly\"") != std::string::npos);
@@ -126,7 +126,7 @@ TEST_CASE("the exported USDA cage's OpenSubdiv limit is FIRE's surface", "[cage]
 
 TEST_CASE("the exported OBJ cage carries OpenSubdiv's tags for its border, creases and corners", "[cage]") {
   const Cage cage = pawn_cage(true);
-  auto text = fire::encode_cage_obj(cage, fire::LengthUnit::m);
+  auto text = fire::encode_cage_obj(cage, fire::LengthUnit::Metre);
   REQUIRE(text.ok());
   auto polygons = fire::parse_obj(*text, "cage.obj");
   REQUIRE(polygons.ok());

@@ -41,10 +41,10 @@ sd::BaseTopology topology_of(const fire::PolygonMesh& mesh, std::span<const uint
 sd::VertexRule rule_of(OpenSubdiv::Sdc::Crease::Rule rule) {
   using Crease = OpenSubdiv::Sdc::Crease;
   switch (rule) {
-    case Crease::RULE_DART: return sd::VertexRule::dart;
-    case Crease::RULE_CREASE: return sd::VertexRule::crease;
-    case Crease::RULE_CORNER: return sd::VertexRule::corner;
-    default: return sd::VertexRule::smooth;
+    case Crease::RULE_DART: return sd::VertexRule::Dart;
+    case Crease::RULE_CREASE: return sd::VertexRule::Crease;
+    case Crease::RULE_CORNER: return sd::VertexRule::Corner;
+    default: return sd::VertexRule::Smooth;
   }
 }
 
@@ -200,7 +200,7 @@ TEST_CASE("infinitely sharp creases equal OpenSubdiv", "[subdivide][opensubdiv]"
     REQUIRE(base.ok());
     if (std::string(name) != "cube") {
       const auto& rules = base->levels[0].vertex_rules;
-      for (auto rule : {sd::VertexRule::dart, sd::VertexRule::crease, sd::VertexRule::corner})
+      for (auto rule : {sd::VertexRule::Dart, sd::VertexRule::Crease, sd::VertexRule::Corner})
         CHECK(std::count(rules.begin(), rules.end(), rule) > 0);
     }
     for (int levels = 1; levels <= 3; ++levels) check_against_opensubdiv(mesh, mesh.positions, sharp, levels);

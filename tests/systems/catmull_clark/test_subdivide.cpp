@@ -52,7 +52,7 @@ TEST_CASE("one level of a cube has the textbook Catmull-Clark points", "[subdivi
   REQUIRE(base.edge_vertices[0] == 0);
   REQUIRE(base.edge_vertices[1] == 3);
   CHECK((points[8 + 6 + 0] - Vec3(-0.75, 0, -0.75)).norm() < 1e-15);
-  for (uint32_t v = 0; v < level.vertex_count; ++v) CHECK(level.vertex_rules[v] == sd::VertexRule::smooth);
+  for (uint32_t v = 0; v < level.vertex_count; ++v) CHECK(level.vertex_rules[v] == sd::VertexRule::Smooth);
 }
 
 TEST_CASE("a crease keeps its edge points on the straight edge and moves along it", "[subdivide]") {
@@ -60,7 +60,7 @@ TEST_CASE("a crease keeps its edge points on the straight edge and moves along i
   const std::vector<uint32_t> sharp = {4, 5, 5, 6, 6, 7, 7, 4};
   auto refinement = sd::build_refinement(cube_topology(sharp), {1, true});
   REQUIRE(refinement.ok());
-  for (uint32_t v = 4; v < 8; ++v) CHECK(refinement->levels[0].vertex_rules[v] == sd::VertexRule::crease);
+  for (uint32_t v = 4; v < 8; ++v) CHECK(refinement->levels[0].vertex_rules[v] == sd::VertexRule::Crease);
   std::vector<Vec3> points, scratch;
   sd::evaluate(*refinement, kCubePoints, points, scratch);
   CHECK((points[6] - Vec3(0.75, 0.75, 1)).norm() < 1e-15);
@@ -97,10 +97,10 @@ TEST_CASE("given border corners: unflagged single-face boundary vertices move al
   auto refinement = sd::build_refinement({6, offsets, faces, {}, only_0}, {1, true});
   REQUIRE(refinement.ok());
   const auto& rules = refinement->levels[0].vertex_rules;
-  CHECK(rules[0] == sd::VertexRule::corner);  // flagged, one face
-  CHECK(rules[2] == sd::VertexRule::crease);  // unflagged, one face: EdgeAndCorner would make it a corner
-  CHECK(rules[1] == sd::VertexRule::crease);  // unflagged, two faces: as EdgeAndCorner
-  CHECK(rules[4] == sd::VertexRule::corner);  // flagged, two faces: a corner EdgeAndCorner would not make
+  CHECK(rules[0] == sd::VertexRule::Corner);  // flagged, one face
+  CHECK(rules[2] == sd::VertexRule::Crease);  // unflagged, one face: EdgeAndCorner would make it a corner
+  CHECK(rules[1] == sd::VertexRule::Crease);  // unflagged, two faces: as EdgeAndCorner
+  CHECK(rules[4] == sd::VertexRule::Corner);  // flagged, two faces: a corner EdgeAndCorner would not make
   // The crease rule along the border: vertex 2 moves to 3/4 of itself plus 1/8 of its border neighbours
   // (1 and 5), off its own position, where a corner would stay.
   std::vector<Vec3> points, scratch;

@@ -109,7 +109,7 @@ std::string make_glb(const nlohmann::json& doc, const std::string& bin) {
 TEST_CASE("OBJ export keeps polygons, exact positions and unit normals", "[export]") {
   TempDir dir;
   const SurfaceMesh s = house();
-  REQUIRE(write_surface(s, dir.file("house.obj"), LengthUnit::m).ok());
+  REQUIRE(write_surface(s, dir.file("house.obj"), LengthUnit::Metre).ok());
   CHECK(dir.entries() == std::vector<std::string>{"house.obj"});  // no temporary file left behind
   auto back = read_surface(dir.file("house.obj"));
   REQUIRE(back.ok());
@@ -131,7 +131,7 @@ TEST_CASE("OBJ export keeps polygons, exact positions and unit normals", "[expor
 TEST_CASE("binary PLY round-trips at float precision with polygons kept", "[export]") {
   TempDir dir;
   const SurfaceMesh s = house();
-  REQUIRE(write_surface(s, dir.file("house.ply"), LengthUnit::m).ok());
+  REQUIRE(write_surface(s, dir.file("house.ply"), LengthUnit::Metre).ok());
   const std::string bytes = read_bytes(dir.file("house.ply"));
   CHECK(bytes.starts_with("ply\nformat binary_little_endian 1.0\n"));
   const size_t header = bytes.find("end_header\n") + 11;
@@ -152,7 +152,7 @@ TEST_CASE("binary PLY round-trips at float precision with polygons kept", "[expo
 TEST_CASE("binary STL holds the fan triangles with facet normals", "[export]") {
   TempDir dir;
   const SurfaceMesh s = house();
-  REQUIRE(write_surface(s, dir.file("house.STL"), LengthUnit::m).ok());  // extensions are case-insensitive
+  REQUIRE(write_surface(s, dir.file("house.STL"), LengthUnit::Metre).ok());  // extensions are case-insensitive
   const std::string bytes = read_bytes(dir.file("house.STL"));
   CHECK(bytes.substr(0, 5) != "solid");  // would read as ASCII STL
   const std::vector<uint32_t> tris = fan(s);
@@ -176,7 +176,7 @@ TEST_CASE("ASCII STL reads as the binary one does, and a binary header that star
       "solid two\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   vertex 0 1 0\n  endloop\n endfacet\n"
       " facet normal 0 0 -1\n  outer loop\n   vertex 0 0 0\n   vertex 0 1 0\n   vertex 1 0 0.5e-1\n  endloop\n endfacet\n"
       "endsolid two\n";
-  auto r = decode_surface(ascii, SurfaceFormat::stl, "two.stl");
+  auto r = decode_surface(ascii, SurfaceFormat::Stl, "two.stl");
   INFO((r.ok() ? "" : r.error()));
   REQUIRE(r.ok());
   REQUIRE(r->face_count() == 2);
@@ -188,11 +188,11 @@ TEST_CASE("ASCII STL reads as the binary one does, and a binary header that star
   REQUIRE(write_surface(house(), dir.file("a.stl")).ok());
   std::string binary = read_bytes(dir.file("a.stl"));
   binary.replace(0, 5, "solid");
-  auto b = decode_surface(binary, SurfaceFormat::stl, "b.stl");
+  auto b = decode_surface(binary, SurfaceFormat::Stl, "b.stl");
   REQUIRE(b.ok());
   CHECK(b->face_count() == 6);
   auto refuse = [](const std::string& text, const char* part) {
-    auto bad = decode_surface(text, SurfaceFormat::stl, "bad.stl");
+    auto bad = decode_surface(text, SurfaceFormat::Stl, "bad.stl");
     REQUIRE_FALSE(bad.ok());
     CHECK_THAT(bad.error(), Contains(part));
   };
@@ -302,23 +302,23 @@ TEST_CASE("corrupt PLY and STL files are refused with the file and the problem",
     CHECK_THAT(r.error(), Contains("bad.file"));
     CHECK_THAT(r.error(), Contains(part));
   };
-  refuse(ply.substr(0, ply.size() - 1), SurfaceFormat::ply, "truncated in face 2");
-  refuse(ply.substr(0, ply.find("end_header") + 20), SurfaceFormat::ply, "truncated: 8 vertices");
-  refuse(ply + "x", SurfaceFormat::ply, "1 bytes after the last face");
-  refuse(std::string(ply).replace(ply.find("float nz"), 8, "double n"), SurfaceFormat::ply, "unsupported PLY layout");
-  refuse(std::string(ply).replace(ply.find("binary_little"), 13, "binary_bigxxx"), SurfaceFormat::ply,
+  refuse(ply.substr(0, ply.size() - 1), SurfaceFormat::Ply, "truncated in face 2");
+  refuse(ply.substr(0, ply.find("end_header") + 20), SurfaceFormat::Ply, "truncated: 8 vertices");
+  refuse(ply + "x", SurfaceFormat::Ply, "1 bytes after the last face");
+  refuse(std::string(ply).replace(ply.find("float nz"), 8, "double n"), SurfaceFormat::Ply, "unsupported PLY layout");
+  refuse(std::string(ply).replace(ply.find("binary_little"), 13, "binary_bigxxx"), SurfaceFormat::Ply,
          "unsupported PLY layout");
-  refuse("solid x\nendsolid\n", SurfaceFormat::ply, "not a PLY file");
+  refuse("solid x\nendsolid\n", SurfaceFormat::Ply, "not a PLY file");
   std::string nan_ply = ply;
   const float nan = std::numeric_limits<float>::quiet_NaN();
   std::memcpy(nan_ply.data() + ply.find("end_header") + 11 + 24 * 2 + 4, &nan, 4);
-  refuse(nan_ply, SurfaceFormat::ply, "vertex 2 has a non-finite value");
-  refuse(stl.substr(0, stl.size() - 1), SurfaceFormat::stl, "must have 384 bytes, found 383");
-  refuse(stl.substr(0, 50), SurfaceFormat::stl, "too short");
+  refuse(nan_ply, SurfaceFormat::Ply, "vertex 2 has a non-finite value");
+  refuse(stl.substr(0, stl.size() - 1), SurfaceFormat::Stl, "must have 384 bytes, found 383");
+  refuse(stl.substr(0, 50), SurfaceFormat::Stl, "too short");
   std::string nan_stl = stl;
   std::memcpy(nan_stl.data() + 84 + 50 * 4 + 12, &nan, 4);
-  refuse(nan_stl, SurfaceFormat::stl, "triangle 4 has a non-finite value");
-  refuse("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 nan\nf 1 2 3\n", SurfaceFormat::obj, "bad.file:4: normal coordinate");
+  refuse(nan_stl, SurfaceFormat::Stl, "triangle 4 has a non-finite value");
+  refuse("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 nan\nf 1 2 3\n", SurfaceFormat::Obj, "bad.file:4: normal coordinate");
 }
 
 TEST_CASE("bad surfaces and paths are refused and leave no file", "[export][reject]") {
@@ -420,10 +420,10 @@ TEST_CASE("mesh exports are in millimetres by default, say so, and read back in 
   auto raw = parse_obj(obj.substr(obj.find("\nv ")), "body");  // without the units line: the numbers as written
   REQUIRE(raw.ok());
   for (size_t v = 0; v < s.positions.size(); ++v) CHECK((raw->positions[v] - 1000 * s.positions[v]).norm() <= 1e-12 * 1000);
-  REQUIRE(write_surface(s, dir.file("cm.obj"), LengthUnit::cm).ok());
+  REQUIRE(write_surface(s, dir.file("cm.obj"), LengthUnit::Centimetre).ok());
   CHECK(read_bytes(dir.file("cm.obj")).find("# units: cm, up: +Z\n") != std::string::npos);
   // glTF is metres whatever is asked.
-  REQUIRE(write_surface(s, dir.file("a.glb"), LengthUnit::mm).ok());
+  REQUIRE(write_surface(s, dir.file("a.glb"), LengthUnit::Millimetre).ok());
   auto glb = read_surface(dir.file("a.glb"));
   REQUIRE(glb.ok());
   for (size_t v = 0; v < s.positions.size(); ++v) CHECK((glb->positions[v] - s.positions[v]).norm() < 1e-6);

@@ -21,7 +21,7 @@ double height(double x, double y) { return 0.5 * std::sin(0.6 * x) * std::cos(0.
 TEST_CASE("a fit advanced 1, 7 or all back-substitutions at a time ends on solve's points bit for bit",
           "[reconstruct][fit]") {
   // Two Coons steps: four pieces per network edge, so that phase 3 splits the spans too.
-  const Options options{Method::fire, 2, 2, Planarity::least_squares};
+  const Options options{Method::Fire, 2, 2, Planarity::LeastSquares};
   ReconstructionState state;
   SurfaceMesh surface;
   REQUIRE(reconstruct_update(grid_network(4, 3, 17, height), options, state, surface).ok());

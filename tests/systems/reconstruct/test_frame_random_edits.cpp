@@ -47,7 +47,7 @@ TEST_CASE("random edits through the frame: shown in the commit frame, settled wi
   std::mt19937_64 rng(20261201);
   Mesh net = grid_network(4, 3, 9, random_edit_height);
   EditHistory history;
-  const Options options{Method::fire, 1, 2, Planarity::least_squares};
+  const Options options{Method::Fire, 1, 2, Planarity::LeastSquares};
   SurfaceBuild build;
   SurfaceLevels surface;
   Frame frame = 0;

@@ -36,14 +36,14 @@ TEST_CASE("polylines are read by arc length: nearest sample or linear", "[geomet
   const std::vector<Vec3> line{{0, 0, 0}, {1, 0, 0}, {1, 3, 0}};  // segments of length 1 and 3
   const std::vector<double> t = arc_parameters(line);
   CHECK(t == std::vector<double>{0, 0.25, 1});
-  CHECK(sample_polyline(line, t, 0.1, Sampling::nearest) == line[0]);
-  CHECK(sample_polyline(line, t, 0.2, Sampling::nearest) == line[1]);
-  CHECK(sample_polyline(line, t, 0.7, Sampling::nearest) == line[2]);
-  CHECK(sample_polyline(line, t, 0.625, Sampling::linear).isApprox(Vec3(1, 1.5, 0), 1e-15));
-  CHECK(sample_polyline(line, t, 1.0, Sampling::linear) == line[2]);
+  CHECK(sample_polyline(line, t, 0.1, Sampling::Nearest) == line[0]);
+  CHECK(sample_polyline(line, t, 0.2, Sampling::Nearest) == line[1]);
+  CHECK(sample_polyline(line, t, 0.7, Sampling::Nearest) == line[2]);
+  CHECK(sample_polyline(line, t, 0.625, Sampling::Linear).isApprox(Vec3(1, 1.5, 0), 1e-15));
+  CHECK(sample_polyline(line, t, 1.0, Sampling::Linear) == line[2]);
   CHECK(middle_sample(t) == 1);
   // Ties go to the lower index: 0.125 is as far from 0 as from 0.25.
-  CHECK(sample_polyline(line, t, 0.125, Sampling::nearest) == line[0]);
+  CHECK(sample_polyline(line, t, 0.125, Sampling::Nearest) == line[0]);
 }
 
 TEST_CASE("smooth sampling passes through the samples and follows the curve between them", "[geometry]") {
@@ -57,16 +57,16 @@ TEST_CASE("smooth sampling passes through the samples and follows the curve betw
   double linear_error = 0, smooth_error = 0;
   for (int k = 0; k <= 160; ++k) {
     const double s = k / 160.0;
-    linear_error = std::max(linear_error, std::abs(sample_polyline(arc, t, s, Sampling::linear).norm() - 1));
-    smooth_error = std::max(smooth_error, std::abs(sample_polyline(arc, t, s, Sampling::smooth).norm() - 1));
+    linear_error = std::max(linear_error, std::abs(sample_polyline(arc, t, s, Sampling::Linear).norm() - 1));
+    smooth_error = std::max(smooth_error, std::abs(sample_polyline(arc, t, s, Sampling::Smooth).norm() - 1));
   }
   CHECK(linear_error > 4e-3);
   CHECK(smooth_error < linear_error / 20);
-  for (size_t i = 0; i < arc.size(); ++i) CHECK(sample_polyline(arc, t, t[i], Sampling::smooth).isApprox(arc[i], 1e-14));
+  for (size_t i = 0; i < arc.size(); ++i) CHECK(sample_polyline(arc, t, t[i], Sampling::Smooth).isApprox(arc[i], 1e-14));
   // A straight polyline stays straight and keeps the arc parameter.
   const std::vector<Vec3> line{{0, 0, 0}, {1, 0, 0}, {3, 0, 0}, {4, 0, 0}};
   const std::vector<double> u = arc_parameters(line);
-  CHECK(sample_polyline(line, u, 0.6, Sampling::smooth).isApprox(Vec3(2.4, 0, 0), 1e-14));
+  CHECK(sample_polyline(line, u, 0.6, Sampling::Smooth).isApprox(Vec3(2.4, 0, 0), 1e-14));
 }
 
 TEST_CASE("splitting a polyline at its middle sample, a 2-point line at its midpoint", "[geometry]") {
@@ -84,7 +84,7 @@ TEST_CASE("splitting a polyline at its middle sample, a 2-point line at its midp
 TEST_CASE("the Coons patch interpolates four curved sides", "[geometry][coons]") {
   const Square sq;
   const std::vector<Side> sides = sq.sides();
-  for (Sampling mode : {Sampling::nearest, Sampling::linear}) {
+  for (Sampling mode : {Sampling::Nearest, Sampling::Linear}) {
     for (uint32_t k = 0; k < 4; ++k) {
       // Every sample of every side, at its own walking parameter.
       const Side& side = sides[k];
@@ -99,11 +99,11 @@ TEST_CASE("the Coons patch interpolates four curved sides", "[geometry][coons]")
   }
   // Inside, the patch is the sum of the two ruled surfaces minus the bilinear one (thesis 6.2 eq. 1).
   const double u = 0.3, v = 0.6;
-  const Vec3 ruled_u = sides[0].at(u, Sampling::linear) * (1 - v) + sides[2].at(1 - u, Sampling::linear) * v;
-  const Vec3 ruled_v = sides[3].at(1 - v, Sampling::linear) * (1 - u) + sides[1].at(v, Sampling::linear) * u;
+  const Vec3 ruled_u = sides[0].at(u, Sampling::Linear) * (1 - v) + sides[2].at(1 - u, Sampling::Linear) * v;
+  const Vec3 ruled_v = sides[3].at(1 - v, Sampling::Linear) * (1 - u) + sides[1].at(v, Sampling::Linear) * u;
   const Vec3 bilinear = sq.s0.front() * ((1 - u) * (1 - v)) + sq.s0.back() * (u * (1 - v)) + sq.s2.back() * (u * v) +
                         sq.s2.front() * ((1 - u) * v);
-  CHECK((coons_point(sides, u, v, Sampling::linear) - (ruled_u + ruled_v - bilinear)).norm() < 1e-15);
+  CHECK((coons_point(sides, u, v, Sampling::Linear) - (ruled_u + ruled_v - bilinear)).norm() < 1e-15);
 }
 
 TEST_CASE("the n-sided patch is the bilinear Coons patch for n = 4", "[geometry][patch]") {
@@ -114,7 +114,7 @@ TEST_CASE("the n-sided patch is the bilinear Coons patch for n = 4", "[geometry]
     for (double v : {0.2, 0.5, 0.9}) {
       const Eigen::Vector2d p = domain_corner(4, 0) * ((1 - u) * (1 - v)) + domain_corner(4, 1) * (u * (1 - v)) +
                                 domain_corner(4, 2) * (u * v) + domain_corner(4, 3) * ((1 - u) * v);
-      CHECK((sided_patch_point(sides, p) - coons_point(sides, u, v, Sampling::linear)).norm() < 1e-12);
+      CHECK((sided_patch_point(sides, p) - coons_point(sides, u, v, Sampling::Linear)).norm() < 1e-12);
     }
 }
 
@@ -132,7 +132,7 @@ TEST_CASE("the n-sided patch interpolates its sides", "[geometry][patch]") {
     for (uint32_t k = 0; k < n; ++k)
       for (double s : {0.2, 0.5, 0.9}) {
         const Eigen::Vector2d p = domain_corner(n, k) + (domain_corner(n, k + 1) - domain_corner(n, k)) * s;
-        CHECK((sided_patch_point(sides, p) - sides[k].at(s, Sampling::linear)).norm() < 1e-9);
+        CHECK((sided_patch_point(sides, p) - sides[k].at(s, Sampling::Linear)).norm() < 1e-9);
       }
     // A flat polygon gives a flat patch: its centre lies in the plane of the sides.
     std::vector<std::vector<Vec3>> flat(n);
@@ -151,7 +151,7 @@ TEST_CASE("planarity measures are zero for a plane and grow with the twist", "[g
   const std::array<Vec3, 4> flat{Vec3(0, 0, 1), Vec3(2, 0, 1), Vec3(2, 1, 1), Vec3(0, 1.5, 1)};
   const std::array<Vec3, 4> bent{Vec3(0, 0, 0), Vec3(2, 0, 0.1), Vec3(2, 1, 0), Vec3(0, 1.5, 0.1)};
   const std::array<Vec3, 4> twisted{Vec3(0, 0, 0), Vec3(2, 0, 0.5), Vec3(2, 1, 0), Vec3(0, 1.5, 0.5)};
-  for (Planarity m : {Planarity::least_squares, Planarity::mean_normal, Planarity::hough}) {
+  for (Planarity m : {Planarity::LeastSquares, Planarity::MeanNormal, Planarity::Hough}) {
     CHECK(planarity_error(flat, m) < 1e-24);
     CHECK(planarity_error(bent, m) > 1e-6);
     CHECK(planarity_error(twisted, m) > planarity_error(bent, m));
@@ -159,7 +159,7 @@ TEST_CASE("planarity measures are zero for a plane and grow with the twist", "[g
   // Least squares: four points alternating +-h off a plane are h^2 from it each (when h is small
   // against their spread the best plane is the middle one).
   const std::array<Vec3, 4> alternating{Vec3(-1, -1, 0.01), Vec3(1, -1, -0.01), Vec3(1, 1, 0.01), Vec3(-1, 1, -0.01)};
-  CHECK(planarity_error(alternating, Planarity::least_squares) == Approx(4e-4).epsilon(1e-12));
+  CHECK(planarity_error(alternating, Planarity::LeastSquares) == Approx(4e-4).epsilon(1e-12));
 }
 
 TEST_CASE("greedy triquadrification cuts off the flattest quads", "[geometry][triquad]") {
@@ -168,7 +168,7 @@ TEST_CASE("greedy triquadrification cuts off the flattest quads", "[geometry][tr
     for (uint32_t k = 0; k < n; ++k) c.emplace_back(std::cos(2 * std::numbers::pi * k / n), std::sin(2 * std::numbers::pi * k / n), 0);
     return c;
   };
-  for (Planarity m : {Planarity::least_squares, Planarity::mean_normal, Planarity::hough}) {
+  for (Planarity m : {Planarity::LeastSquares, Planarity::MeanNormal, Planarity::Hough}) {
     std::vector<Vec3> pentagon = ring(5);
     pentagon[2].z() = 1;  // only the quad 3,4,0,1 avoids the raised corner
     const auto faces = triquadrify(pentagon, m);

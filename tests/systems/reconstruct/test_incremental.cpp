@@ -43,9 +43,9 @@ void update(Mesh& net, const Options& options, ReconstructionState& state, Surfa
 
 TEST_CASE("adding, moving and deleting a curve on a 200-face network", "[reconstruct][incremental]") {
   const uint32_t nx = 20, ny = 10;
-  for (Method method : {Method::fire, Method::thesis}) {
-    INFO((method == Method::fire ? "fire" : "thesis"));
-    const Options options{method, 1, 2, Planarity::least_squares};
+  for (Method method : {Method::Fire, Method::Thesis}) {
+    INFO((method == Method::Fire ? "fire" : "thesis"));
+    const Options options{method, 1, 2, Planarity::LeastSquares};
     Mesh net = grid_network(nx, ny, 9, height);
     REQUIRE(net.face_count() == 200);
     ReconstructionState state;
@@ -95,7 +95,7 @@ TEST_CASE("adding, moving and deleting a curve on a 200-face network", "[reconst
     net.move_vertex(v, net.vertices.position[v] + Vec3(0.8, 0, 0));
     update(net, options, state, surface);
     CHECK_FALSE(state.last_update().topology_rebuilt);
-    if (method == Method::fire) CHECK(shape_weights(state.base(), FitWeights{}) != square);
+    if (method == Method::Fire) CHECK(shape_weights(state.base(), FitWeights{}) != square);
     check_equals_full_rebuild(net, options, surface);
 
     // Deleting the curve again.
@@ -129,8 +129,8 @@ TEST_CASE("a noisy network's fit follows its noise, and a move that changes the 
   // The same curves without the ripple are exact; an explicit weight is used as is.
   CHECK(fit_fairness(options, noise_estimate(grid_network(6, 4, 20, height))) == options.fairness);
   // Exact curves are read on the smooth curve through their samples, noisy ones along their chords.
-  CHECK(fit_targets(noise_estimate(grid_network(6, 4, 20, height))) == Sampling::smooth);
-  CHECK(fit_targets(noise) == Sampling::linear);
+  CHECK(fit_targets(noise_estimate(grid_network(6, 4, 20, height))) == Sampling::Smooth);
+  CHECK(fit_targets(noise) == Sampling::Linear);
   Options explicit_weight;
   explicit_weight.fairness_from_noise = false;
   CHECK(fit_fairness(explicit_weight, noise) == explicit_weight.fairness);

@@ -30,8 +30,8 @@ TEST_CASE("random edits: incremental reconstruction equals a rebuild after every
   std::mt19937_64 rng(20261214);
   Mesh net = grid_network(4, 3, 9, random_edit_height);
   EditHistory history;
-  const Options fire_options{Method::fire, 1, 2, Planarity::least_squares};
-  const Options thesis_options{Method::thesis, 1, 2, Planarity::least_squares};
+  const Options fire_options{Method::Fire, 1, 2, Planarity::LeastSquares};
+  const Options thesis_options{Method::Thesis, 1, 2, Planarity::LeastSquares};
   ReconstructionState fire_state, thesis_state;
   SurfaceMesh fire_surface, thesis_surface;
   int applied = 0, thesis_refused = 0, compared = 0, closed_steps = 0, holed_steps = 0, crossed = 0, chained_steps = 0;

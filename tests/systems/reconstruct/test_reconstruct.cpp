@@ -50,11 +50,11 @@ double nearest_distance(const std::vector<Vec3>& points, const Vec3& p) {
 TEST_CASE("thesis: a pentagon triquadrifies into a quad and a triangle, then 7 quads", "[reconstruct][thesis]") {
   const Mesh net = polygon_network(5);
   std::vector<EdgeSplits> splits;
-  const FacePatch p = patch_of(net, FaceIndex{0}, {Method::thesis, 1, Planarity::least_squares}, splits);
+  const FacePatch p = patch_of(net, FaceIndex{0}, {Method::Thesis, 1, Planarity::LeastSquares}, splits);
   CHECK(p.first_stage_sizes == std::vector<uint32_t>{4, 3});
   CHECK(p.face_count() == 7);
   CHECK(p.interior.size() == 3);  // the cut's midpoint and the two centres
-  const BaseMesh b = base_of(net, {Method::thesis, 1, 2, Planarity::least_squares});
+  const BaseMesh b = base_of(net, {Method::Thesis, 1, 2, Planarity::LeastSquares});
   CHECK(b.vertex_count() == 13);  // 5 corners, 5 edge midpoints, 3 inside
   CHECK(b.face_count() == 7);
   CHECK(b.curve_count() == 19);   // 10 halves of the sides, 2 of the cut, 4 + 3 spokes
@@ -74,15 +74,15 @@ TEST_CASE("thesis: a pentagon triquadrifies into a quad and a triangle, then 7 q
 TEST_CASE("thesis: the centre of a 4-sided face is its Coons point x(1/2, 1/2)", "[reconstruct][thesis]") {
   const Mesh net = polygon_network(4, 11);
   std::vector<EdgeSplits> splits;
-  const FacePatch p = patch_of(net, FaceIndex{0}, {Method::thesis, 1, Planarity::least_squares}, splits);
+  const FacePatch p = patch_of(net, FaceIndex{0}, {Method::Thesis, 1, Planarity::LeastSquares}, splits);
   REQUIRE(p.interior.size() == 1);
   std::vector<std::vector<double>> params;
   std::vector<Side> sides;
   for (OrientedEdge oe : net.face_loop(FaceIndex{0})) params.push_back(arc_parameters(net.polyline(edge_of(oe))));
   for (uint32_t k = 0; k < 4; ++k) sides.push_back({net.polyline(edge_of(net.face_loop(FaceIndex{0})[k])), params[k], false});
-  CHECK(p.interior[0] == coons_point(sides, 0.5, 0.5, Sampling::nearest));
+  CHECK(p.interior[0] == coons_point(sides, 0.5, 0.5, Sampling::Nearest));
   // Two steps: a 5 x 5 grid of base vertices.
-  const BaseMesh b = base_of(net, {Method::thesis, 2, 1, Planarity::least_squares});
+  const BaseMesh b = base_of(net, {Method::Thesis, 2, 1, Planarity::LeastSquares});
   CHECK(b.vertex_count() == 25);
   CHECK(b.face_count() == 16);
   check_disk(b);
@@ -91,7 +91,7 @@ TEST_CASE("thesis: the centre of a 4-sided face is its Coons point x(1/2, 1/2)",
 TEST_CASE("FIRE: an n-sided face becomes n quads around its centre", "[reconstruct][fire]") {
   for (uint32_t n : {2u, 3u, 4u, 5u, 6u}) {
     const Mesh net = n == 2 ? polygon_network(n) : cornered_polygon_network(n);
-    const BaseMesh b = base_of(net, {Method::fire, 1, 2, Planarity::least_squares});
+    const BaseMesh b = base_of(net, {Method::Fire, 1, 2, Planarity::LeastSquares});
     INFO("n = " << n);
     CHECK(b.vertex_count() == 2 * n + 1);
     CHECK(b.face_count() == n);
@@ -106,7 +106,7 @@ TEST_CASE("FIRE: an n-sided face becomes n quads around its centre", "[reconstru
       CHECK(b.positions[b.face_vertices[4 * k + 1]] == line[middle_sample(arc_parameters(line))]);
     }
     // The surface: n * 4^2 quads.
-    auto s = reconstruct_surface(net, {Method::fire, 1, 2, Planarity::least_squares});
+    auto s = reconstruct_surface(net, {Method::Fire, 1, 2, Planarity::LeastSquares});
     REQUIRE(s.ok());
     CHECK(s->face_count() == 16 * n);
     CHECK(s->normals.size() == s->positions.size());
@@ -120,7 +120,7 @@ TEST_CASE("FIRE: a side much longer than its face's mean side gets more pieces, 
   const Mesh net = cornered_polygon_network({0, d, 2 * d, 3 * d, 4 * d}, 17);
   for (uint32_t steps : {1u, 2u}) {
     INFO(steps << " Coons steps");
-    const BaseMesh b = base_of(net, {Method::fire, steps, 2, Planarity::least_squares});
+    const BaseMesh b = base_of(net, {Method::Fire, steps, 2, Planarity::LeastSquares});
     const uint32_t pieces = 1u << steps;
     REQUIRE(b.side_count() == 5);
     for (uint32_t s = 0; s < 5; ++s)
@@ -136,12 +136,12 @@ TEST_CASE("FIRE: a side much longer than its face's mean side gets more pieces, 
     CHECK(pentagons == pieces);
     // Still a disk with every base edge carrying one curve.
     CHECK(int64_t(b.vertex_count()) - int64_t(b.curve_count()) + int64_t(b.face_count()) == 1);
-    auto surface = reconstruct_surface(net, {Method::fire, steps, 2, Planarity::least_squares});
+    auto surface = reconstruct_surface(net, {Method::Fire, steps, 2, Planarity::LeastSquares});
     REQUIRE(surface.ok());
     CHECK(surface->face_count() == 4 * corners);
   }
   // The thesis's Coons steps split every side alike.
-  const BaseMesh thesis = base_of(net, {Method::thesis, 1, 2, Planarity::least_squares});
+  const BaseMesh thesis = base_of(net, {Method::Thesis, 1, 2, Planarity::LeastSquares});
   for (uint32_t s = 0; s < thesis.side_count(); ++s) CHECK(thesis.side_curve_offsets[s + 1] - thesis.side_curve_offsets[s] == 2);
 }
 
@@ -152,7 +152,7 @@ TEST_CASE("FIRE: sides that run straight on through a corner are one side, split
   for (uint32_t n : {4u, 5u, 6u}) {
     INFO("n = " << n);
     const Mesh net = polygon_network(n);
-    const BaseMesh b = base_of(net, {Method::fire, 1, 2, Planarity::least_squares});
+    const BaseMesh b = base_of(net, {Method::Fire, 1, 2, Planarity::LeastSquares});
     const uint32_t halves = 2 * (n - 4);
     CHECK(b.face_count() == 4);
     check_disk(b);
@@ -164,7 +164,7 @@ TEST_CASE("FIRE: sides that run straight on through a corner are one side, split
       one_piece += pieces == 1;
     }
     CHECK(one_piece == halves);
-    auto surface = reconstruct_surface(net, {Method::fire, 1, 2, Planarity::least_squares});
+    auto surface = reconstruct_surface(net, {Method::Fire, 1, 2, Planarity::LeastSquares});
     REQUIRE(surface.ok());
     CHECK(surface->face_count() == 4 * 16);
   }
@@ -208,7 +208,7 @@ TEST_CASE("FIRE: a straight corner joins its sides only where every face of thos
     const FaceIndex upper_face = net.add_face(upper);
     REQUIRE(upper_face != kNone);
     REQUIRE(net.validate() == "");
-    const BaseMesh b = base_of(net, {Method::fire, 1, 2, Planarity::least_squares});
+    const BaseMesh b = base_of(net, {Method::Fire, 1, 2, Planarity::LeastSquares});
     check_disk(b);
     uint32_t upper_quads = 0;
     for (uint32_t f = 0; f < b.face_count(); ++f) upper_quads += b.face_source[f] == upper_face;
@@ -225,7 +225,7 @@ TEST_CASE("FIRE: a border vertex is a corner only where the border turns", "[rec
   // Two unit squares side by side: the four outer corners turn by 90 degrees, the middle vertices of
   // the long sides go straight on.
   const Mesh grid = grid_network(2, 1, 9, [](double x, double y) { return 0.1 * x * y; });
-  const BaseMesh b = base_of(grid, {Method::fire, 1, 2, Planarity::least_squares});
+  const BaseMesh b = base_of(grid, {Method::Fire, 1, 2, Planarity::LeastSquares});
   REQUIRE(b.border_corners.size() == b.vertex_count());
   uint32_t corners = 0;
   for (uint32_t v = 0; v < b.vertex_count(); ++v) {
@@ -239,10 +239,10 @@ TEST_CASE("FIRE: a border vertex is a corner only where the border turns", "[rec
   // A face bounded by arcs of one circle has a smooth border: no corners at all, where EdgeAndCorner
   // made each meeting point of two arcs a corner.
   const Mesh disk = polygon_network(4);
-  const BaseMesh d = base_of(disk, {Method::fire, 1, 2, Planarity::least_squares});
+  const BaseMesh d = base_of(disk, {Method::Fire, 1, 2, Planarity::LeastSquares});
   for (uint8_t flag : d.border_corners) CHECK(flag == 0);
   // The thesis pipeline keeps Catmull-Clark's own rule.
-  CHECK(base_of(disk, {Method::thesis, 1, 2, Planarity::least_squares}).border_corners.empty());
+  CHECK(base_of(disk, {Method::Thesis, 1, 2, Planarity::LeastSquares}).border_corners.empty());
 }
 
 TEST_CASE("FIRE: a border turn no larger than the noise's own turning is no corner", "[reconstruct][fire][noise]") {
@@ -258,7 +258,7 @@ TEST_CASE("FIRE: a border turn no larger than the noise's own turning is no corn
   for (uint32_t i = 0; i < uint32_t(net.points.size()); ++i) net.points.set(i, bend(net.points[i]));
   const Vec3 kink(2, -dip, 0);
   auto kink_is_corner = [&](const Mesh& m) {
-    const BaseMesh b = base_of(m, {Method::fire, 1, 2, Planarity::least_squares});
+    const BaseMesh b = base_of(m, {Method::Fire, 1, 2, Planarity::LeastSquares});
     for (uint32_t v = 0; v < b.vertex_count(); ++v)
       if ((b.positions[v] - kink).norm() < 1e-9) return b.border_corners[v] != 0;
     FAIL("no base vertex at the kink");
@@ -291,7 +291,7 @@ TEST_CASE("FIRE: a noisy border's turn is read past the pen's rest at a vertex",
   const double deviation =
       std::max(fit_noise(net), std::sin(tangent_spread_deg(net) * std::numbers::pi / 180) * kTangentReach);
   auto is_corner = [&](const Vec3& at) {
-    const BaseMesh b = base_of(net, {Method::fire, 1, 2, Planarity::least_squares});
+    const BaseMesh b = base_of(net, {Method::Fire, 1, 2, Planarity::LeastSquares});
     for (uint32_t v = 0; v < b.vertex_count(); ++v)
       if ((b.positions[v] - at).norm() < 1e-9) return b.border_corners[v] != 0;
     FAIL("no base vertex at " << at.transpose());
@@ -336,7 +336,7 @@ TEST_CASE("FIRE: a straight corner joins its sides only beyond the noise's own t
   REQUIRE(merged != kNone);
   REQUIRE(net.validate() == "");
   auto base_faces = [&](const Mesh& m) {
-    const BaseMesh b = base_of(m, {Method::fire, 1, 2, Planarity::least_squares});
+    const BaseMesh b = base_of(m, {Method::Fire, 1, 2, Planarity::LeastSquares});
     return std::count(b.face_source.begin(), b.face_source.end(), merged);
   };
   CHECK(tangent_spread_deg(net) < 0.5);
@@ -424,7 +424,7 @@ TEST_CASE("FIRE: the fitted limit surface passes through the drawn samples", "[r
   REQUIRE(smooth.ok());
   CHECK(worst_distance(*smooth) < 1e-4);
   // The thesis pipeline does not pass through them: Catmull-Clark shrinks the base mesh.
-  auto thesis = reconstruct_surface(net, {Method::thesis, 1, 3, Planarity::least_squares});
+  auto thesis = reconstruct_surface(net, {Method::Thesis, 1, 3, Planarity::LeastSquares});
   REQUIRE(thesis.ok());
   CHECK(worst_distance(*thesis) > 1e-2);
 }
@@ -435,11 +435,11 @@ TEST_CASE("bad networks and options are rejected with the element named", "[reco
     REQUIRE_FALSE(r.ok());
     return r.error();
   };
-  const Options thesis{Method::thesis, 1, 3, Planarity::least_squares}, fire{};
+  const Options thesis{Method::Thesis, 1, 3, Planarity::LeastSquares}, fire{};
   CHECK_THAT(error_of(polygon_network(2), thesis), Catch::Contains("face 0 has 2 edges"));
   CHECK(reconstruct_surface(polygon_network(2), fire).ok());
-  CHECK_THAT(error_of(polygon_network(4), {Method::fire, 0, 3, Planarity::least_squares}), Catch::Contains("Coons steps"));
-  CHECK_THAT(error_of(polygon_network(4), {Method::fire, 1, 9, Planarity::least_squares}), Catch::Contains("subdivision level"));
+  CHECK_THAT(error_of(polygon_network(4), {Method::Fire, 0, 3, Planarity::LeastSquares}), Catch::Contains("Coons steps"));
+  CHECK_THAT(error_of(polygon_network(4), {Method::Fire, 1, 9, Planarity::LeastSquares}), Catch::Contains("subdivision level"));
   CHECK_THAT(error_of(Mesh{}, fire), Catch::Contains("no faces"));
   Options unfair;
   unfair.fairness = std::nan("");
