@@ -278,10 +278,11 @@ std::optional<Band> find_band(const Cells& g, const std::vector<char>& inside, c
       if (!other || std::count(rim.begin(), rim.end(), 1) != static_cast<long>(other->size())) continue;
       // The rims share no vertex with each other or with the border: each becomes a loop of its own.
       std::vector<char> on_rim(net.vertices.size(), 0);
-      for (const Leg& l : cycle) on_rim[net.curves[l.curve].a] = 1;
+      for (const Leg& l : cycle) on_rim[net.curves[l.curve].a] = on_rim[net.curves[l.curve].b] = 1;
       for (uint32_t k = 0; k < net.curves.size(); ++k)
         if (net.curves[k].border) on_rim[net.curves[k].a] = on_rim[net.curves[k].b] = 1;
-      if (std::any_of(other->begin(), other->end(), [&](const Leg& l) { return on_rim[net.curves[l.curve].a] != 0; })) continue;
+      if (std::any_of(other->begin(), other->end(), [&](const Leg& l) { return on_rim[net.curves[l.curve].a] || on_rim[net.curves[l.curve].b]; }))
+        continue;
       std::vector<char> rest = inside;
       for (uint32_t c = 0; c < g.count(); ++c) rest[c] = rest[c] && !band.cells[c];
       if (!connected(g, rest, std::vector<char>(net.curves.size(), 0))) continue;

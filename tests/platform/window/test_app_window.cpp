@@ -2,7 +2,7 @@
 // validation layer on: a scripted interaction through the window's GLFW callbacks (an orbit drag, a zoom, the
 // help overlay, an undo, a resize, a close), a screenshot of the presented frame checked by pixel statistics,
 // the recorded input log replayed to the same hash; strokes drawn with the mouse on pawn.obj, replayed bit for
-// bit; the pen's feedback (closing vertex, tinted face, snap target); a curve marked sharp and the surface
+// bit, and the whole pawn and the whole mug, handle included, drawn and measured; the pen's feedback (closing vertex, tinted face, snap target); a curve marked sharp and the surface
 // exported; and no display, a bad export: a clear message, no crash.
 #include <catch2/catch.hpp>
 
@@ -20,6 +20,7 @@
 #include "platform/surface_io.hpp"
 #include "platform/render/renderer.hpp"
 #include "systems/evaluate/evaluate.hpp"
+#include "tests/platform/window/mug_drawing.hpp"
 #include "tests/platform/window/pawn_drawing.hpp"
 #include "tools/simulation/simulate.hpp"
 
@@ -428,6 +429,67 @@ TEST_CASE("fire app: the whole pawn drawn with the mouse, one split undone, repl
   REQUIRE(eval.exit_code == 0);
   const auto measured = nlohmann::json::parse(eval.out);
   CHECK(measured["rms"].get<double>() <= 0.01);
+  fs::remove_all(dir);
+}
+
+// Issue 40: the mug, its handle included, drawn with the mouse by the simulated person's plan (mug_drawing.hpp):
+// the border round its foot, the cup inside and out, the handle's roots capped and opened with O, the handle drawn
+// last across the two holes; its surface keeps the mug's topology, a handle and one border.
+TEST_CASE("fire app: the whole mug drawn with the mouse, its handle across two holes, replays bit for bit and measures within 1 percent",
+          "[app][window][sketch][whole-drawing]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("mug");
+  auto mug = fire::read_obj(FIRE_MUG);
+  REQUIRE(mug);
+  // What the app draws on at its default --reference-levels.
+  auto reference = fire::evaluate::reference_limit_surface(mug->positions, mug->face_offsets, mug->face_vertices, 3);
+  REQUIRE(reference);
+  const auto drawing = fire::test::mouse_drawing(mug->view(), *reference, 1280, 800);
+  INFO((drawing ? "" : drawing.error()));
+  REQUIRE(drawing);
+  INFO(drawing->strokes << " strokes, " << drawing->pieces << " of them pieces of a longer curve");
+  CHECK(drawing->holes == 2);  // the handle's two roots
+  const std::string script = (dir / "mug.script").string(), record = (dir / "mug.log").string(),
+                    exported = (dir / "mug_surface.obj").string(), shot = (dir / "mug.png").string();
+  REQUIRE(fire::write_file_atomic(script, drawing->script));
+  const Run app = run_app(179,
+                          "--reference " + quote(FIRE_MUG) + " --size 1280x800 --snap-pixels 6 --script " + quote(script) +
+                              " --record " + quote(record) + " --export " + quote(exported) + " --screenshot " + quote(shot),
+                          dir);
+  INFO("xvfb-run exit: " << app.runner_exit << "\nstdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  const auto json = nlohmann::json::parse(app.out);
+  CHECK(json["faces"] == drawing->faces);
+  CHECK(json["edges"] == drawing->edges);
+  CHECK(json["border_loops"] == 1);
+  CHECK(app.err.find("exported") != std::string::npos);
+  CHECK(app.err.find("provisional") == std::string::npos);
+  const auto log = fire::read_text_file(record);
+  REQUIRE(log);
+  CHECK(log->find(" cmd undo\n") != std::string::npos);
+  size_t holes = 0;
+  for (size_t at = log->find(" cmd hole "); at != std::string::npos; at = log->find(" cmd hole ", at + 1)) ++holes;
+  CHECK(holes == 2);
+  for (int run_index = 0; run_index < 2; ++run_index) {
+    const Run replay = run(quote(FIRE_BINARY) + " replay " + quote(record) + " --hash", dir);
+    REQUIRE(replay.exit_code == 0);
+    CHECK(replay.out == json["hash"].get<std::string>() + "\n");
+    CHECK(replay.err.find("rejected") == std::string::npos);
+  }
+  const Run eval = run(quote(FIRE_BINARY) + " eval " + quote(exported) + " --reference " + quote(FIRE_MUG), dir);
+  INFO("fire eval: " << eval.out << eval.err);
+  REQUIRE(eval.exit_code == 0);
+  const auto measured = nlohmann::json::parse(eval.out);
+  CHECK(measured["rms"].get<double>() <= 0.01);
+  // The mug's topology, counted after welding: V - E + F = 2 - 2 (one handle) - 1 (one border loop).
+  CHECK(measured["reference_euler_characteristic"] == -1);
+  CHECK(measured["reference_border_loops"] == 1);
+  CHECK(measured["euler_characteristic"] == measured["reference_euler_characteristic"]);
+  CHECK(measured["border_loops"] == measured["reference_border_loops"]);
+  // The last frame, from the app's first view: the curves over the surface, the handle among them.
+  auto image = fire::render::read_png(shot);
+  REQUIRE(image);
+  CHECK(curve_pixels(*image) > 3000);
   fs::remove_all(dir);
 }
 
