@@ -2,8 +2,9 @@
 // validation layer on: a scripted interaction through the window's GLFW callbacks (an orbit drag, a zoom, the
 // help overlay, an undo, a resize, a close), a screenshot of the presented frame checked by pixel statistics,
 // the recorded input log replayed to the same hash; strokes drawn with the mouse on pawn.obj, replayed bit for
-// bit, and the whole pawn and the whole mug, handle included, drawn and measured; the pen's feedback (closing vertex, tinted face, snap target); a curve marked sharp and the surface
-// exported; and no display, a bad export: a clear message, no crash.
+// bit, and the whole pawn and the whole mug, handle included, drawn and measured; the pen's feedback (closing
+// vertex, tinted face, snap target); a curve marked sharp and the surface exported; and no display, a bad export:
+// a clear message, no crash.
 #include <catch2/catch.hpp>
 
 #include <Eigen/Geometry>
