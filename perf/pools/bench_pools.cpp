@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "engine/mesh.hpp"
+#include "perf/baseline.hpp"
 #include "systems/split/edit.hpp"
 
 using namespace fire;
@@ -136,7 +137,12 @@ Layout our_layout(const Mesh& m) {
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  const bool write = argc == 2 && std::string(argv[1]) == "--write-baseline";
+  if (argc > 2 || (argc == 2 && !write)) die("usage: bench_pools [--write-baseline]");
+  const std::string baseline_path = FIRE_SOURCE_DIR "/perf/pools/baseline.json";
+  const auto baseline = fire::perf::read_baseline(baseline_path);
+  if (!baseline) die(baseline.error());
   std::printf("# bench_pools: %u faces by splitting, curves of %u points, medians of %d runs\n", kFaces, kCurvePoints, kRepetitions);
 
   // ---- build by splitting
@@ -289,5 +295,16 @@ int main() {
   std::printf("| read all points: shuffled order | %.1f us (%.2f ns/point) | %.1f us (%.2f ns/point) |\n", t_random * 1e6,
               t_random * 1e9 / double(np), t_om_random * 1e6, t_om_random * 1e9 / double(np));
   std::printf("checksums: %.17g %.17g %.17g %.17g %.17g\n", sum_pool, sum_edges, sum_random, sum_om_edges, sum_om_random);
+  // OpenMesh over FIRE, each kept in perf/pools/baseline.json.
+  const std::vector<fire::perf::Figure> figures = {
+      {"heap bytes per point: OpenMesh / FIRE after compaction", double(om_heap) / double(mesh.pool_bytes()), 0},
+      {"read all points edge by edge: OpenMesh / FIRE", t_om_edges / t_edges, 0},
+      {"read all points in shuffled order: OpenMesh / FIRE", t_om_random / t_random, 0}};
+  std::printf("\n%s", fire::perf::compare_with_baseline(*baseline, figures, baseline_path).c_str());
+  if (write) {
+    if (Status written = fire::perf::write_baseline(baseline_path, "bench_pools", "bench_pools", figures); !written)
+      die(written.error);
+    std::printf("\nwrote %s\n", baseline_path.c_str());
+  }
   return 0;
 }

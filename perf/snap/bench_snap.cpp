@@ -23,6 +23,7 @@
 
 #include "engine/mesh.hpp"
 #include "engine/snap_index.hpp"
+#include "perf/baseline.hpp"
 #include "systems/split/edit.hpp"
 
 using namespace fire;
@@ -181,7 +182,14 @@ struct Row {
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  const bool write = argc == 2 && std::string(argv[1]) == "--write-baseline";
+  if (argc > 2 || (argc == 2 && !write)) die("usage: bench_snap [--write-baseline]");
+  const std::string baseline_path = FIRE_SOURCE_DIR "/perf/snap/baseline.json";
+  const auto baseline = fire::perf::read_baseline(baseline_path);
+  if (!baseline) die(baseline.error());
+  // nanoflann's time over ours, each row: kept in perf/snap/baseline.json.
+  std::vector<fire::perf::Figure> figures;
   std::printf("# bench_snap: snapping index vs nanoflann %d.%d.%d; %u queries per row, insert/delete %u curves of %u points;"
               " best of %d, thread CPU time\n",
               NANOFLANN_VERSION >> 8, (NANOFLANN_VERSION >> 4) & 0xF, NANOFLANN_VERSION & 0xF, kQueries, kEdits, kCurvePoints,
@@ -249,6 +257,7 @@ int main() {
       const double per = 1e9 / double(row.queries.size());
       std::printf("%-8zu %-14s %12.1f %12.1f %12.1f %9.2f %9.2f\n", n, row.name, inc * per, blk * per, nano * per,
                   inc / nano, blk / nano);
+      figures.push_back({std::to_string(target) + " points, " + row.name + ": nanoflann / ours (incremental)", nano / inc, 0});
     }
 
     // Insert and delete one curve at a time: ours through the mesh and update(), nanoflann's dynamic index
@@ -311,6 +320,14 @@ int main() {
                 "insert curve", 1e6 * ours_insert, "", 1e6 * nano_insert, ours_insert / nano_insert);
     std::printf("%-8zu %-14s %12.2f %12s %12.2f %9.3f\n", n, "delete curve", 1e6 * ours_delete, "", 1e6 * nano_delete,
                 ours_delete / nano_delete);
+    figures.push_back({std::to_string(target) + " points, insert curve: nanoflann dynamic / ours", nano_insert / ours_insert, 0});
+    figures.push_back({std::to_string(target) + " points, delete curve: nanoflann dynamic / ours", nano_delete / ours_delete, 0});
+  }
+  std::printf("\n%s", fire::perf::compare_with_baseline(*baseline, figures, baseline_path).c_str());
+  if (write) {
+    if (fire::Status written = fire::perf::write_baseline(baseline_path, "bench_snap", "bench_snap", figures); !written)
+      die(written.error);
+    std::printf("\nwrote %s\n", baseline_path.c_str());
   }
   return 0;
 }

@@ -5,7 +5,9 @@
 //  (b) positions only, topology fixed, points moved: evaluate (level by level, stencils applied from
 //      the level arrays), explicit stencil tables level by level, and the factorized table, vs
 //      Far::StencilTable::UpdateValues (factorized last level, and level by level).
-// Prints one Markdown table row per case with medians over the repetitions.
+// Prints one Markdown table row per case with medians over the repetitions, then each case's two ratios (the
+// fastest OpenSubdiv over ours, from scratch and with points moved) against perf/subdivide/baseline.json and
+// issue 45's targets (3x and 4x); --write-baseline keeps this run's ratios there.
 #include <opensubdiv/far/primvarRefiner.h>
 #include <opensubdiv/far/stencilTable.h>
 #include <opensubdiv/far/stencilTableFactory.h>
@@ -22,6 +24,7 @@
 #include <vector>
 
 #include "engine/surface.hpp"
+#include "perf/baseline.hpp"
 #include "platform/obj.hpp"
 #include "systems/reconstruct/reconstruct.hpp"
 #include "systems/catmull_clark/catmull_clark.hpp"
@@ -134,7 +137,11 @@ void move_points(std::vector<Vec3>& points, uint64_t& state) {
     }
 }
 
-void run_case(const Mesh& mesh, int levels, int repetitions, Order order) {
+// Issue 45: the fastest OpenSubdiv configuration measured over ours, from scratch and with points moved.
+constexpr double kScratchTarget = 3.0, kMovingTarget = 4.0;
+
+// Prints the case's row and returns its two ratios.
+std::vector<fire::perf::Figure> run_case(const Mesh& mesh, int levels, int repetitions, Order order) {
   const sd::BaseTopology topology{uint32_t(mesh.positions.size()), mesh.face_offsets, mesh.face_vertices, {}};
   const OsdInput osd_input(mesh);
   const std::vector<Point> osd_base = to_points(mesh.positions);
@@ -248,16 +255,33 @@ void run_case(const Mesh& mesh, int levels, int repetitions, Order order) {
               a_osd_full.median() / a_ours_full.median(), b_ours.median(), b_ours_explicit.median(),
               b_ours_factorized.median(), b_osd_default.median(), b_osd_factorized.median(), b_osd_per_level.median(),
               b_osd_best / b_ours_best, std::max(a_check, b_check));
+  const std::string name = mesh.name + ", level " + std::to_string(levels);
+  return {{name + ": (a) from scratch, OSD / ours", a_osd.median() / a_ours.median(), kScratchTarget},
+          {name + ": (b) points moved, fastest OSD / fastest ours", b_osd_best / b_ours_best, kMovingTarget}};
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::string data = argc > 1 ? argv[1] : FIRE_DATA_DIR;
-  const int repetitions = argc > 2 ? std::atoi(argv[2]) : 11;
-  const std::string order_name = argc > 3 ? argv[3] : "interleaved";
-  if (repetitions < 1 || (order_name != "interleaved" && order_name != "warm")) {
-    std::fprintf(stderr, "usage: bench_subdivide [DATA_DIR] [REPETITIONS >= 1] [interleaved|warm]\n");
+  std::vector<std::string> args;
+  bool write = false;
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--write-baseline")
+      write = true;
+    else
+      args.emplace_back(argv[i]);
+  }
+  const std::string data = args.size() > 0 ? args[0] : FIRE_DATA_DIR;
+  const int repetitions = args.size() > 1 ? std::atoi(args[1].c_str()) : 11;
+  const std::string order_name = args.size() > 2 ? args[2] : "interleaved";
+  if (args.size() > 3 || repetitions < 1 || (order_name != "interleaved" && order_name != "warm")) {
+    std::fprintf(stderr, "usage: bench_subdivide [DATA_DIR] [REPETITIONS >= 1] [interleaved|warm] [--write-baseline]\n");
+    return 1;
+  }
+  const std::string baseline_path = FIRE_SOURCE_DIR "/perf/subdivide/baseline.json";
+  const auto baseline = fire::perf::read_baseline(baseline_path);
+  if (!baseline) {
+    std::fprintf(stderr, "bench_subdivide: %s\n", baseline.error().c_str());
     return 1;
   }
   const Order order = order_name == "warm" ? Order::Warm : Order::Interleaved;
@@ -300,7 +324,18 @@ int main(int argc, char** argv) {
               "(b) OSD last level factorized ms | (b) OSD level by level ms | (b) fastest OSD / fastest ours | "
               "max difference |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::vector<fire::perf::Figure> figures;
   for (const Mesh* mesh : {&control, &coons})
-    for (int levels : {3, 4}) run_case(*mesh, levels, repetitions, order);
+    for (int levels : {3, 4})
+      for (fire::perf::Figure& f : run_case(*mesh, levels, repetitions, order)) figures.push_back(std::move(f));
+  std::printf("\n%s", fire::perf::compare_with_baseline(*baseline, figures, baseline_path).c_str());
+  if (write) {
+    const std::string command = "bench_subdivide " + std::to_string(repetitions) + " " + order_name;
+    if (fire::Status written = fire::perf::write_baseline(baseline_path, "bench_subdivide", command, figures); !written) {
+      std::fprintf(stderr, "bench_subdivide: %s\n", written.error.c_str());
+      return 1;
+    }
+    std::printf("\nwrote %s\n", baseline_path.c_str());
+  }
   return 0;
 }
