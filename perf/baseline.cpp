@@ -92,4 +92,20 @@ Status write_baseline(const std::string& path, const std::string& benchmark, con
   return write_file_atomic(path, j.dump(2) + "\n");
 }
 
+Result<BaselineRun> start_baseline_run(const std::string& benchmark, const std::string& path, int argc, char** argv) {
+  const bool write = argc == 2 && std::string(argv[1]) == "--write-baseline";
+  if (argc > 2 || (argc == 2 && !write)) return Result<BaselineRun>::failure("usage: " + benchmark + " [--write-baseline]");
+  Result<Baseline> baseline = read_baseline(path);
+  if (!baseline) return Result<BaselineRun>::failure(baseline.error());
+  return BaselineRun{benchmark, path, std::move(*baseline), write};
+}
+
+Status finish_baseline_run(const BaselineRun& run, const std::string& command, const std::vector<Figure>& now) {
+  std::printf("\n%s", compare_with_baseline(run.baseline, now, run.path).c_str());
+  if (!run.write) return Status::success();
+  if (Status written = write_baseline(run.path, run.benchmark, command, now); !written) return written;
+  std::printf("\nwrote %s\n", run.path.c_str());
+  return Status::success();
+}
+
 }  // namespace fire::perf

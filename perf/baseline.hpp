@@ -35,4 +35,15 @@ std::string compare_with_baseline(const Baseline& baseline, const std::vector<Fi
 Status write_baseline(const std::string& path, const std::string& benchmark, const std::string& command,
                       const std::vector<Figure>& now);
 
+// A benchmark's run against its baseline: the file read at the start (a malformed one stops the run before any
+// timing), then at the end the comparison printed and, with --write-baseline, the file replaced.
+struct BaselineRun {
+  std::string benchmark, path;
+  Baseline baseline;
+  bool write = false;
+};
+// For a benchmark whose only argument is an optional --write-baseline.
+Result<BaselineRun> start_baseline_run(const std::string& benchmark, const std::string& path, int argc, char** argv);
+Status finish_baseline_run(const BaselineRun& run, const std::string& command, const std::vector<Figure>& now);
+
 }  // namespace fire::perf

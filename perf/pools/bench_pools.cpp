@@ -138,10 +138,7 @@ Layout our_layout(const Mesh& m) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bool write = argc == 2 && std::string(argv[1]) == "--write-baseline";
-  if (argc > 2 || (argc == 2 && !write)) die("usage: bench_pools [--write-baseline]");
-  const std::string baseline_path = FIRE_SOURCE_DIR "/perf/pools/baseline.json";
-  const auto baseline = fire::perf::read_baseline(baseline_path);
+  const auto baseline = fire::perf::start_baseline_run("bench_pools", FIRE_SOURCE_DIR "/perf/pools/baseline.json", argc, argv);
   if (!baseline) die(baseline.error());
   std::printf("# bench_pools: %u faces by splitting, curves of %u points, medians of %d runs\n", kFaces, kCurvePoints, kRepetitions);
 
@@ -300,11 +297,6 @@ int main(int argc, char** argv) {
       {"heap bytes per point: OpenMesh / FIRE after compaction", double(om_heap) / double(mesh.pool_bytes()), 0},
       {"read all points edge by edge: OpenMesh / FIRE", t_om_edges / t_edges, 0},
       {"read all points in shuffled order: OpenMesh / FIRE", t_om_random / t_random, 0}};
-  std::printf("\n%s", fire::perf::compare_with_baseline(*baseline, figures, baseline_path).c_str());
-  if (write) {
-    if (Status written = fire::perf::write_baseline(baseline_path, "bench_pools", "bench_pools", figures); !written)
-      die(written.error);
-    std::printf("\nwrote %s\n", baseline_path.c_str());
-  }
+  if (fire::Status done = fire::perf::finish_baseline_run(*baseline, "bench_pools", figures); !done) die(done.error);
   return 0;
 }

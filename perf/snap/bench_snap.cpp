@@ -183,10 +183,7 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bool write = argc == 2 && std::string(argv[1]) == "--write-baseline";
-  if (argc > 2 || (argc == 2 && !write)) die("usage: bench_snap [--write-baseline]");
-  const std::string baseline_path = FIRE_SOURCE_DIR "/perf/snap/baseline.json";
-  const auto baseline = fire::perf::read_baseline(baseline_path);
+  const auto baseline = fire::perf::start_baseline_run("bench_snap", FIRE_SOURCE_DIR "/perf/snap/baseline.json", argc, argv);
   if (!baseline) die(baseline.error());
   // nanoflann's time over ours, each row: kept in perf/snap/baseline.json.
   std::vector<fire::perf::Figure> figures;
@@ -323,11 +320,6 @@ int main(int argc, char** argv) {
     figures.push_back({std::to_string(target) + " points, insert curve: nanoflann dynamic / ours", nano_insert / ours_insert, 0});
     figures.push_back({std::to_string(target) + " points, delete curve: nanoflann dynamic / ours", nano_delete / ours_delete, 0});
   }
-  std::printf("\n%s", fire::perf::compare_with_baseline(*baseline, figures, baseline_path).c_str());
-  if (write) {
-    if (fire::Status written = fire::perf::write_baseline(baseline_path, "bench_snap", "bench_snap", figures); !written)
-      die(written.error);
-    std::printf("\nwrote %s\n", baseline_path.c_str());
-  }
+  if (fire::Status done = fire::perf::finish_baseline_run(*baseline, "bench_snap", figures); !done) die(done.error);
   return 0;
 }

@@ -328,14 +328,11 @@ int main(int argc, char** argv) {
   for (const Mesh* mesh : {&control, &coons})
     for (int levels : {3, 4})
       for (fire::perf::Figure& f : run_case(*mesh, levels, repetitions, order)) figures.push_back(std::move(f));
-  std::printf("\n%s", fire::perf::compare_with_baseline(*baseline, figures, baseline_path).c_str());
-  if (write) {
-    const std::string command = "bench_subdivide " + std::to_string(repetitions) + " " + order_name;
-    if (fire::Status written = fire::perf::write_baseline(baseline_path, "bench_subdivide", command, figures); !written) {
-      std::fprintf(stderr, "bench_subdivide: %s\n", written.error.c_str());
-      return 1;
-    }
-    std::printf("\nwrote %s\n", baseline_path.c_str());
+  const fire::perf::BaselineRun run{"bench_subdivide", baseline_path, *baseline, write};
+  const std::string command = "bench_subdivide " + std::to_string(repetitions) + " " + order_name;
+  if (fire::Status done = fire::perf::finish_baseline_run(run, command, figures); !done) {
+    std::fprintf(stderr, "bench_subdivide: %s\n", done.error.c_str());
+    return 1;
   }
   return 0;
 }
