@@ -193,7 +193,10 @@ int run_simulate_drawing(const SimulateArgs& a) {
   if (!tags) return fail(command, tags.error());
   Result<std::vector<Vec3>> placed = object_frame(mesh->positions, a.drawing.height_m);
   if (!placed) return fail(command, mesh_path + ": " + placed.error());
-  const PolygonMeshView control{*placed, mesh->face_offsets, mesh->face_vertices, mesh_path};
+  mesh->positions = std::move(*placed);
+  Result<int> closed_holes = close_small_holes(*mesh, tags->sharp_edges, tags->border_corners, kShortestStroke);
+  if (!closed_holes) return fail(command, mesh_path + ": " + closed_holes.error());
+  const PolygonMeshView control = mesh->view(mesh_path);
   Result<Mesh> network = network_from_mesh(
       control, UnrefineOptions{.unrefine = a.unrefine, .limit = true, .sharp_edges = tags->sharp_edges, .border_corners = tags->border_corners});
   if (!network) return fail(command, network.error());
@@ -208,7 +211,6 @@ int run_simulate_drawing(const SimulateArgs& a) {
   // The object as a cage, its crease tags with it, so that fire eval measures against the limit surface drawn on.
   Cage placed_object;
   placed_object.mesh = *mesh;
-  placed_object.mesh.positions = *placed;
   placed_object.sharp_edges = tags->sharp_edges;
   placed_object.border_corners = tags->border_corners;
   const Result<std::string> object =
@@ -229,6 +231,7 @@ int run_simulate_drawing(const SimulateArgs& a) {
   out["poses"] = st.poses;
   out["pieces"] = st.pieces;
   out["holes"] = st.holes;
+  out["holes_closed"] = *closed_holes;
   out["sharp"] = st.sharp;
   out["mark_touches"] = st.mark_touches;
   out["curves_drawn"] = st.curves_drawn;
@@ -597,13 +600,15 @@ void add_tracking_commands(CLI::App& app, Registry& registry) {
       "t crease tags in --mesh) are marked sharp at the end, the pen touching each (cmd sharp X Y Z). When no stroke "
       "left is seen whole by both cameras, the object is turned to a pose that shows one and registered again on the "
       "marks seen there; a chain no pose shows whole is drawn in pieces, turning the object between them. The pen's "
-      "LED is at its tip, on the limit surface, which is what hides it from a camera. "
+      "LED is at its tip, on the limit surface, which is what hides it from a camera. A border loop under 5 mm across "
+      "(the rook's 3 mm hole under its base) is a hole no stroke can draw round: the object is drawn on, and written "
+      "by --object-out, with it closed, its vertices one at their centre. "
       "The stray reflection (--stray) as in every session. Hand occlusions (--occlusion) are off by default: while one "
       "camera follows the pen the tracker emits no samples, so a hand passing a corner of a stroke that runs along "
       "several curves makes a chord there, a later curve meant to end at that corner misses it and is rejected, and "
       "the curves that depend on it after it. "
       "Prints one JSON line: the session's report counts, strokes (border and split), undos, registrations, poses, "
-      "pieces, holes, mark touches, curves drawn of the network's total. When it cannot draw every curve (--max-strokes aside), it writes nothing and "
+      "pieces, holes (opened with cmd hole; holes_closed: under 5 mm across, closed), mark touches, curves drawn of the network's total. When it cannot draw every curve (--max-strokes aside), it writes nothing and "
       "exits 1, naming the first curve it could not draw and why.");
   dr->callback([drawing, &registry] { registry.exit_code = run_simulate_drawing(*drawing); });
 

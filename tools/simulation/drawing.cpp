@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <numeric>
 
+#include "engine/text.hpp"
 #include "platform/simulated_rig/simulated_rig_detail.hpp"
 #include "systems/tracking/registration.hpp"
 #include "tools/simulation/drawing_plan.hpp"
@@ -220,6 +222,90 @@ Result<std::vector<Vec3>> object_frame(std::span<const Vec3> positions, double h
   out.reserve(positions.size());
   for (const Vec3& p : positions) out.push_back((p - base) * scale);
   return out;
+}
+
+Result<int> close_small_holes(PolygonMesh& mesh, std::vector<uint32_t>& sharp_edges, std::vector<uint8_t>& border_corners,
+                              double narrowest_m) {
+  using R = Result<int>;
+  const auto key = [](uint32_t a, uint32_t b) { return std::pair{std::min(a, b), std::max(a, b)}; };
+  std::map<std::pair<uint32_t, uint32_t>, int> uses;
+  for (uint32_t f = 0; f < mesh.face_count(); ++f) {
+    const auto face = mesh.face(f);
+    for (size_t k = 0; k < face.size(); ++k) ++uses[key(face[k], face[(k + 1) % face.size()])];
+  }
+  // Each border edge as its face walks it; a loop follows them from vertex to vertex.
+  std::map<uint32_t, uint32_t> next;
+  for (uint32_t f = 0; f < mesh.face_count(); ++f) {
+    const auto face = mesh.face(f);
+    for (size_t k = 0; k < face.size(); ++k) {
+      const uint32_t a = face[k], b = face[(k + 1) % face.size()];
+      if (uses[key(a, b)] != 1) continue;
+      if (!next.emplace(a, b).second) return R::failure("vertex " + std::to_string(a) + " lies on the border twice");
+    }
+  }
+  std::vector<uint32_t> merged_into(mesh.positions.size());
+  std::iota(merged_into.begin(), merged_into.end(), 0u);
+  int closed = 0;
+  std::vector<uint8_t> walked(mesh.positions.size(), 0), in_closed_loop(mesh.positions.size(), 0);
+  for (const auto& [start, unused] : next) {
+    if (walked[start]) continue;
+    std::vector<uint32_t> loop;
+    for (uint32_t v = start; !walked[v]; v = next.at(v)) {
+      walked[v] = 1;
+      loop.push_back(v);
+    }
+    Vec3 centre = Vec3::Zero();
+    for (uint32_t v : loop) centre += mesh.positions[v];
+    centre /= static_cast<double>(loop.size());
+    double across = 0;
+    for (uint32_t v : loop) across = std::max(across, 2 * (mesh.positions[v] - centre).norm());
+    if (across >= narrowest_m) continue;
+    mesh.positions[start] = centre;
+    for (uint32_t v : loop) merged_into[v] = start, in_closed_loop[v] = 1;
+    ++closed;
+  }
+  if (closed == 0) return 0;
+
+  constexpr uint32_t kNoVertex = ~0u;
+  PolygonMesh out;
+  std::vector<uint32_t> number(mesh.positions.size(), kNoVertex);
+  for (uint32_t f = 0; f < mesh.face_count(); ++f) {
+    std::vector<uint32_t> face;
+    for (uint32_t v : mesh.face(f))
+      if (face.empty() || merged_into[v] != face.back()) face.push_back(merged_into[v]);
+    while (face.size() > 1 && face.front() == face.back()) face.pop_back();
+    if (face.size() < 3) continue;
+    for (uint32_t v : face) {
+      if (number[v] == kNoVertex) {
+        number[v] = static_cast<uint32_t>(out.positions.size());
+        out.positions.push_back(mesh.positions[v]);
+      }
+      out.face_vertices.push_back(number[v]);
+    }
+    out.face_offsets.push_back(static_cast<uint32_t>(out.face_vertices.size()));
+  }
+  std::map<std::pair<uint32_t, uint32_t>, int> uses_after;
+  for (uint32_t f = 0; f < out.face_count(); ++f) {
+    const auto face = out.face(f);
+    for (size_t k = 0; k < face.size(); ++k)
+      if (++uses_after[key(face[k], face[(k + 1) % face.size()])] > 2)
+        return R::failure("closing a hole under " + format_mm(narrowest_m) + " across would give edge " + std::to_string(face[k]) +
+                          "-" + std::to_string(face[(k + 1) % face.size()]) + " a third face");
+  }
+  std::vector<uint32_t> sharp;
+  for (size_t k = 0; k + 1 < sharp_edges.size(); k += 2) {
+    const uint32_t a = number[merged_into[sharp_edges[k]]], b = number[merged_into[sharp_edges[k + 1]]];
+    if (a != kNoVertex && b != kNoVertex && a != b) sharp.insert(sharp.end(), {a, b});
+  }
+  if (!border_corners.empty()) {
+    std::vector<uint8_t> corners(out.positions.size(), 0);
+    for (uint32_t v = 0; v < border_corners.size(); ++v)
+      if (!in_closed_loop[v] && number[v] != kNoVertex) corners[number[v]] = border_corners[v];
+    border_corners = std::move(corners);
+  }
+  sharp_edges = std::move(sharp);
+  mesh = std::move(out);
+  return closed;
 }
 
 Result<SimulatedDrawing> simulate_drawing(const RigOptions& o, const DrawingOptions& d, const PolygonMeshView& object,

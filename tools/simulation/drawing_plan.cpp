@@ -9,6 +9,7 @@
 
 #include "engine/input_log.hpp"
 #include "engine/text.hpp"
+#include "systems/sketch/sketch.hpp"
 
 namespace fire::simulation {
 using namespace tracking;  // the cameras, calibration and tracking this simulation feeds and checks
@@ -36,9 +37,6 @@ constexpr uint32_t kNoLoop = ~0u;
 constexpr size_t kMaxLegs = 4;
 constexpr size_t kMaxLegsStuck = 8;
 constexpr size_t kMaxPieces = 4;
-// A tracked stroke shorter than this is taken for a touch of the pen, or loses its middle to the pauses at its
-// ends (metres: the sketch's 3 mm at each end, and 2 mm to draw).
-constexpr double kShortestStroke = 0.005;
 constexpr size_t kPieceMargin = 2;  // points
 // How far a piece's free end stays from every curve drawn (metres): the sketch's snap distance and a few times
 // the tracked pen's error, so the tracked end is not taken for one on the network.
@@ -384,11 +382,25 @@ Result<std::vector<Layout>> lay_out(Cells& g, const std::vector<char>& visible) 
       auto shown_around = [&](uint32_t f) {
         return std::all_of(net.faces[f].begin(), net.faces[f].end(), [&](const Leg& l) { return visible[l.curve] != 0; });
       };
+      // A border stroke that ends within the sketch's snap distance of where the loop began closes it there: the
+      // loop's corners must lie farther apart than that (the rook's crenellations have smaller faces at the top).
+      auto corners_apart = [&](uint32_t f, uint32_t h) {
+        std::vector<uint32_t> corners;
+        for (uint32_t face : {f, h})
+          for (const Leg& l : net.faces[face]) corners.push_back(net.curves[l.curve].a), corners.push_back(net.curves[l.curve].b);
+        std::sort(corners.begin(), corners.end());
+        corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+        for (size_t i = 0; i < corners.size(); ++i)
+          for (size_t j = i + 1; j < corners.size(); ++j)
+            if ((net.vertices[corners[i]] - net.vertices[corners[j]]).norm() < SketchSettings{}.snap_distance) return false;
+        return true;
+      };
       for (uint32_t k = 0; k < net.curves.size(); ++k)
         if (g.beside[k].size() == 2 && g.beside[k][0] != g.beside[k][1] && part[g.beside[k][0]]) {
-          // Faces whose curves some pose shows first.
+          // Faces whose curves some pose shows first, and whose loop the sketch can close where it is meant to.
           const double z = centre_z(g.beside[k][0]) + centre_z(g.beside[k][1]) +
-                           (shown_around(g.beside[k][0]) && shown_around(g.beside[k][1]) ? 1e6 : 0);
+                           (shown_around(g.beside[k][0]) && shown_around(g.beside[k][1]) ? 1e6 : 0) +
+                           (corners_apart(g.beside[k][0], g.beside[k][1]) ? 2e6 : 0);
           if (z > best) best = z, pair = {g.beside[k][0], g.beside[k][1]};
         }
       if (pair.first == kNoLoop) return R::failure(which + " is closed and has no two faces side by side");

@@ -84,6 +84,17 @@ inline constexpr int kOccluderLevels = 1;
 // The object's own frame: `positions` scaled to `height_m` along +z, the centre of its base at the origin.
 Result<std::vector<Vec3>> object_frame(std::span<const Vec3> positions, double height_m);
 
+// A tracked stroke shorter than this is taken for a touch of the pen, or loses its middle to the pauses at its
+// ends (metres: the sketch's 3 mm at each end, and 2 mm to draw).
+inline constexpr double kShortestStroke = 0.005;
+
+// Closes each border loop of `mesh` narrower than `narrowest_m` (twice its vertices' farthest distance from
+// their centroid), a hole too small to draw round and to tell its vertices apart on (the rook's 3 mm hole under
+// its base): the loop's vertices become one, at their centroid, so the faces around it meet there. Unused vertices are dropped and the tags renumbered with the rest. Returns how many loops it
+// closed, or why it cannot (a loop through a vertex twice, or a face that would use an edge a third time).
+Result<int> close_small_holes(PolygonMesh& mesh, std::vector<uint32_t>& sharp_edges, std::vector<uint8_t>& border_corners,
+                              double narrowest_m);
+
 // `object` (its surface, object frame, metres: the control mesh's limit surface, limit_mesh() at
 // kOccluderLevels, which is what hides the pen from a camera) placed before the rig in one of `turns` poses at
 // a time, and, where it needs them, upside down and leaning further. Six marks are picked among the network's
