@@ -4,6 +4,7 @@
 //   - idle: the frame sustained for --seconds with nothing drawn: mean fps, p50 and p99 frame time (wall
 //     time between presents), the process's CPU time per frame, and where the time goes: per stage, and
 //     the fps with the surface or the curves hidden;
+//   - orbiting: the camera turned a little every frame, as a drag turns it, for --seconds: mean fps, p50 and p99;
 //   - drawing: strokes across grid cells, one pen sample (0.5 mm on) per displayed frame, as the mouse pen
 //     logs them: bytes uploaded on the frames of a stroke in progress, and on the frames from its pen-up
 //     (split, refine, subdivide) until nothing more is uploaded.
@@ -74,6 +75,10 @@ struct Measurement {
   Stat frame_ms;
   Stages stages;
   std::vector<double> toggle_fps;  // surface hidden, curves hidden, both
+  // orbiting
+  size_t orbit_frames = 0;
+  double orbit_seconds = 0;
+  Stat orbit_frame_ms;
   // drawing
   Stat stroke_bytes, stroke_bytes_per_point, stroke_scene_bytes, stroke_frame_ms;
   Stat commit_bytes, commit_frames, commit_frame_ms, commit_surface_bytes;
@@ -85,6 +90,8 @@ struct Measurement {
 constexpr int kStrokes = 6, kSamples = 41;
 // Seconds of each idle run with parts of the scene hidden.
 constexpr int kToggleS = 3;
+// How far the camera turns per orbiting frame: a drag of 2 pixels a frame (render::kOrbitRadiansPerPixel).
+constexpr float kOrbitStepPx = 2;
 
 // CPU time of the whole process (the app thread and lavapipe's), which waiting for a core on a shared
 // machine does not inflate as it does the wall time.
@@ -175,6 +182,28 @@ Measurement run(const Config& c, double seconds) {
     r.toggle_fps.push_back(double(frames) / (ms_between(from, WallClock::now()) / 1000.0));
   }
   app.hud_data.view = {};
+
+  // Orbiting: every frame a new camera, as while a drag turns the view; then back where it was.
+  {
+    render::Orbit moving = orbit;
+    const auto from = WallClock::now();
+    auto previous = from;
+    while (previous - from < std::chrono::duration<double>(seconds)) {
+      moving.rotate(kOrbitStepPx, 0);
+      app.window().poll();
+      app.window().events().clear();
+      if (!app.display(moving) || !app.status()) {
+        r.problem = "an orbiting frame was not shown: " + app.status().error;
+        return r;
+      }
+      const auto now = WallClock::now();
+      r.orbit_frame_ms.add(ms_between(previous, now));
+      previous = now;
+    }
+    r.orbit_frames = r.orbit_frame_ms.v.size();
+    r.orbit_seconds = ms_between(from, previous) / 1000.0;
+    frame();
+  }
 
   // Strokes across cells away from each other, bottom to top through the cell's middle: each splits it.
   auto log = [&](EventKind kind, const Vec3& p = Vec3::Zero()) {
@@ -286,6 +315,15 @@ int main(int argc, char** argv) {
                 r.name.c_str(), r.faces_before, r.config.levels, r.quads, r.frames, r.seconds, fps,
                 r.frame_ms.percentile(50), r.frame_ms.percentile(99), r.frame_ms.max(), r.cpu_ms_per_frame, target,
                 fps >= target ? "met" : "missed");
+  }
+  std::printf("\nOrbiting: the camera turned by a %.0f-pixel drag every frame, for the same seconds (a frame unlike the one "
+              "before is drawn whole):\n\n| network | L | frames | mean fps | p50 ms | p99 ms | max ms | target |\n"
+              "|---|---|---|---|---|---|---|---|\n", double(kOrbitStepPx));
+  for (const Measurement& r : results) {
+    const double fps = double(r.orbit_frames) / r.orbit_seconds;
+    std::printf("| %s | %u | %zu | %.1f | %.2f | %.2f | %.2f | >= 30 fps: %s |\n", r.name.c_str(), r.config.levels,
+                r.orbit_frames, fps, r.orbit_frame_ms.percentile(50), r.orbit_frame_ms.percentile(99), r.orbit_frame_ms.max(),
+                fps >= 30 ? "met" : "missed");
   }
   std::printf("\nIdle fps with parts of the scene hidden (the app's keys 1 and 2; %d s each; left: the clear, "
               "the resolve if multisampled, HUD, present):\n\n| network | L | all | surface hidden | curves hidden | both hidden |\n"
