@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <numbers>
 #include <string>
 #include <tuple>
 #include <unordered_map>
@@ -189,6 +190,7 @@ Renderer::~Renderer() {
   for (Buffer* b : {&readback_, &points_, &vertices_, &surface_vertices_, &surface_indices_, &reference_vertices_,
                     &reference_indices_, &stroke_, &pen_, &marks_})
     destroy(*b);
+  for (Coarse& c : coarse_) destroy(c.indices);
   for (Target* t : {&color_, &resolve_, &depth_, &layer_color_, &layer_depth_}) destroy(*t);
   for (VkPipeline p : {surface_, reference_pipeline_, curves_, markers_, wireframe_, pen_face_})
     if (p) vkDestroyPipeline(device, p, nullptr);
@@ -394,7 +396,9 @@ Status Renderer::upload_vertices(const Mesh& network) {
 
 Status Renderer::upload_surface(const SurfaceLevels& s) {
   surface_settled_ = s.settled;
+  surface_level_ = s.level;
   if (s.empty()) {
+    ++surface_layout_;
     blocks_.clear();
     free_blocks_.clear();
     surface_draws_.clear();
@@ -415,6 +419,12 @@ Status Renderer::upload_surface(const SurfaceLevels& s) {
 
 Status Renderer::layout_surface(const SurfaceLevels& s) {
   // The blocks held so far, by key; a key seen twice (never from the subdivide system) keeps its first.
+  ++surface_layout_;
+  surface_quads_ = s.quad_count();
+  Box box;
+  for (const Vec3& p : s.positions) box.add(p);
+  surface_centre_ = 0.5f * (box.lo + box.hi);
+  surface_radius_ = 0.5f * glm::length(box.hi - box.lo);
   std::vector<Block> old = std::move(blocks_);
   std::unordered_map<uint32_t, size_t> old_by_key;
   for (size_t i = 0; i < old.size(); ++i) old_by_key.emplace(old[i].key, i);
@@ -728,21 +738,92 @@ void Renderer::begin_rendering(VkCommandBuffer cmd, VkImageView color_view, VkIm
   vkCmdSetScissor(cmd, 0, 1, &scissor);
 }
 
-void Renderer::record_layer(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options) {
+namespace {
+
+// The quads one level coarser (4 indices each): every group of four consecutive quads, the children of one
+// quad, becomes the quad of the corners that no other quad of its group uses, child by child. False where the
+// quads do not group so.
+bool coarsen(std::span<const uint32_t> fine, std::vector<uint32_t>& out) {
+  if (fine.size() % 16 != 0) return false;
+  out.clear();
+  for (size_t group = 0; group < fine.size(); group += 16) {
+    const std::span<const uint32_t> children = fine.subspan(group, 16);
+    for (size_t child = 0; child < 4; ++child) {
+      uint32_t corner = kNone;
+      for (size_t i = 0; i < 4; ++i) {
+        const uint32_t v = children[4 * child + i];
+        if (std::count(children.begin(), children.end(), v) != 1) continue;
+        if (corner != kNone) return false;
+        corner = v;
+      }
+      if (corner == kNone) return false;
+      out.push_back(corner);
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+uint32_t Renderer::coarser_step(const Camera& camera) const {
+  if (surface_level_ < 2 || blocks_.empty() || !(surface_radius_ > 0)) return 0;
+  const float pixel = pixel_size_at(camera, surface_centre_, settings_.height);
+  if (!(pixel > 0)) return 0;
+  // The quads' size on screen, roughly: the surface's bounding disc shared by the half of its quads facing the camera.
+  const float radius_px = surface_radius_ / pixel;
+  const float quad_px = std::sqrt(std::numbers::pi_v<float> * radius_px * radius_px / (0.5f * float(std::max(surface_quads_, 1u))));
+  uint32_t step = 0;
+  while (step + 1 < surface_level_ && quad_px * float(1u << step) < kCoarseQuadPx) ++step;
+  return step;
+}
+
+bool Renderer::build_coarse(uint32_t step) {
+  if (coarse_.size() < step) coarse_.resize(step);
+  Coarse& c = coarse_[step - 1];
+  if (c.built && c.layout == surface_layout_) return c.index_count > 0;
+  c.built = true;
+  c.layout = surface_layout_;
+  c.index_count = 0;
+  std::vector<uint32_t> indices, quads, coarser;
+  for (const Block& b : blocks_) {
+    quads = b.quads;
+    for (uint32_t k = 0; k < step; ++k) {
+      if (!coarsen(quads, coarser)) return false;
+      quads.swap(coarser);
+    }
+    for (size_t q = 0; q < quads.size(); q += 4)
+      for (size_t corner : {0, 1, 2, 0, 2, 3}) indices.push_back(b.first_vertex + quads[q + corner]);
+  }
+  const VkDeviceSize bytes = VkDeviceSize(indices.size()) * sizeof(uint32_t);
+  bool grown = false;
+  if (indices.empty() || !reserve(c.indices, bytes, kIndex, grown)) return false;
+  copy_into(c.indices, 0, indices.data(), bytes);
+  c.index_count = uint32_t(indices.size());
+  return true;
+}
+
+void Renderer::record_layer(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options, uint32_t step) {
   const float scale = float(settings_.height) / 720.0f;
   Pass pass{cmd, layout_, camera_constants(camera, settings_.width, settings_.height)};
   PushConstants& pc = pass.pc;
+  auto draw_surface = [&] {
+    if (step > 0) {
+      vkCmdBindIndexBuffer(cmd, coarse_[step - 1].indices.buffer, 0, VK_INDEX_TYPE_UINT32);
+      vkCmdDrawIndexed(cmd, coarse_[step - 1].index_count, 1, 0, 0, 0);
+      return;
+    }
+    vkCmdBindIndexBuffer(cmd, surface_indices_.buffer, 0, VK_INDEX_TYPE_UINT32);
+    for (const auto& [first, count] : surface_draws_) vkCmdDrawIndexed(cmd, count, 1, first, 0, 0);
+  };
   if (!surface_draws_.empty() && options.surface) {
     pc.color = linear(surface_settled_ ? Palette::surface : Palette::provisional_surface);
     pass.bind(surface_, surface_vertices_.buffer);
-    vkCmdBindIndexBuffer(cmd, surface_indices_.buffer, 0, VK_INDEX_TYPE_UINT32);
-    for (const auto& [first, count] : surface_draws_) vkCmdDrawIndexed(cmd, count, 1, first, 0, 0);
+    draw_surface();
   }
   if (!surface_draws_.empty() && options.wireframe && wireframe_) {
     pc.color = linear(Palette::wireframe);
     pass.bind(wireframe_, surface_vertices_.buffer);
-    vkCmdBindIndexBuffer(cmd, surface_indices_.buffer, 0, VK_INDEX_TYPE_UINT32);
-    for (const auto& [first, count] : surface_draws_) vkCmdDrawIndexed(cmd, count, 1, first, 0, 0);
+    draw_surface();
   }
   if (!curve_draws_.empty() && options.curves) {
     pc.color = linear(Palette::curve);
@@ -816,7 +897,10 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
                       VkImageView target_view, bool target_takes_copies) {
   const LayerKey key{camera.view_projection(), camera.eye, camera.key_light, camera.line_depth_pull, options, scene_version_};
   const bool still = last_key_ && *last_key_ == key;
+  const bool moved = last_key_ && (last_key_->view_proj != key.view_proj || last_key_->eye != key.eye);
   last_key_ = key;
+  drawn_step_ = settings_.coarser_while_moving && moved ? coarser_step(camera) : 0;
+  if (drawn_step_ > 0 && !build_coarse(drawn_step_)) drawn_step_ = 0;
   const VkImage frame_color = color_.image ? color_.image : target;
   const VkImageView frame_view = color_.image ? color_.view : target_view;
   const VkImageView resolve_view = color_.image ? target_view : VK_NULL_HANDLE;
@@ -831,7 +915,7 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
     barriers.push_back(overwrite(depth_.image, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_ASPECT_DEPTH_BIT, kDepthStage, kDepthAccess));
     record_barriers(cmd, barriers);
     begin_rendering(cmd, frame_view, resolve_view, depth_.view, true, false);
-    record_layer(cmd, camera, options);
+    record_layer(cmd, camera, options, drawn_step_);
     record_overlays(cmd, camera);
     vkCmdEndRendering(cmd);
     return;
@@ -844,7 +928,7 @@ void Renderer::record(VkCommandBuffer cmd, const Camera& camera, const DrawOptio
     record_barriers(cmd, barriers);
     barriers.clear();
     begin_rendering(cmd, layer_color_.view, VK_NULL_HANDLE, layer_depth_.view, true, true);
-    record_layer(cmd, camera, options);
+    record_layer(cmd, camera, options, 0);
     vkCmdEndRendering(cmd);
     barriers.push_back(image_barrier(layer_color_.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                                      VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, kColorStage, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,

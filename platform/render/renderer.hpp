@@ -10,7 +10,8 @@
 // large marker, and the border's first vertex as a larger one when a stroke ending at the pen would close it;
 // in a live session the object's registration marks, the one to touch next larger and red.
 // A frame the same as the one before but for the stroke, the pen's feedback and the marks (record()) copies
-// the rest from the layer it kept, so a still scene is rasterised once.
+// the rest from the layer it kept, so a still scene is rasterised once. A frame whose camera moved may draw
+// the surface at a coarser level (RenderSettings::coarser_while_moving); no other frame does.
 //
 // Uploads copy only what changed and count the bytes (UploadStats, per upload() call, i.e. per frame):
 // - points: the GPU keeps a float copy of the point pool at the pool's indices. An edge's points are
@@ -24,7 +25,9 @@
 //   triangles are copied. Then, and when SurfaceLevels::frame is newer than the last frame uploaded, the
 //   vertices in SurfaceLevels::changed are converted to float and copied where they differ from what the
 //   block holds: a commit copies the triangles of the patches it changed and the vertices whose values
-//   moved (the limit fit moves most of them a little at every commit: perf/notes/render.md).
+//   moved (the limit fit moves most of them a little at every commit: perf/notes/render.md);
+// - the surface's coarser levels (RenderSettings::coarser_while_moving): their triangles, in the first frame
+//   that draws one after the blocks were laid out, counted with that frame's upload.
 // Buffers are host-visible; growing one re-uploads its whole content (counted as well). The surface's
 // buffers grow by half again, and are laid out afresh when freed blocks outnumber the used ones.
 #include <cstdint>
@@ -51,7 +54,15 @@ struct RenderSettings {
   // The colour format drawn in: the window's swapchain format for the present path (R8G8B8A8_SRGB or
   // B8G8R8A8_SRGB; image() returns RGBA either way).
   VkFormat color_format = VK_FORMAT_R8G8B8A8_SRGB;
+  // A frame whose camera moved since the frame before draws the surface at a coarser level, chosen by how
+  // large its quads are on screen (at least kCoarseQuadPx across while the camera moves); every other frame
+  // draws the surface's own level. For the app's window, where a drag turns the camera every frame.
+  bool coarser_while_moving = false;
 };
+
+// While the camera moves, the surface is drawn at the finest level whose quads are about this many pixels
+// across or more (RenderSettings::coarser_while_moving).
+inline constexpr float kCoarseQuadPx = 4.0f;
 
 // Colours of the scene, sRGB 0..255: shared with the tests, which find the curves and the background by them.
 struct Palette {
@@ -124,6 +135,8 @@ class Renderer {
               VkImageView target_view, bool target_takes_copies);
   // How many frames in a row were still frames, copied from the layer (0 after a frame drawn whole).
   uint64_t layer_frames() const { return layer_uses_; }
+  // How many levels coarser than its own the last frame drew the surface (0: its own level).
+  uint32_t coarser_levels() const { return drawn_step_; }
   VkFormat color_format() const { return color_format_; }
   // New target size (a resized window); waits for the device first. Uploaded data is kept.
   Status resize(uint32_t width, uint32_t height);
@@ -158,7 +171,11 @@ class Renderer {
   Status create_pipelines();
   void begin_rendering(VkCommandBuffer cmd, VkImageView color_view, VkImageView resolve_view, VkImageView depth_view,
                        bool clear, bool keep);
-  void record_layer(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options);
+  void record_layer(VkCommandBuffer cmd, const Camera& camera, const DrawOptions& options, uint32_t step);
+  // How many levels coarser a frame whose camera moved draws the surface (RenderSettings::coarser_while_moving).
+  uint32_t coarser_step(const Camera& camera) const;
+  // Makes coarse_[step - 1] hold the surface's triangles `step` levels coarser; false where it cannot.
+  bool build_coarse(uint32_t step);
   void record_overlays(VkCommandBuffer cmd, const Camera& camera);
   void copy_into(Buffer& buffer, VkDeviceSize offset, const void* data, VkDeviceSize bytes);
   Status upload_points(const Mesh& network);
@@ -227,6 +244,22 @@ class Renderer {
   std::vector<uint32_t> block_vertex_;  // scratch: per surface vertex its block vertex, kNone outside the patch
   std::vector<std::pair<uint32_t, uint32_t>> surface_draws_;  // (first index, index count), runs of blocks
   uint64_t surface_topology_ = 0;
+  // The surface `step` levels coarser (coarse_[step - 1]), for frames whose camera moved: each quad the corners
+  // of a group of four quads one level finer that no other quad of the group uses (catmull_clark's children of
+  // one quad), over the same vertices. Those are limit positions, so this is the coarser level's limit mesh.
+  // Built in the first frame that wants it after the blocks were laid out (surface_layout_).
+  struct Coarse {
+    Buffer indices;
+    uint32_t index_count = 0;  // 0: the blocks' quads do not group so
+    uint64_t layout = 0;
+    bool built = false;
+  };
+  std::vector<Coarse> coarse_;
+  uint64_t surface_layout_ = 0;  // moves whenever the blocks are laid out
+  uint32_t surface_level_ = 0, surface_quads_ = 0;
+  glm::vec3 surface_centre_{0.0f};
+  float surface_radius_ = 0;
+  uint32_t drawn_step_ = 0;
   Frame surface_frame_ = 0;
   bool surface_seen_ = false;
   bool surface_settled_ = true;

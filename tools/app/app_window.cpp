@@ -33,7 +33,7 @@ Result<std::unique_ptr<AppWindow>> AppWindow::open(World& world, Scheduler& sche
   app->presenter_ = std::move(*presenter);
   auto renderer =
       render::Renderer::create(*app->context_, {std::max(app->width_, 1u), std::max(app->height_, 1u), 0,
-                                                app->presenter_->format()});
+                                                app->presenter_->format(), true});
   if (!renderer) return R::failure(renderer.error());
   app->renderer_ = std::move(*renderer);
   if (Status s = app->renderer_->set_reference(reference_positions, reference_triangles); !s) return R::failure(s.error);

@@ -536,6 +536,78 @@ TEST_CASE("a still frame is not drawn again: its layer is copied and the stroke 
   CHECK_FALSE(same(with_reference, tinted));
 }
 
+TEST_CASE("while the camera moves the surface is drawn coarser, by its quads' size on screen; a still frame is drawn whole",
+          "[render][coarser]") {
+  auto context = make_context();
+  Scene scene = demo_scene();
+  scene.surface.level = reconstruct::Options{}.levels;  // what reconstruct_surface refined, as the subdivide system says it
+  REQUIRE(scene.surface.level >= 2);
+  auto drawn = [&](Renderer& r, const Camera& c) {
+    REQUIRE(r.upload(scene.network, scene.surface));
+    REQUIRE(r.draw(c));
+    CHECK(context->validation_message_count() == 0);
+    return r.image();
+  };
+  const Box box = box_of(scene);
+  // From the framed view to one three times as far, where the surface's quads are a few pixels across.
+  Orbit orbit = frame_orbit(box, kWidth, kHeight);
+  const Camera camera = orbit_camera(orbit, kWidth, kHeight);
+  orbit.distance *= 3;
+  orbit.rotate(40, 0);
+  const Camera elsewhere = orbit_camera(orbit, kWidth, kHeight);
+  orbit.rotate(40, 0);
+  const Camera beside = orbit_camera(orbit, kWidth, kHeight);  // as far: as many levels dropped
+
+  auto whole_renderer = Renderer::create(*context, {kWidth, kHeight});
+  REQUIRE(whole_renderer);
+  drawn(**whole_renderer, camera);
+  const Image whole = drawn(**whole_renderer, elsewhere);
+  CHECK((*whole_renderer)->coarser_levels() == 0);  // off unless asked for: headless renders draw every level
+
+  auto renderer = Renderer::create(*context, {kWidth, kHeight, 0, VK_FORMAT_R8G8B8A8_SRGB, true});
+  REQUIRE(renderer);
+  Renderer& r = **renderer;
+  drawn(r, camera);
+  CHECK(r.coarser_levels() == 0);  // a first frame did not move
+  const Image moving = drawn(r, elsewhere);
+  const uint32_t step = r.coarser_levels();
+  INFO("levels dropped " << step << " of " << scene.surface.level << ", quads " << scene.surface.quad_count());
+  REQUIRE(step >= 1);
+  REQUIRE(step < scene.surface.level);
+  // Its triangles were built for this frame: a quarter of the quads per level, 6 indices each.
+  CHECK(r.last_upload().bytes == uint64_t(scene.surface.quad_count() >> (2 * step)) * 6 * sizeof(uint32_t));
+  // A coarser limit mesh of the same surface: not the same pixels, but within a pixel or two along its outline.
+  size_t differing = 0;
+  for (size_t i = 0; i < moving.rgba.size(); i += 4)
+    for (int k = 0; k < 3; ++k)
+      if (std::abs(int(moving.rgba[i + k]) - int(whole.rgba[i + k])) > 48) {
+        ++differing;
+        break;
+      }
+  CHECK(moving.rgba != whole.rgba);
+  CHECK(differing < moving.rgba.size() / 4 / 50);
+  // The camera stops: drawn whole, the pixels of a renderer that never draws coarser.
+  CHECK(drawn(r, elsewhere).rgba == whole.rgba);
+  CHECK(r.coarser_levels() == 0);
+  // Moving on at that distance draws the triangles built before.
+  drawn(r, beside);
+  CHECK(r.coarser_levels() == step);
+  CHECK(r.last_upload().bytes == 0);
+  // Closer, the quads are larger on screen and fewer levels are dropped.
+  auto big = Renderer::create(*context, {1280, 720, 0, VK_FORMAT_R8G8B8A8_SRGB, true});
+  REQUIRE(big);
+  Orbit big_orbit = frame_orbit(box, 1280, 720);
+  drawn(**big, orbit_camera(big_orbit, 1280, 720));
+  big_orbit.distance *= 4;
+  drawn(**big, orbit_camera(big_orbit, 1280, 720));
+  const uint32_t far_step = (*big)->coarser_levels();
+  big_orbit.distance /= 16;
+  drawn(**big, orbit_camera(big_orbit, 1280, 720));
+  const uint32_t near_step = (*big)->coarser_levels();
+  INFO("levels dropped far away " << far_step << ", close up " << near_step);
+  CHECK(far_step > near_step);
+}
+
 TEST_CASE("Vulkan failures name the call") {
   CHECK(vk_failure("vkCreateDevice(physical_, &device, nullptr, &device_)", VK_ERROR_DEVICE_LOST) ==
         "vkCreateDevice failed: VK_ERROR_DEVICE_LOST (-4)");
