@@ -85,7 +85,10 @@ Status Hud::status() const {
                          render::vk_result_name(g_backend_failure));
 }
 
-bool Hud::wants_mouse() const { return ImGui::GetIO().WantCaptureMouse; }
+bool Hud::covers(double x, double y) const {
+  return std::any_of(panels_.begin(), panels_.end(),
+                     [&](const Panel& p) { return x >= p.x0 && x < p.x1 && y >= p.y0 && y < p.y1; });
+}
 
 namespace {
 
@@ -128,9 +131,15 @@ constexpr ImGuiWindowFlags kFixed = ImGuiWindowFlags_NoDecoration | ImGuiWindowF
                                     ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
                                     ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoMove;
 
+// The current window's rectangle, kept so that a press can be told to be on the HUD when it happens.
+void keep_panel(std::vector<Panel>& panels) {
+  const ImVec2 at = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
+  panels.push_back({at.x, at.y, at.x + size.x, at.y + size.y});
+}
+
 // fire aim: the lines, the problems in red (or a green line saying there are none), both camera views side by
 // side at up to half the sensor's size, smaller when the window is narrow.
-void build_aiming(const HudData& d) {
+void build_aiming(const HudData& d, std::vector<Panel>& panels) {
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_Always);
   ImGui::SetNextWindowBgAlpha(0.9f);
   ImGui::Begin("FIRE aim", nullptr, kFixed);
@@ -149,6 +158,7 @@ void build_aiming(const HudData& d) {
   draw_camera(0, d.cameras[0], scale);
   ImGui::SameLine();
   draw_camera(1, d.cameras[1], scale);
+  keep_panel(panels);
   ImGui::End();
 }
 
@@ -159,8 +169,9 @@ void Hud::build(const HudData& d) {
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
 
+  panels_.clear();
   if (d.aiming) {
-    build_aiming(d);
+    build_aiming(d, panels_);
     ImGui::Render();
     return;
   }
@@ -217,6 +228,7 @@ void Hud::build(const HudData& d) {
   if (d.cameras[1].present) draw_camera(1, d.cameras[1], 1.0f / 8.0f);
   ImGui::TextDisabled("H: help");
   const float panel_right = ImGui::GetWindowPos().x + ImGui::GetWindowSize().x;
+  keep_panel(panels_);
   ImGui::End();
 
   if (d.help) {
@@ -247,6 +259,7 @@ void Hud::build(const HudData& d) {
       ImGui::TextUnformatted(text.c_str());
       ImGui::PopTextWrapPos();
     }
+    keep_panel(panels_);
     ImGui::End();
   }
   ImGui::Render();

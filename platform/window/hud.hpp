@@ -60,6 +60,11 @@ struct HudData {
   std::vector<std::string> keys;
 };
 
+// A HUD window's rectangle, in window coordinates.
+struct Panel {
+  float x0, y0, x1, y1;
+};
+
 class Hud {
  public:
   // Installs ImGui's GLFW callbacks over the window's (they forward to them) and its Vulkan objects.
@@ -71,8 +76,11 @@ class Hud {
   // Lays out this frame's HUD; the draw happens in draw(), inside the presenter's overlay pass.
   void build(const HudData& data);
   void draw(VkCommandBuffer cmd);
-  // Whether the pointer or keyboard is over the HUD this frame: the scene then ignores them.
-  bool wants_mouse() const;
+  // Whether window point (x, y) lies on one of the HUD's panels as last built: a press or a scroll there is the
+  // HUD's, and the scene ignores it. By where each event lands, not by ImGui's WantCaptureMouse, which it
+  // updates once a frame: a press on the panel and a drag on the scene within one frame would both go to
+  // whichever had the pointer the frame before.
+  bool covers(double x, double y) const;
   // A Vulkan call inside ImGui's backend failed (it reports through a callback that cannot return).
   Status status() const;
 
@@ -81,6 +89,7 @@ class Hud {
   VkDevice device_ = VK_NULL_HANDLE;
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   bool glfw_ = false, vulkan_ = false;
+  std::vector<Panel> panels_;  // the last build's windows
 };
 
 }  // namespace fire::window

@@ -333,7 +333,7 @@ int run_app(const AppOptions& a) {
       }
       case WindowEventKind::ButtonPress:
         cursor = glm::vec2(float(e.x), float(e.y));
-        if (app.hud().wants_mouse() || dragging || panning || drawing) break;
+        if (app.hud().covers(cursor.x, cursor.y) || dragging || panning || drawing) break;
         if (shift || e.button == window::Button::Middle) panning = true;
         else if (e.button == window::Button::Left && live) {
           hud_data.status = "--live: the IR pen draws; right drag orbits, Shift + drag pans";
@@ -353,7 +353,7 @@ int run_app(const AppOptions& a) {
         dragging = panning = drawing = false;
         break;
       case WindowEventKind::Scroll:
-        if (!app.hud().wants_mouse()) {
+        if (!app.hud().covers(cursor.x, cursor.y)) {
           orbit.zoom(float(e.y));
           view_moved = true;
         }

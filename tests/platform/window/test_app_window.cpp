@@ -219,6 +219,32 @@ TEST_CASE("fire app: curves toggled off are not drawn", "[app][window]") {
   fs::remove_all(dir);
 }
 
+TEST_CASE("fire app: a press on the HUD stays the HUD's, and a drag on the scene in the same frame still draws",
+          "[app][window][sketch]") {
+  REQUIRE(has_xvfb());
+  const fs::path dir = scratch("hud_then_scene");
+  const std::string record = (dir / "draw.log").string();
+  const Run app = run_app(165,
+                          "--reference " + quote(FIRE_PAWN) + " --size 960x720 --script " +
+                              quote(FIRE_WINDOW_TEST_DIR "/hud_then_scene.script") + " --record " + quote(record),
+                          dir);
+  INFO("xvfb-run exit: " << app.runner_exit << "\nstdout: " << app.out << "\nstderr: " << app.err);
+  REQUIRE(app.exit_code == 0);
+  CHECK(nlohmann::json::parse(app.out)["edges"] == 1);  // the drag: the border's first curve
+  const auto log = fire::read_text_file(record);
+  REQUIRE(log);
+  auto parsed = fire::parse_input_log(*log, record);
+  REQUIRE(parsed);
+  size_t downs = 0, ups = 0;
+  for (const fire::InputEvent& e : parsed->events) {
+    downs += e.kind == fire::EventKind::Down;
+    ups += e.kind == fire::EventKind::Up;
+  }
+  CHECK(downs == 1);  // the press on the panel drew nothing
+  CHECK(ups == 1);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("fire app: strokes drawn with the mouse on a reference mesh replay bit for bit", "[app][window][sketch]") {
   REQUIRE(has_xvfb());
   const fs::path dir = scratch("draw");
