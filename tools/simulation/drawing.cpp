@@ -247,20 +247,26 @@ Result<int> close_small_holes(PolygonMesh& mesh, std::vector<uint32_t>& sharp_ed
   std::iota(merged_into.begin(), merged_into.end(), 0u);
   int closed = 0;
   std::vector<uint8_t> walked(mesh.positions.size(), 0), in_closed_loop(mesh.positions.size(), 0);
+  std::vector<Vec3> position = mesh.positions;  // `mesh` is left alone unless every hole closes
   for (const auto& [start, unused] : next) {
     if (walked[start]) continue;
     std::vector<uint32_t> loop;
-    for (uint32_t v = start; !walked[v]; v = next.at(v)) {
+    bool open = false;  // a border that stops (faces turned against each other) is no hole to close
+    for (uint32_t v = start; !walked[v] && !open;) {
       walked[v] = 1;
       loop.push_back(v);
+      const auto after = next.find(v);
+      open = after == next.end();
+      if (!open) v = after->second;
     }
+    if (open) continue;
     Vec3 centre = Vec3::Zero();
-    for (uint32_t v : loop) centre += mesh.positions[v];
+    for (uint32_t v : loop) centre += position[v];
     centre /= static_cast<double>(loop.size());
     double across = 0;
-    for (uint32_t v : loop) across = std::max(across, 2 * (mesh.positions[v] - centre).norm());
+    for (uint32_t v : loop) across = std::max(across, 2 * (position[v] - centre).norm());
     if (across >= narrowest_m) continue;
-    mesh.positions[start] = centre;
+    position[start] = centre;
     for (uint32_t v : loop) merged_into[v] = start, in_closed_loop[v] = 1;
     ++closed;
   }
@@ -278,7 +284,7 @@ Result<int> close_small_holes(PolygonMesh& mesh, std::vector<uint32_t>& sharp_ed
     for (uint32_t v : face) {
       if (number[v] == kNoVertex) {
         number[v] = static_cast<uint32_t>(out.positions.size());
-        out.positions.push_back(mesh.positions[v]);
+        out.positions.push_back(position[v]);
       }
       out.face_vertices.push_back(number[v]);
     }
