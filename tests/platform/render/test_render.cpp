@@ -536,7 +536,7 @@ TEST_CASE("a still frame is not drawn again: its layer is copied and the stroke 
   CHECK_FALSE(same(with_reference, tinted));
 }
 
-TEST_CASE("while the camera moves the surface is drawn coarser, by its quads' size on screen; a still frame is drawn whole",
+TEST_CASE("while the camera moves the surface is drawn coarser, by its quads' size on screen, and a still frame whole",
           "[render][coarser]") {
   auto context = make_context();
   Scene scene = demo_scene();
