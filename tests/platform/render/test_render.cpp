@@ -88,6 +88,18 @@ struct Rect {
   bool contains(float x, float y, float inset) const { return x >= x0 + inset && x <= x1 - inset && y >= y0 + inset && y <= y1 - inset; }
 };
 
+// Pixels of two images of one size whose colour differs by more than 48 in some channel.
+size_t pixels_differing(const Image& a, const Image& b) {
+  size_t differing = 0;
+  for (size_t i = 0; i < a.rgba.size(); i += 4)
+    for (int k = 0; k < 3; ++k)
+      if (std::abs(int(a.rgba[i + k]) - int(b.rgba[i + k])) > 48) {
+        ++differing;
+        break;
+      }
+  return differing;
+}
+
 // Compares with the committed image (or rewrites it on request, and fails): at most 1% of the pixels differ by
 // more than 48 in a channel (edges may move by a pixel between driver versions), and the mean difference is small.
 void check_expected(const Image& image, const std::string& name) {
@@ -344,13 +356,7 @@ TEST_CASE("samples per pixel: by device, by setting or by FIRE_SAMPLES, 4x draws
   auto one = Renderer::create(*context, one_sample);
   REQUIRE(one);
   const Image a = render_scene(*context, **one, scene, View::Iso), b = render_scene(*context, **four, scene, View::Iso);
-  size_t differing = 0;
-  for (size_t i = 0; i < a.rgba.size(); i += 4)
-    for (int k = 0; k < 3; ++k)
-      if (std::abs(int(a.rgba[i + k]) - int(b.rgba[i + k])) > 48) {
-        ++differing;
-        break;
-      }
+  const size_t differing = pixels_differing(a, b);
   INFO(differing << " of " << a.rgba.size() / 4 << " pixels differ by more than 48 in a channel");
   CHECK(differing < a.rgba.size() / 4 / 25);  // 2.2 % on lavapipe, 320 x 180: the curves' and markers' edges
   CHECK(a.rgba != b.rgba);  // the edges are smoothed: 4x did run
@@ -577,13 +583,7 @@ TEST_CASE("while the camera moves the surface is drawn coarser, by its quads' si
   // Its triangles were built for this frame: a quarter of the quads per level, 6 indices each.
   CHECK(r.last_upload().bytes == uint64_t(scene.surface.quad_count() >> (2 * step)) * 6 * sizeof(uint32_t));
   // A coarser limit mesh of the same surface: not the same pixels, but within a pixel or two along its outline.
-  size_t differing = 0;
-  for (size_t i = 0; i < moving.rgba.size(); i += 4)
-    for (int k = 0; k < 3; ++k)
-      if (std::abs(int(moving.rgba[i + k]) - int(whole.rgba[i + k])) > 48) {
-        ++differing;
-        break;
-      }
+  const size_t differing = pixels_differing(moving, whole);
   CHECK(moving.rgba != whole.rgba);
   CHECK(differing < moving.rgba.size() / 4 / 50);
   // The camera stops: drawn whole, the pixels of a renderer that never draws coarser.
