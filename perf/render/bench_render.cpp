@@ -137,11 +137,12 @@ Measurement run(const Config& c, double seconds) {
   r.samples = uint32_t(app.renderer().samples());
   const render::Orbit orbit = frame_orbit(app::scene_box(w.mesh, w.surface, {}), app.width(), app.height());
   // The app's loop without its input handling: events are drained, none is made.
-  auto frame = [&] {
+  auto frame_from = [&](const render::Orbit& camera) {
     app.window().poll();
     app.window().events().clear();
-    return app.display(orbit) && app.status();
+    return app.display(camera) && app.status();
   };
+  auto frame = [&] { return frame_from(orbit); };
 
   // Warm-up: the first frame uploads the whole scene; the next second settles caches and the swapchain.
   if (!frame()) {
@@ -191,9 +192,7 @@ Measurement run(const Config& c, double seconds) {
     auto previous = from;
     while (previous - from < std::chrono::duration<double>(seconds)) {
       moving.rotate(kOrbitStepPx, 0);
-      app.window().poll();
-      app.window().events().clear();
-      if (!app.display(moving) || !app.status()) {
+      if (!frame_from(moving)) {
         r.problem = "an orbiting frame was not shown: " + app.status().error;
         return r;
       }
