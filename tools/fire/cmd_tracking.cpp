@@ -597,7 +597,8 @@ void add_tracking_commands(CLI::App& app, Registry& registry) {
       "curves between points already drawn, shortest first, each inside one face (an ear decomposition). The other "
       "border loops and a handle's ends are drawn round and opened with cmd hole; a handle and a closed object's "
       "top are drawn last, across the hole, from loop to loop. The curves along a crease of the object (OpenSubdiv's "
-      "t crease tags in --mesh) are marked sharp at the end, the pen touching each (cmd sharp X Y Z). When no stroke "
+      "t crease tags in --mesh) are marked sharp as soon as they have faces on both sides, the pen touching each run "
+      "of them the sketch holds as one curve (cmd sharp X Y Z). When no stroke "
       "left is seen whole by both cameras, the object is turned to a pose that shows one and registered again on the "
       "marks seen there; a chain no pose shows whole is drawn in pieces, turning the object between them. The pen's "
       "LED is at its tip, on the limit surface, which is what hides it from a camera. A border loop under 5 mm across "
@@ -608,7 +609,7 @@ void add_tracking_commands(CLI::App& app, Registry& registry) {
       "several curves makes a chord there, a later curve meant to end at that corner misses it and is rejected, and "
       "the curves that depend on it after it. "
       "Prints one JSON line: the session's report counts, strokes (border and split), undos, registrations, poses, "
-      "pieces, holes (opened with cmd hole; holes_closed: under 5 mm across, closed), mark touches, curves drawn of the network's total. When it cannot draw every curve (--max-strokes aside), it writes nothing and "
+      "pieces, holes (opened with cmd hole; holes_closed: under 5 mm across, closed), sharp (touches of cmd sharp), mark touches, curves drawn of the network's total. When it cannot draw every curve (--max-strokes aside), it writes nothing and "
       "exits 1, naming the first curve it could not draw and why.");
   dr->callback([drawing, &registry] { registry.exit_code = run_simulate_drawing(*drawing); });
 

@@ -729,9 +729,46 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
     return std::nullopt;
   };
 
+  // The curves along a crease of the object are marked sharp as soon as they are drawn with faces on both sides (the
+  // border is a crease already), so that the surface shown while the drawing grows keeps its creases. The sketch
+  // holds a run of curves through vertices where only two meet and no stroke ended as one curve, which one touch
+  // marks and a second would unmark (cmd sharp toggles): each run is touched once, in the middle of its longest
+  // curve, when all its curves are to be marked, and at the end of the drawing when any is.
+  std::vector<char> marked(net.curves.size(), 0);
+  auto mark_creases = [&](bool at_end) {
+    auto to_mark = [&](uint32_t k) { return net.curves[k].sharp && drawing.curve[k] && drawing.surface_beside(k) == 2; };
+    Sets runs(net.curves.size());
+    for (uint32_t v = 0; v < net.vertices.size(); ++v) {
+      if (drawing.end_vertex[v]) continue;
+      std::vector<uint32_t> drawn_here;
+      for (uint32_t k : g.at[v])
+        if (drawing.curve[k]) drawn_here.push_back(k);
+      if (drawn_here.size() == 2) runs.join(drawn_here[0], drawn_here[1]);
+    }
+    std::vector<char> any(net.curves.size(), 0), all(net.curves.size(), 1), done(net.curves.size(), 0);
+    std::vector<uint32_t> longest(net.curves.size(), kNoLoop);
+    for (uint32_t k = 0; k < net.curves.size(); ++k) {
+      if (!drawing.curve[k]) continue;
+      const uint32_t run = runs.find(k);
+      any[run] |= to_mark(k);
+      all[run] &= to_mark(k);
+      done[run] |= marked[k];
+      if (longest[run] == kNoLoop || chain_length(net, {{k, true}}) > chain_length(net, {{longest[run], true}})) longest[run] = k;
+    }
+    for (uint32_t run = 0; run < net.curves.size(); ++run) {
+      if (longest[run] == kNoLoop || done[run] || !(at_end ? any[run] : all[run])) continue;
+      const std::vector<Vec3>& points = net.curves[longest[run]].points;
+      steps.push_back({PlanStep::Kind::Sharp, steps.back().pose, {points[points.size() / 2]}});
+      ++plan.sharp;
+      for (uint32_t k = 0; k < net.curves.size(); ++k)
+        if (drawing.curve[k] && runs.find(k) == run) marked[k] = 1;
+    }
+  };
+
   int pose = steps.back().pose, splits = 0;
   for (;;) {
     drawing.update();
+    mark_creases(false);
     // A cap that has become a face of its own, apart from the border, is opened: the pen touches it, cmd hole.
     bool opened = false;
     for (uint32_t cap = static_cast<uint32_t>(g.faces); cap < g.count() && !opened; ++cap) {
@@ -906,30 +943,8 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
       steps.push_back(std::move(again));
     }
   }
-  // The curves along a crease of the object, marked sharp once drawn with faces on both sides (the border is a
-  // crease already). The sketch holds a run of curves through vertices where only two meet as one curve, which
-  // one touch marks: it is touched once, in the middle of its longest curve.
   drawing.update();
-  auto marks_sharp = [&](uint32_t k) { return net.curves[k].sharp && drawing.curve[k] && drawing.surface_beside(k) == 2; };
-  Sets runs(net.curves.size());
-  for (uint32_t v = 0; v < net.vertices.size(); ++v) {
-    std::vector<uint32_t> drawn_here;
-    for (uint32_t k : g.at[v])
-      if (drawing.curve[k]) drawn_here.push_back(k);
-    if (drawn_here.size() == 2 && marks_sharp(drawn_here[0]) && marks_sharp(drawn_here[1])) runs.join(drawn_here[0], drawn_here[1]);
-  }
-  std::vector<uint32_t> longest(net.curves.size(), kNoLoop);
-  for (uint32_t k = 0; k < net.curves.size(); ++k) {
-    if (!marks_sharp(k)) continue;
-    uint32_t& best = longest[runs.find(k)];
-    if (best == kNoLoop || chain_length(net, {{k, true}}) > chain_length(net, {{best, true}})) best = k;
-  }
-  for (uint32_t k : longest)
-    if (k != kNoLoop) {
-      const std::vector<Vec3>& points = net.curves[k].points;
-      steps.push_back({PlanStep::Kind::Sharp, steps.back().pose, {points[points.size() / 2]}});
-      ++plan.sharp;
-    }
+  mark_creases(true);
   plan.curves_drawn = static_cast<size_t>(std::count(drawing.curve.begin(), drawing.curve.end(), 1));
   return plan;
 }

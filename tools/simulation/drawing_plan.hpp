@@ -34,7 +34,7 @@ struct DrawingPlan {
   std::vector<PlanStep> steps;
   int border_strokes = 0;
   int holes = 0;
-  int sharp = 0;   // curves marked sharp
+  int sharp = 0;   // touches of cmd sharp
   int pieces = 0;  // strokes that end off the network, a curve drawn in pieces from several poses
   size_t curves_drawn = 0;
 };

@@ -64,7 +64,7 @@ struct DrawingStats {
   int registrations = 0;    // one each time the object is put in a pose
   int poses = 0;            // how many different poses it was drawn in
   int holes = 0;            // faces opened with cmd hole
-  int sharp = 0;            // curves marked sharp with cmd sharp
+  int sharp = 0;            // touches of cmd sharp, each marking a run of crease curves
   int pieces = 0;           // strokes that end off the network: a curve drawn in pieces, turning the object between
   int mark_touches = 0;
   size_t curves_drawn = 0;  // of the network's curves
