@@ -34,7 +34,7 @@ check "replay --until-stroke 4 and 5: the border alone, then its first split" \
   "'$fire' replay '$src/tools/demo/sketch.log' --until-stroke 4 -o '$tmp/u4.fnet' 2>/dev/null && grep -o '\"reversed\"' '$tmp/u4.fnet' | wc -l | grep -qx 1 && '$fire' replay '$src/tools/demo/sketch.log' --until-stroke 5 -o '$tmp/u5.fnet' 2>/dev/null && grep -o '\"reversed\"' '$tmp/u5.fnet' | wc -l | grep -qx 2"
 expect_error "replay --until-stroke past the log's strokes says how many it has" "commits 18 pen stroke(s), not 19" \
   "$fire" replay "$src/tools/demo/sketch.log" --until-stroke 19
-expect_error "replay --until-stroke 0 is refused" "until-stroke" "$fire" replay "$src/tools/demo/sketch.log" --until-stroke 0
+expect_error "replay --until-stroke 0 is refused, saying what it must be" "until-stroke: must be at least 1, not 0" "$fire" replay "$src/tools/demo/sketch.log" --until-stroke 0
 # The surface the frame's refine and subdivide systems left equals a reconstruction from scratch of the
 # same network, byte for byte.
 check "replay writes the surface, to each --surface" "'$fire' replay '$src/tools/demo/sketch.log' -o '$tmp/s.fnet' --surface '$tmp/live.obj' --surface '$tmp/live.glb' 2>/dev/null && [ -s '$tmp/live.obj' ]"

@@ -368,7 +368,7 @@ void add_network_commands(CLI::App& app, Registry& registry) {
                      "N: replay the log up to the frame that commits its N-th pen stroke (one the network took: part of "
                      "a border, a split, a stroke across curves or a hole, a piece of a chain; commands do not count), "
                      "then let the surface settle: -o, --surface and --hash give the drawing as it was then")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   replay->add_flag("--progress", o->progress,
                    "say how far through the log it is, every 10 %, and end with a summary line (on a terminal it always does, after "
                    "a second, and sums up a replay that took over two seconds)");

@@ -66,13 +66,13 @@ void add_synth_commands(CLI::App& app, Registry& registry) {
   cmd->add_option("--noise", a->options.noise_percent,
                   "P: Gaussian noise with a standard deviation of P percent of the mean control-mesh edge length, "
                   "added to the interior polyline points (network vertices stay put)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->capture_default_str();
   cmd->add_option("--noise-correlation", a->options.noise_correlation_percent,
                   "L: make the noise correlated along each polyline, as a tracked and filtered pen's error is: a "
                   "Gaussian-weighted mean over arc length L percent of the mean control-mesh edge length, rescaled "
                   "so each point keeps the standard deviation of --noise (0: independent per point)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->capture_default_str();
   cmd->add_option("--seed", a->options.seed, "S: seed of the noise (same seed, same network on every run)")
       ->capture_default_str();

@@ -1,6 +1,7 @@
 #pragma once
 // Each area adds its subcommands to the CLI11 app; a subcommand's callback stores its exit code.
 #include <CLI/CLI.hpp>
+#include <sstream>
 #include <string>
 
 #include "engine/input_log.hpp"
@@ -11,6 +12,23 @@ namespace fire::cli {
 struct Registry {
   int exit_code = 0;
 };
+
+// A number option's lower bound. CLI11's PositiveNumber and NonNegativeNumber write the whole double range out
+// in their message (0.000000 to a 309-digit number); this says what the value must be.
+inline CLI::Validator at_least(double least, const std::string& description) {
+  return CLI::Validator(
+      [least](std::string& text) -> std::string {
+        double value = 0;
+        if (!CLI::detail::lexical_cast(text, value)) return "'" + text + "' is not a number";
+        if (value >= least) return {};
+        std::ostringstream message;
+        message << "must be at least " << least << ", not " << text;
+        return message.str();
+      },
+      description);
+}
+inline const CLI::Validator kPositive = at_least(1, "POSITIVE");
+inline const CLI::Validator kNonNegative = at_least(0, "NONNEGATIVE");
 
 // replay, open, export-network (engine foundation)
 void add_network_commands(CLI::App& app, Registry& registry);
