@@ -204,8 +204,9 @@ struct Refiner {
               Eigen::Vector2d(0, 1 - t[3])};
     }
     const Sampling sampling = rule == Rule::ThesisCoons ? Sampling::Nearest : Sampling::Linear;
+    const SidedPatch patch(sided ? std::span<const Side>(sides) : std::span<const Side>());
     auto evaluate = [&](const Eigen::Vector2d& p) -> Vec3 {
-      if (sided) return sided_patch_point(sides, p);
+      if (sided) return patch.at(p);
       return coons_point(quad_sides, p.x(), p.y(), sampling);
     };
 

@@ -219,47 +219,67 @@ Eigen::Vector2d domain_corner(uint32_t n, uint32_t k) {
 // blended by B_i = prod_{j not in {i-1,i,i+1}} d_j / sum_k prod_{j not in {k-1,k,k+1}} d_j, which is 1
 // on side i and vanishes on every side ribbon i does not interpolate. For n = 4 the coordinates are
 // bilinear and the sum is exactly the bilinearly blended Coons patch.
-Vec3 sided_patch_point(std::span<const Side> sides, const Eigen::Vector2d& p) {
-  const uint32_t n = static_cast<uint32_t>(sides.size());
-  auto next = [n](uint32_t i) { return (i + 1) % n; };
-  auto prev = [n](uint32_t i) { return (i + n - 1) % n; };
-  std::vector<double> area(n), lambda(n), d(n), s(n), blend(n);
+SidedPatch::SidedPatch(std::span<const Side> sides) : sides_(sides.begin(), sides.end()) {
+  const auto n = static_cast<uint32_t>(sides.size());
+  corners_.resize(n);
+  for (uint32_t k = 0; k < n; ++k) corners_[k] = domain_corner(n, k);
+  const std::vector<double> zero(n);
+  area_ = lambda_ = d_ = s_ = blend_ = zero;
+  prefix_.assign(n + 1, 0);
+  suffix_.assign(n + 1, 0);
+}
+
+// out[i]: the product of values[j] over every j but the `run` cyclic indices from i - 1 on. Prefix and suffix
+// products where that run does not wrap round the end, the product itself for the few i where it does: O(n),
+// where the product per i was O(n^2) for the many-sided faces of a drawing that has just begun.
+void SidedPatch::products_but_run(const std::vector<double>& values, uint32_t run, std::vector<double>& out) const {
+  const auto n = static_cast<uint32_t>(values.size());
+  prefix_[0] = 1;
+  for (uint32_t k = 0; k < n; ++k) prefix_[k + 1] = prefix_[k] * values[k];
+  suffix_[n] = 1;
+  for (uint32_t k = n; k-- > 0;) suffix_[k] = values[k] * suffix_[k + 1];
+  for (uint32_t i = 0; i < n; ++i) {
+    if (i >= 1 && i - 1 + run <= n) {
+      out[i] = prefix_[i - 1] * suffix_[i - 1 + run];
+      continue;
+    }
+    const uint32_t first = (i + n - 1) % n;
+    double product = 1;
+    for (uint32_t j = (first + run) % n; j != first; j = (j + 1) % n) product *= values[j];
+    out[i] = product;
+  }
+}
+
+Vec3 SidedPatch::at(const Eigen::Vector2d& p) const {
+  const auto n = static_cast<uint32_t>(sides_.size());
+  auto next = [n](uint32_t i) { return i + 1 == n ? 0 : i + 1; };
+  auto prev = [n](uint32_t i) { return i == 0 ? n - 1 : i - 1; };
   for (uint32_t j = 0; j < n; ++j) {
-    const Eigen::Vector2d a = domain_corner(n, j) - p, b = domain_corner(n, next(j)) - p;
-    area[j] = 0.5 * (a.x() * b.y() - a.y() * b.x());
+    const Eigen::Vector2d a = corners_[j] - p, b = corners_[next(j)] - p;
+    area_[j] = 0.5 * (a.x() * b.y() - a.y() * b.x());
   }
   // Wachspress weights w_i = prod_{j not in {i-1, i}} A_j (the corner-area factor is equal for all i on
   // a regular polygon, so it cancels).
+  products_but_run(area_, 2, lambda_);
   double lambda_sum = 0;
+  for (double w : lambda_) lambda_sum += w;
+  for (double& l : lambda_) l /= lambda_sum;
   for (uint32_t i = 0; i < n; ++i) {
-    double w = 1;
-    for (uint32_t j = 0; j < n; ++j)
-      if (j != prev(i) && j != i) w *= area[j];
-    lambda[i] = w;
-    lambda_sum += w;
+    const double pair = lambda_[i] + lambda_[next(i)];
+    d_[i] = 1.0 - pair;
+    s_[i] = pair > 0 ? lambda_[next(i)] / pair : 0.0;
   }
-  for (double& l : lambda) l /= lambda_sum;
-  for (uint32_t i = 0; i < n; ++i) {
-    const double pair = lambda[i] + lambda[next(i)];
-    d[i] = 1.0 - pair;
-    s[i] = pair > 0 ? lambda[next(i)] / pair : 0.0;
-  }
+  products_but_run(d_, 3, blend_);
   double blend_sum = 0;
-  for (uint32_t i = 0; i < n; ++i) {
-    double b = 1;
-    for (uint32_t j = 0; j < n; ++j)
-      if (j != prev(i) && j != i && j != next(i)) b *= d[j];
-    blend[i] = b;
-    blend_sum += b;
-  }
+  for (double b : blend_) blend_sum += b;
   Vec3 sum = Vec3::Zero();
   for (uint32_t i = 0; i < n; ++i) {
-    if (blend[i] == 0) continue;
-    const double si = s[i], di = d[i];
-    const Vec3 ribbon = sides[prev(i)].at(1.0 - di, Sampling::Linear) * (1.0 - si) +
-                        sides[next(i)].at(di, Sampling::Linear) * si + sides[i].at(si, Sampling::Linear) -
-                        sides[i].start() * (1.0 - si) - sides[next(i)].start() * si;
-    sum += ribbon * (blend[i] / blend_sum);
+    if (blend_[i] == 0) continue;
+    const double si = s_[i], di = d_[i];
+    const Vec3 ribbon = sides_[prev(i)].at(1.0 - di, Sampling::Linear) * (1.0 - si) +
+                        sides_[next(i)].at(di, Sampling::Linear) * si + sides_[i].at(si, Sampling::Linear) -
+                        sides_[i].start() * (1.0 - si) - sides_[next(i)].start() * si;
+    sum += ribbon * (blend_[i] / blend_sum);
   }
   return sum;
 }

@@ -74,7 +74,18 @@ Vec3 coons_point(std::span<const Side> sides, double u, double v, Sampling mode)
 // The n-sided C0 patch (n >= 3) over sides walked in loop order, at a point of the regular n-gon domain
 // whose corner k is (cos 2 pi k / n, sin 2 pi k / n). It interpolates every side (side k at the domain
 // side from corner k to k+1, by arc length) and equals coons_point with linear sampling for n = 4.
-Vec3 sided_patch_point(std::span<const Side> sides, const Eigen::Vector2d& domain_point);
+class SidedPatch {
+ public:
+  explicit SidedPatch(std::span<const Side> sides);
+  Vec3 at(const Eigen::Vector2d& domain_point) const;
+
+ private:
+  void products_but_run(const std::vector<double>& values, uint32_t run, std::vector<double>& out) const;
+  std::vector<Side> sides_;
+  std::vector<Eigen::Vector2d> corners_;
+  // Scratch of at(), kept so that the many points of one face allocate nothing.
+  mutable std::vector<double> area_, lambda_, d_, s_, blend_, prefix_, suffix_;
+};
 Eigen::Vector2d domain_corner(uint32_t n, uint32_t k);
 
 }  // namespace fire::reconstruct

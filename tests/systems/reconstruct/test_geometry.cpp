@@ -114,12 +114,13 @@ TEST_CASE("the n-sided patch is the bilinear Coons patch for n = 4", "[geometry]
     for (double v : {0.2, 0.5, 0.9}) {
       const Eigen::Vector2d p = domain_corner(4, 0) * ((1 - u) * (1 - v)) + domain_corner(4, 1) * (u * (1 - v)) +
                                 domain_corner(4, 2) * (u * v) + domain_corner(4, 3) * ((1 - u) * v);
-      CHECK((sided_patch_point(sides, p) - coons_point(sides, u, v, Sampling::Linear)).norm() < 1e-12);
+      CHECK((SidedPatch(sides).at(p) - coons_point(sides, u, v, Sampling::Linear)).norm() < 1e-12);
     }
 }
 
 TEST_CASE("the n-sided patch interpolates its sides", "[geometry][patch]") {
-  for (uint32_t n : {3u, 5u, 6u}) {
+  // 35 sides: the pawn's undrawn rest a third of the way through its drawing.
+  for (uint32_t n : {3u, 5u, 6u, 12u, 35u}) {
     std::vector<std::vector<Vec3>> lines;
     std::vector<std::vector<double>> params;
     for (uint32_t k = 0; k < n; ++k) {
@@ -132,7 +133,7 @@ TEST_CASE("the n-sided patch interpolates its sides", "[geometry][patch]") {
     for (uint32_t k = 0; k < n; ++k)
       for (double s : {0.2, 0.5, 0.9}) {
         const Eigen::Vector2d p = domain_corner(n, k) + (domain_corner(n, k + 1) - domain_corner(n, k)) * s;
-        CHECK((sided_patch_point(sides, p) - sides[k].at(s, Sampling::Linear)).norm() < 1e-9);
+        CHECK((SidedPatch(sides).at(p) - sides[k].at(s, Sampling::Linear)).norm() < 1e-9);
       }
     // A flat polygon gives a flat patch: its centre lies in the plane of the sides.
     std::vector<std::vector<Vec3>> flat(n);
@@ -143,7 +144,7 @@ TEST_CASE("the n-sided patch interpolates its sides", "[geometry][patch]") {
       flat_params[k] = arc_parameters(flat[k]);
     }
     for (uint32_t k = 0; k < n; ++k) flat_sides.push_back({flat[k], flat_params[k], false});
-    CHECK(std::abs(sided_patch_point(flat_sides, Eigen::Vector2d::Zero()).z() - 0.5) < 1e-14);
+    CHECK(std::abs(SidedPatch(flat_sides).at(Eigen::Vector2d::Zero()).z() - 0.5) < 1e-14);
   }
 }
 
