@@ -74,8 +74,9 @@ Result<InputLog> parse_input_log(std::string_view text, const std::string& sourc
       if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
       if (line.substr(0, 9) == "FIRE-LOG ") {
         if (line == "FIRE-LOG 1") log.version = 1;
+        else if (line == "FIRE-LOG 2") log.version = 2;
         else if (line != kInputLogHeader)
-          return fail(1, "unknown input log version '" + std::string(line.substr(9)) + "' (this build reads versions 1 and 2)");
+          return fail(1, "unknown input log version '" + std::string(line.substr(9)) + "' (this build reads versions 1 to 3)");
         continue;
       }
       return fail(1, "not a FIRE input log (the first line must be '" + std::string(kInputLogHeader) + "')");

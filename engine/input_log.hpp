@@ -43,14 +43,14 @@ struct InputLog {
   uint64_t forgotten = 0;
   size_t rejected_hid_lines = 0;      // garbled hid payloads, kept as events with hid_ok = false
   size_t hid_back_in_time = 0;        // hid lines stamped before the line above them, kept
-  // The format version the log was written in (engine/INPUT_LOG.md): version 1 logs replay by the sketch
-  // rules they were drawn with (SketchSettings::topology_strokes off).
-  uint32_t version = 2;
+  // The format version the log was written in (engine/INPUT_LOG.md): older logs replay by the sketch rules
+  // they were drawn with (SketchSettings::topology_strokes and middle_picks_face).
+  uint32_t version = 3;
 };
 
-inline constexpr uint32_t kInputLogVersion = 2;
-inline constexpr std::string_view kInputLogHeader = "FIRE-LOG 2";
-// The header line of a log of `version` (1 or 2), without its end of line.
+inline constexpr uint32_t kInputLogVersion = 3;
+inline constexpr std::string_view kInputLogHeader = "FIRE-LOG 3";
+// The header line of a log of `version` (1 to 3), without its end of line.
 inline std::string input_log_header(uint32_t version) { return "FIRE-LOG " + std::to_string(version); }
 
 // Parses a whole log held in memory; `source` names it in error messages.

@@ -534,32 +534,43 @@ Snap snap_to_face(const Mesh& m, const SnapIndex& index, const Vec3& start, cons
 
 EdgeIndex pick_edge(const SnapIndex& index, const Vec3& p, double limit) { return index.nearest(p, limit).edge; }
 
+namespace {
+
+// How far p lies off face f's plane where it projects inside the face's boundary within the boundary's reach
+// from its centroid (face_under's test for one face); nothing where it does not.
+std::optional<double> height_inside(const Mesh& m, FaceIndex f, const Vec3& p) {
+  const std::vector<Vec3> loop = m.face_boundary(f);
+  const LoopPlane lp = loop_plane(loop);
+  const Vec3 &centroid = lp.centroid, &normal = lp.normal;
+  if (normal.norm() == 0) return std::nullopt;  // a degenerate loop has no inside
+  double extent = 0;
+  for (const Vec3& q : loop) extent = std::max(extent, (q - centroid).norm());
+  const double height = std::abs((p - centroid).dot(normal));
+  if (height > extent) return std::nullopt;
+  // Crossing test in the plane, on a basis (u, v) of it.
+  const Vec3 u = normal.unitOrthogonal(), v = normal.cross(u);
+  auto plane = [&](const Vec3& q) { return std::pair{(q - centroid).dot(u), (q - centroid).dot(v)}; };
+  const auto [px, py] = plane(p);
+  bool inside = false;
+  for (size_t i = 0, j = loop.size() - 1; i < loop.size(); j = i++) {
+    const auto [xi, yi] = plane(loop[i]);
+    const auto [xj, yj] = plane(loop[j]);
+    if ((yi > py) != (yj > py) && px < xj + (py - yj) * (xi - xj) / (yi - yj)) inside = !inside;
+  }
+  return inside ? std::optional<double>(height) : std::nullopt;
+}
+
+}  // namespace
+
 FaceIndex face_under(const Mesh& m, const Vec3& p) {
   FaceIndex best;
   double best_height = std::numeric_limits<double>::infinity();
   for (FaceIndex f{0}; f < m.face_slots(); ++f) {
     if (!m.face_alive(f)) continue;
-    const std::vector<Vec3> loop = m.face_boundary(f);
-    const LoopPlane lp = loop_plane(loop);
-    const Vec3 &centroid = lp.centroid, &normal = lp.normal;
-    if (normal.norm() == 0) continue;  // a degenerate loop has no inside
-    double extent = 0;
-    for (const Vec3& q : loop) extent = std::max(extent, (q - centroid).norm());
-    const double height = std::abs((p - centroid).dot(normal));
-    if (height > extent || height >= best_height) continue;
-    // Crossing test in the plane, on a basis (u, v) of it.
-    const Vec3 u = normal.unitOrthogonal(), v = normal.cross(u);
-    auto plane = [&](const Vec3& q) { return std::pair{(q - centroid).dot(u), (q - centroid).dot(v)}; };
-    const auto [px, py] = plane(p);
-    bool inside = false;
-    for (size_t i = 0, j = loop.size() - 1; i < loop.size(); j = i++) {
-      const auto [xi, yi] = plane(loop[i]);
-      const auto [xj, yj] = plane(loop[j]);
-      if ((yi > py) != (yj > py) && px < xj + (py - yj) * (xi - xj) / (yi - yj)) inside = !inside;
-    }
-    if (inside) {
+    const std::optional<double> height = height_inside(m, f, p);
+    if (height && *height < best_height) {
       best = f;
-      best_height = height;
+      best_height = *height;
     }
   }
   return best;
@@ -720,6 +731,13 @@ void sketch_system(const std::vector<InputEvent>& frame_events, const Mesh& mesh
           // over several faces, cross a border loop's hole (the far side of the surface), or, far from every
           // curve, start a new part.
           Snap s = snap_to_face(mesh, snap, r.command.points.front(), r.command.points.back(), both_snap);
+          // No camera saw it (the mouse): of the faces that hold both ends, the one its middle sample lies in.
+          if (s.face != kNone && settings.middle_picks_face && !viewpoint) {
+            const Vec3& middle = r.command.points[r.command.points.size() / 2];
+            const Snap holding = snap_to_face(mesh, snap, r.command.points.front(), r.command.points.back(), both_snap,
+                                              [&](const Snap& c) { return height_inside(mesh, c.face, middle).has_value(); });
+            if (holding.face != kNone) s = holding;
+          }
           // Seen from the cameras, a stroke goes into the face it splits. Where several faces, or a face and a
           // border loop's hole (the far side, drawn with the object turned over), hold both ends, that tells them
           // apart: of the faces, the nearest one it goes into; into none, the hole. Which way the faces turn about

@@ -36,6 +36,9 @@ struct SketchSettings {
   // border loop's hole (the far side of the surface), and one with both ends far from every curve starts a new
   // part's border. Off for a version-1 log, where such strokes were refused, so it replays as it was drawn.
   bool topology_strokes = true;
+  // Where several faces hold both ends of a stroke that no camera saw (the mouse), the face its middle sample
+  // lies in takes it, not the nearest. Off for a log before version 3, which gave it the nearest face.
+  bool middle_picks_face = true;
 };
 
 // For a pen tracked by the rig: vertex_snap (metres), a few times the tracked pen's error at rest, and

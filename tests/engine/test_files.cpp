@@ -86,7 +86,12 @@ TEST_CASE("input log: truncated, unknown version and malformed lines are refused
     CHECK_THAT(r.error(), Contains(part));
   };
   refuse("FIRE-LOG 1\n0 down\n10 pen 1 2", "truncated");
-  refuse("FIRE-LOG 3\n", "unknown input log version '3'");
+  refuse("FIRE-LOG 4\n", "unknown input log version '4' (this build reads versions 1 to 3)");
+  for (uint32_t version : {1u, 2u, 3u}) {
+    auto read = parse_input_log("FIRE-LOG " + std::to_string(version) + "\n0 down\n", "v.log");
+    REQUIRE(read.ok());
+    CHECK(read->version == version);
+  }
   refuse("hello\n", "not a FIRE input log");
   refuse("", "empty");
   refuse("FIRE-LOG 1\n10 pen 1 2\n", "pen needs three numbers");
@@ -122,7 +127,7 @@ TEST_CASE("input log: marks measured by touch read and format back: cmd table, c
   CHECK(log->events[3].command == CommandKind::Mark);
   CHECK(log->events[3].p == Vec3(0.5, 0, 1));
   for (const InputEvent& e : log->events) CHECK(is_touch_command(e.command));
-  CHECK(format_input_log(log->events) == "FIRE-LOG 2\n10 cmd table\n20 cmd measure 4\n30 cmd mark 4\n40 cmd mark 4 0.5 0 1\n");
+  CHECK(format_input_log(log->events, log->version) == "FIRE-LOG 2\n10 cmd table\n20 cmd measure 4\n30 cmd mark 4\n40 cmd mark 4 0.5 0 1\n");
 }
 
 TEST_CASE("input log: a garbled device report is counted, not fatal", "[files]") {

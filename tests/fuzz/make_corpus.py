@@ -47,7 +47,7 @@ put("input_log", "every_kind.log", "FIRE-LOG 1\n# a comment\n0 meta scenario ske
     "40 cmd undo\n41 cmd redo\n42 cmd close\n43 cmd delete 0.1 0.2 0.3\n44 cmd sharp 0.1 0.2 0.3\n"
     "45 cmd mark 3 0.01 -0.02 0.15\n46 cmd register\n")
 put("input_log", "crlf.log", "FIRE-LOG 1\r\n0 down\r\n1 pen 1 2 3\r\n2 up\r\n")
-put("input_log", "bad_version.log", "FIRE-LOG 3\n0 down\n")
+put("input_log", "bad_version.log", "FIRE-LOG 4\n0 down\n")
 put("input_log", "version2.log", "FIRE-LOG 2\n30 down\n31 pen 0 0.05 0.1\n33 up\n40 cmd hole 0.1 0.2 0.3\n41 cmd undo\n")
 put("input_log", "back_in_time.log", "FIRE-LOG 1\n5 down\n4 up\n")
 put("input_log", "truncated.log", "FIRE-LOG 1\n0 down\n1 pen 0 0")

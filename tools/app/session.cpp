@@ -39,9 +39,10 @@ std::vector<SystemSpec> session_systems(World& w) {
       [](const std::vector<InputEvent>& events, const Mesh& mesh, const SnapIndex& snap, const SketchSettings& settings,
          const InputLog& log, const RegistrationState& registration, SketchState& state, std::vector<EditRequest>& requests,
          std::vector<Rejection>& rejections, PenFeedback& feedback) {
-        // A version-1 log replays by the rules it was drawn with.
+        // An older log replays by the rules it was drawn with.
         SketchSettings rules = settings;
         rules.topology_strokes = settings.topology_strokes && log.version >= 2;
+        rules.middle_picks_face = settings.middle_picks_face && log.version >= 3;
         // Camera 0 sits at the rig's origin.
         const std::optional<Vec3> viewpoint =
             registration.transform ? std::optional<Vec3>(registration.transform->t) : std::nullopt;

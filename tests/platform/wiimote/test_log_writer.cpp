@@ -34,7 +34,7 @@ TEST_CASE("a stream's lines never go back: a report read before the last line is
   CHECK(log.meta("device", "0 00:1F:32:00:00:0A camera0 0306") == 3000);
   CHECK(log.hid(1, kReport, 6 * kMs) == 3000);  // read at 1 ms, handed in after the 3 ms line
   CHECK(log.restamped() == 1);
-  CHECK(text.str() == "FIRE-LOG 2\n2000 hid 0 330000\n3000 meta device 0 00:1F:32:00:00:0A camera0 0306\n3000 hid 1 330000\n");
+  CHECK(text.str() == "FIRE-LOG 3\n2000 hid 0 330000\n3000 meta device 0 00:1F:32:00:00:0A camera0 0306\n3000 hid 1 330000\n");
 }
 
 TEST_CASE("a live log holds events in stamp order until taken, and what was taken is final") {

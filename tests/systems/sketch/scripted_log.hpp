@@ -13,7 +13,7 @@ namespace fire::test {
 
 // A log built line by line, each event 10 ms after the last, so each lands in a frame of its own.
 struct Log {
-  std::string text = "FIRE-LOG 2\n";
+  std::string text = std::string(kInputLogHeader) + "\n";
   int64_t t = 0;
   Log& event(const std::string& what) {
     text += std::to_string(t += 10000) + " " + what + "\n";

@@ -125,14 +125,14 @@ TEST_CASE("a version-1 log replays by version 1's rules: the same strokes are re
   square(separate, 0.5);
   for (Log* log : {&closed, &separate}) {
     const std::string version2 = log->text;
-    log->text.replace(0, std::string("FIRE-LOG 2").size(), "FIRE-LOG 1");
+    log->text.replace(0, kInputLogHeader.size(), "FIRE-LOG 1");
     const auto old = replay(*log);
     REQUIRE(old->log.version == 1);
     CHECK(old->mesh.face_count() == (log == &closed ? 2 : 1));
     REQUIRE_FALSE(old->rejections.empty());
     CHECK_THAT(old->rejections.back().reason, Catch::Matchers::Contains("does not start and end on the boundary of one face"));
     log->text = version2;
-    CHECK(replay(*log)->log.version == 2);
+    CHECK(replay(*log)->log.version == kInputLogVersion);
   }
 }
 
@@ -219,6 +219,27 @@ TEST_CASE("seen from the cameras, a stroke whose ends one face holds, drawn unde
   CHECK(over->mesh.face_count() == 3);
 }
 
+namespace {
+
+// Of the two faces beside the curve bowed from x = 5 cm toward `side` (+1 or -1) along x, how many lie on that side.
+int faces_beside_bowed_curve_on_its_side(const Mesh& mesh, double side) {
+  EdgeIndex bowed;
+  for (EdgeIndex e{0}; e < mesh.edge_slots(); ++e)
+    if (mesh.edge_alive(e) && side * (mesh.polyline(e)[mesh.edges.point_count[e] / 2].x() - 0.05) > 0.02) bowed = e;
+  REQUIRE(bowed != kNone);
+  int on_its_side = 0;
+  for (uint32_t f : mesh.edges.face[bowed]) {
+    REQUIRE(f != kNone);
+    Vec3 centre = Vec3::Zero();
+    const std::vector<Vec3> boundary = mesh.face_boundary(FaceIndex{f});
+    for (const Vec3& p : boundary) centre += p;
+    on_its_side += side * (centre.x() / double(boundary.size()) - 0.05) > 0;
+  }
+  return on_its_side;
+}
+
+}  // namespace
+
 TEST_CASE("seen from the cameras, of two faces that hold both ends of a stroke, it splits the one it goes into", "[sketch][topology]") {
   // The square split by an arch between (5, 0) and (5, 10) cm; then a second curve between the same two vertices,
   // bowed toward +x or -x: both halves hold its ends, at the same distance.
@@ -238,16 +259,34 @@ TEST_CASE("seen from the cameras, of two faces that hold both ends of a stroke, 
     CHECK(w->rejections.empty());
     REQUIRE(w->mesh.face_count() == 3);
     // Every face beside the new curve lies on the side it was bowed toward.
-    EdgeIndex bowed;
-    for (EdgeIndex e{0}; e < w->mesh.edge_slots(); ++e)
-      if (w->mesh.edge_alive(e) && side * (w->mesh.polyline(e)[w->mesh.edges.point_count[e] / 2].x() - 0.05) > 0.02) bowed = e;
-    REQUIRE(bowed != kNone);
-    for (uint32_t f : w->mesh.edges.face[bowed]) {
-      REQUIRE(f != kNone);
-      Vec3 centre = Vec3::Zero();
-      const std::vector<Vec3> boundary = w->mesh.face_boundary(FaceIndex{f});
-      for (const Vec3& p : boundary) centre += p;
-      CHECK(side * (centre.x() / double(boundary.size()) - 0.05) > 0);
+    CHECK(faces_beside_bowed_curve_on_its_side(w->mesh, side) == 2);
+  }
+}
+
+TEST_CASE("with no camera (the mouse), of two faces that hold both ends of a stroke, it splits the one its middle lies in",
+          "[sketch][topology]") {
+  // The square split by a straight curve between (5, 0) and (5, 10) cm; a second curve between the same two
+  // vertices, bowed toward +x or -x in the plane: both halves hold its ends, at the same distance.
+  for (const double side : {1.0, -1.0}) {
+    for (const bool version2 : {false, true}) {
+      Log log;
+      square(log);
+      arc(log, {0.05, 0, 0}, {0.05, 0.1, 0});
+      log.event("down");
+      for (int k = 0; k <= 10; ++k) {
+        const double t = k / 10.0;
+        log.pen(0.05 + side * 0.03 * std::sin(std::numbers::pi * t), 0.1 * t, 0);
+      }
+      log.event("up");
+      if (version2) log.text.replace(0, kInputLogHeader.size(), "FIRE-LOG 2");
+      const auto w = replay(log);
+      INFO("bowed toward " << side << " x, version " << w->log.version << "\n" << rejections(*w));
+      CHECK(w->rejections.empty());
+      REQUIRE(w->mesh.face_count() == 3);
+      // The faces beside the bowed curve: both on its side from version 3. A version-2 log gives the stroke to
+      // the lowest face slot, as it did when it was drawn: the +x half, so bowed toward -x the curve runs through
+      // that half, with one face on each side.
+      CHECK(faces_beside_bowed_curve_on_its_side(w->mesh, side) == (version2 && side < 0 ? 1 : 2));
     }
   }
 }

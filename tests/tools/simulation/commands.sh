@@ -29,7 +29,7 @@ for m in thesis dlt optimal; do
   one_line "$out"
   for k in static_rms_mm dynamic_rms_mm samples strokes rejected_reports time_offset_ms; do has_number "$out" "$k"; done
 done
-head -1 pen.log | grep -qx 'FIRE-LOG 2' || fail "pen.log is not an input log"
+head -1 pen.log | grep -qx 'FIRE-LOG 3' || fail "pen.log is not an input log"
 grep -q ' down$' pen.log && grep -q ' up$' pen.log && grep -q ' pen ' pen.log || fail "pen.log lacks down/pen/up"
 
 # Hands passing in front of the cameras (0.5 occlusions per second per camera) do not break strokes:
