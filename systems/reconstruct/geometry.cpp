@@ -219,7 +219,7 @@ Eigen::Vector2d domain_corner(uint32_t n, uint32_t k) {
 // blended by B_i = prod_{j not in {i-1,i,i+1}} d_j / sum_k prod_{j not in {k-1,k,k+1}} d_j, which is 1
 // on side i and vanishes on every side ribbon i does not interpolate. For n = 4 the coordinates are
 // bilinear and the sum is exactly the bilinearly blended Coons patch.
-SidedPatch::SidedPatch(std::span<const Side> sides) : sides_(sides.begin(), sides.end()) {
+SidedPatch::SidedPatch(std::span<const Side> sides) : sides_(sides) {
   const auto n = static_cast<uint32_t>(sides.size());
   corners_.resize(n);
   for (uint32_t k = 0; k < n; ++k) corners_[k] = domain_corner(n, k);

@@ -74,6 +74,7 @@ Vec3 coons_point(std::span<const Side> sides, double u, double v, Sampling mode)
 // The n-sided C0 patch (n >= 3) over sides walked in loop order, at a point of the regular n-gon domain
 // whose corner k is (cos 2 pi k / n, sin 2 pi k / n). It interpolates every side (side k at the domain
 // side from corner k to k+1, by arc length) and equals coons_point with linear sampling for n = 4.
+// `sides` must outlive the patch.
 class SidedPatch {
  public:
   explicit SidedPatch(std::span<const Side> sides);
@@ -81,7 +82,7 @@ class SidedPatch {
 
  private:
   void products_but_run(const std::vector<double>& values, uint32_t run, std::vector<double>& out) const;
-  std::vector<Side> sides_;
+  std::span<const Side> sides_;
   std::vector<Eigen::Vector2d> corners_;
   // Scratch of at(), kept so that the many points of one face allocate nothing.
   mutable std::vector<double> area_, lambda_, d_, s_, blend_, prefix_, suffix_;

@@ -27,7 +27,7 @@ inline CLI::Validator at_least(double least, const std::string& description) {
       },
       description);
 }
-inline const CLI::Validator kPositive = at_least(1, "POSITIVE");
+inline const CLI::Validator kPositive = at_least(1, "POSITIVE");  // counts: 1 or more
 inline const CLI::Validator kNonNegative = at_least(0, "NONNEGATIVE");
 
 // replay, open, export-network (engine foundation)

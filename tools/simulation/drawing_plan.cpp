@@ -735,7 +735,12 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
   // marks and a second would unmark (cmd sharp toggles): each run is touched once, in the middle of its longest
   // curve, when all its curves are to be marked, and at the end of the drawing when any is.
   std::vector<char> marked(net.curves.size(), 0);
+  const bool creased = std::any_of(net.curves.begin(), net.curves.end(), [](const auto& c) { return c.sharp; });
+  std::vector<double> length(net.curves.size(), 0);
+  if (creased)
+    for (uint32_t k = 0; k < net.curves.size(); ++k) length[k] = chain_length(net, {{k, true}});
   auto mark_creases = [&](bool at_end) {
+    if (!creased) return;
     auto to_mark = [&](uint32_t k) { return net.curves[k].sharp && drawing.curve[k] && drawing.surface_beside(k) == 2; };
     Sets runs(net.curves.size());
     for (uint32_t v = 0; v < net.vertices.size(); ++v) {
@@ -746,23 +751,25 @@ Result<DrawingPlan> plan_drawing(const DrawingNetwork& net, const PoseQuestions&
       if (drawn_here.size() == 2) runs.join(drawn_here[0], drawn_here[1]);
     }
     std::vector<char> any(net.curves.size(), 0), all(net.curves.size(), 1), done(net.curves.size(), 0);
-    std::vector<uint32_t> longest(net.curves.size(), kNoLoop);
+    std::vector<uint32_t> longest(net.curves.size(), kNoLoop), run_of(net.curves.size(), kNoLoop);
     for (uint32_t k = 0; k < net.curves.size(); ++k) {
       if (!drawing.curve[k]) continue;
-      const uint32_t run = runs.find(k);
+      const uint32_t run = run_of[k] = runs.find(k);
       any[run] |= to_mark(k);
       all[run] &= to_mark(k);
       done[run] |= marked[k];
-      if (longest[run] == kNoLoop || chain_length(net, {{k, true}}) > chain_length(net, {{longest[run], true}})) longest[run] = k;
+      if (longest[run] == kNoLoop || length[k] > length[longest[run]]) longest[run] = k;
     }
+    std::vector<char> touch(net.curves.size(), 0);
     for (uint32_t run = 0; run < net.curves.size(); ++run) {
       if (longest[run] == kNoLoop || done[run] || !(at_end ? any[run] : all[run])) continue;
+      touch[run] = 1;
       const std::vector<Vec3>& points = net.curves[longest[run]].points;
       steps.push_back({PlanStep::Kind::Sharp, steps.back().pose, {points[points.size() / 2]}});
       ++plan.sharp;
-      for (uint32_t k = 0; k < net.curves.size(); ++k)
-        if (drawing.curve[k] && runs.find(k) == run) marked[k] = 1;
     }
+    for (uint32_t k = 0; k < net.curves.size(); ++k)
+      if (run_of[k] != kNoLoop && touch[run_of[k]]) marked[k] = 1;
   };
 
   int pose = steps.back().pose, splits = 0;
