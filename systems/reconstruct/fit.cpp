@@ -542,8 +542,10 @@ Steps<FitRun::Fitted> FitRun::fit_steps(const LimitFit::Impl& m, const BaseMesh&
         targets.row(span.rows[k]) = sample_polyline(span.line, span.params, fractions[i++], m.settings.targets).transpose();
   };
   // Each foot is searched between its neighbours' current targets, so that the targets stay in order.
-  auto feet = [&](const Eigen::VectorXd& current, Eigen::VectorXd& out) {
+  // Also sums the squared distances of the fitted points to their new feet into `distance`.
+  auto feet = [&](const Eigen::VectorXd& current, Eigen::VectorXd& out, double& distance) {
     double largest_move = 0;
+    distance = 0;
     Eigen::Index i = 0;
     for (const Span& span : whole) {
       const Eigen::Index count = Eigen::Index(span.rows.size()) - 2;
@@ -558,7 +560,10 @@ Steps<FitRun::Fitted> FitRun::fit_steps(const LimitFit::Impl& m, const BaseMesh&
         } else {
           lo = hi = 0.5 * (lo + hi);
         }
-        out[i] = foot_fraction(span, fitted.row(span.rows[size_t(k + 1)]).transpose(), lo, hi);
+        const Vec3 point = fitted.row(span.rows[size_t(k + 1)]).transpose();
+        out[i] = foot_fraction(span, point, lo, hi);
+        if (m.settings.stall_rounds > 0)
+          distance += (sample_polyline(span.line, span.params, out[i], m.settings.targets) - point).squaredNorm();
         largest_move = std::max(largest_move, std::abs(out[i] - current[i]) * span.length);
       }
     }
@@ -573,8 +578,15 @@ Steps<FitRun::Fitted> FitRun::fit_steps(const LimitFit::Impl& m, const BaseMesh&
     std::vector<Eigen::VectorXd> step_history, value_history;
     Eigen::MatrixXd gram;
     Eigen::VectorXd previous_g, previous_f;
+    std::vector<double> distances;
     for (uint32_t round = 0; round < rounds; ++round) {
-      if (feet(x, g) <= tolerance) break;
+      double distance = 0;
+      if (feet(x, g, distance) <= tolerance) break;
+      distances.push_back(distance);
+      const uint32_t stall = m.settings.stall_rounds;
+      if (stall > 0 && distances.size() > stall &&
+          distances[distances.size() - 1 - stall] - distance < m.settings.stall_gain * distance)
+        break;
       const Eigen::VectorXd f = g - x;
       if (previous_g.size() > 0) {
         if (step_history.size() == m.settings.anderson_depth) {

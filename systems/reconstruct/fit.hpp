@@ -88,6 +88,12 @@ struct FitWeights {
   uint32_t phase3_iterations = 4;
   uint32_t max_iterations = 110;   // solves in all
   double tolerance = 1e-11;
+  // Noisy curves' feet never settle to `tolerance` (the largest move stays near the noise), so phase 2
+  // would spend all its solves creeping: with stall_rounds > 0 it stops once the squared distances of the
+  // fitted points to their feet fell by less than `stall_gain` of themselves over the last stall_rounds
+  // rounds (fit_weights sets it for noisy curves).
+  uint32_t stall_rounds = 0;
+  double stall_gain = 5e-3;
 };
 
 // Per base vertex, the weight of the shape term (FitWeights::shape); all zero where no quad is thin. The

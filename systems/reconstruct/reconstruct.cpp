@@ -810,6 +810,13 @@ FitWeights fit_weights(const Options& options, double noise) {
   FitWeights weights;
   weights.fairness = fit_fairness(options, noise);
   weights.targets = fit_targets(noise);
+  // Noisy curves: the fit stops where its points' distance to the curves has stopped falling and where
+  // they move by a millionth of the object, both far below the noise (perf/notes/frame.md, "A fit that
+  // stops where noisy curves stop it").
+  if (weights.targets == Sampling::Linear) {
+    weights.stall_rounds = 5;
+    weights.tolerance = 1e-6;
+  }
   if (!options.fairness_from_noise || !(kNoisyFairness > options.fairness)) {
     weights.shape = 0;
     return weights;

@@ -1,9 +1,10 @@
 // FitRun, the fit spread over frames: however its back-substitutions are spread over calls, it ends on
 // LimitFit::solve's points bit for bit, runs exactly the budget per call, and needs no base mesh after it
-// starts.
+// starts. And a fit of noisy curves stops where they stop it.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstring>
+#include <random>
 
 #include "networks.hpp"
 #include "systems/reconstruct/fit.hpp"
@@ -58,4 +59,41 @@ TEST_CASE("a fit advanced 1, 7 or all back-substitutions at a time ends on solve
     CHECK(std::memcmp(run.points().data(), solved.data(), solved.size() * sizeof(Vec3)) == 0);
   }
   CHECK_FALSE(FitRun().running());
+}
+
+TEST_CASE("a fit of noisy curves stops once its distance to them stops falling, as close to them as one that runs every solve",
+          "[reconstruct][fit]") {
+  const Options options{Method::Fire, 1, 2, Planarity::LeastSquares};
+  ReconstructionState state;
+  SurfaceMesh surface;
+  REQUIRE(reconstruct_update(grid_network(4, 3, 33, height), options, state, surface).ok());
+  BaseMesh base = state.base();
+  // Seeded noise of 1 % of a face's side on every sample but the curves' ends (the network's vertices).
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  for (uint32_t c = 0; c + 1 < base.curve_offsets.size(); ++c)
+    for (uint32_t k = base.curve_offsets[c] + 1; k + 1 < base.curve_offsets[c + 1]; ++k)
+      for (int axis = 0; axis < 3; ++axis) base.curve_points[k][axis] += noise(rng);
+  const catmull_clark::BaseTopology topology{base.vertex_count(), base.face_offsets, base.face_vertices, base.sharp_edges,
+                                             base.border_corners};
+  auto refinement = catmull_clark::build_refinement(topology, {int(options.levels), true});
+  REQUIRE(refinement.ok());
+  auto limit = catmull_clark::build_limit_stencils(*refinement);
+  REQUIRE(limit.ok());
+  // The weights the reconstruction gives noisy curves, with and without the stop.
+  const FitWeights creeping{.fairness = kNoisyFairness, .targets = Sampling::Linear};
+  FitWeights stopping = creeping;
+  stopping.stall_rounds = 5;
+  stopping.tolerance = 1e-6;
+  auto fit_with = [&](const FitWeights& weights, std::vector<Vec3>& points) {
+    auto fit = LimitFit::build(*refinement, *limit, base, weights);
+    REQUIRE(fit.ok());
+    return fit->solve(base, points);
+  };
+  std::vector<Vec3> crept, stopped;
+  const LimitFit::Report all = fit_with(creeping, crept), early = fit_with(stopping, stopped);
+  INFO("every solve: " << all.iterations << " back-substitutions, rms " << all.rms << "; stopped: " << early.iterations
+                       << ", rms " << early.rms);
+  CHECK(early.iterations * 2 <= all.iterations);
+  CHECK(early.rms <= 1.02 * all.rms);
 }
