@@ -51,14 +51,14 @@ struct Run {
   std::string problem;
 };
 
-Run replay(const std::vector<InputEvent>& events, uint32_t levels, double snap, uint32_t fit_solves,
+Run replay(const std::vector<InputEvent>& events, uint32_t levels, double snap, uint32_t fit_work,
            const std::optional<TrackingRig>& rig = std::nullopt) {
   World w;
   w.log.events = events;
   w.sketch_settings.snap_distance = snap;
   if (rig) set_rig(w, *rig);
   w.surface_options.levels = levels;
-  w.surface_options.fit_solves_per_frame = fit_solves;
+  w.surface_options.fit_work_per_frame = fit_work;
   std::vector<SystemSpec> systems = session_systems(w);
   auto scheduler = Scheduler::build(std::move(systems), thread_cpu_ns);
   Run run;
@@ -175,25 +175,25 @@ int main(int argc, char** argv) {
     tracked = std::move(*log);
     rig = std::move(*loaded);
   }
-  const uint32_t fit_solves = whole_fit ? reconstruct::kWholeFit : reconstruct::Options{}.fit_solves_per_frame;
+  const uint32_t fit_work = whole_fit ? reconstruct::kWholeFit : reconstruct::Options{}.fit_work_per_frame;
   auto demo = read_input_log(FIRE_SOURCE_DIR "/tools/demo/sketch.log");
   if (!demo) {
     std::fprintf(stderr, "bench_frame: %s\n", demo.error().c_str());
     return 1;
   }
   std::printf("# bench_frame: every frame with input or a fit running, thread CPU time, one core; fit: %s\n\n",
-              whole_fit ? "whole in the commit frame" : (std::to_string(fit_solves) + " back-substitutions per frame").c_str());
+              whole_fit ? "whole in the commit frame" : (std::to_string(fit_work) + " base vertices times back-substitutions per frame").c_str());
   std::printf("| drawing | L | final | frames | p50 ms | p99 ms | max ms | commit p50 ms | commit max ms | "
               "fit frame p50 ms | fit frame max ms | shown after (frames) | settled after (frames) |\n"
               "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   std::vector<std::pair<std::string, std::pair<uint32_t, Run>>> runs;
   for (uint32_t levels : {2u, 3u}) {
-    runs.push_back({"demo dome", {levels, replay(demo->events, levels, SketchSettings{}.snap_distance, fit_solves)}});
+    runs.push_back({"demo dome", {levels, replay(demo->events, levels, SketchSettings{}.snap_distance, fit_work)}});
     report("demo dome", levels, runs.back().second.second);
-    runs.push_back({"grid 200", {levels, replay(grid, levels, 0.005, fit_solves)}});
+    runs.push_back({"grid 200", {levels, replay(grid, levels, 0.005, fit_work)}});
     report("grid 200", levels, runs.back().second.second);
     if (tracked) {
-      runs.push_back({"tracked", {levels, replay(tracked->events, levels, SketchSettings{}.snap_distance, fit_solves, rig)}});
+      runs.push_back({"tracked", {levels, replay(tracked->events, levels, SketchSettings{}.snap_distance, fit_work, rig)}});
       report("tracked", levels, runs.back().second.second);
     }
   }

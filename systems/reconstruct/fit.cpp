@@ -219,8 +219,9 @@ LimitFit::~LimitFit() = default;
 LimitFit::LimitFit(LimitFit&&) noexcept = default;
 LimitFit& LimitFit::operator=(LimitFit&&) noexcept = default;
 
-Result<LimitFit> LimitFit::build(const catmull_clark::Refinement& refinement, const catmull_clark::LimitStencils& limit,
-                                 const BaseMesh& base, const FitWeights& settings) {
+Result<LimitFit> LimitFit::build_rows(const catmull_clark::Refinement& refinement,
+                                      const catmull_clark::LimitStencils& limit, const BaseMesh& base,
+                                      const FitWeights& settings) {
   const uint32_t last = static_cast<uint32_t>(refinement.levels.size() - 1);
   const catmull_clark::Level& level0 = refinement.levels[0];
   const uint32_t nb = base.vertex_count();
@@ -283,7 +284,15 @@ Result<LimitFit> LimitFit::build(const catmull_clark::Refinement& refinement, co
       triplets.emplace_back(static_cast<int>(r), static_cast<int>(table.sources[k]), table.weights[k]);
   impl->rows.resize(Eigen::Index(selected.size()), nb);
   impl->rows.setFromTriplets(triplets.begin(), triplets.end());
+  LimitFit fit;
+  fit.impl_ = std::move(impl);
+  return fit;
+}
 
+Status LimitFit::factor(const BaseMesh& base, const FitWeights& settings) {
+  Impl* impl = impl_.get();
+  impl->settings = settings;
+  const uint32_t nb = impl->base_vertices;
   impl->data_normal = Sparse(impl->rows.transpose()) * impl->rows;
   const double data_scale = impl->data_normal.diagonal().mean();
   const Sparse laplacian = umbrella(base);
@@ -301,12 +310,17 @@ Result<LimitFit> LimitFit::build(const catmull_clark::Refinement& refinement, co
   }
   impl->ridge = settings.ridge * data_scale;
   impl->solver.compute(impl->normal_matrix(fairness));
-  if (impl->solver.info() != Eigen::Success)
-    return Result<LimitFit>::failure("the limit fit's normal matrix could not be factored");
+  if (impl->solver.info() != Eigen::Success) return Status::failure("the limit fit's normal matrix could not be factored");
   impl->inverse_diagonal = impl->solver.vectorD().cwiseInverse();
   impl->rows_by_column = impl->rows;
-  LimitFit fit;
-  fit.impl_ = std::move(impl);
+  return Status::success();
+}
+
+Result<LimitFit> LimitFit::build(const catmull_clark::Refinement& refinement, const catmull_clark::LimitStencils& limit,
+                                 const BaseMesh& base, const FitWeights& settings) {
+  Result<LimitFit> fit = build_rows(refinement, limit, base, settings);
+  if (!fit) return fit;
+  if (Status factored = fit->factor(base, settings); !factored) return Result<LimitFit>::failure(factored.error);
   return fit;
 }
 

@@ -110,6 +110,13 @@ class LimitFit {
   // Rows and factorization for this topology (`refinement` of `base`, with last-level adjacency).
   static Result<LimitFit> build(const catmull_clark::Refinement& refinement, const catmull_clark::LimitStencils& limit,
                                 const BaseMesh& base, const FitWeights& weights);
+  // build in two halves, which the frame runs in two frames (each costs about as much as the other): the
+  // rows (the limit stencils of the fitted points, composed down the levels), then the normal matrix and
+  // its factorization, for the same `base`. Only a factored fit solves.
+  static Result<LimitFit> build_rows(const catmull_clark::Refinement& refinement,
+                                     const catmull_clark::LimitStencils& limit, const BaseMesh& base,
+                                     const FitWeights& weights);
+  Status factor(const BaseMesh& base, const FitWeights& weights);
   struct Report {
     uint32_t iterations = 0;  // solves (back-substitutions)
     double rms = 0;           // rms distance of the fitted limit points to their final targets

@@ -62,10 +62,12 @@ struct ReconstructionCache {
   uint32_t key_vertex_count = 0;
   catmull_clark::Refinement refinement;
   catmull_clark::LimitStencils limit;
-  // fit is the factorization of the current topology only when fit_built; fit_waiting: a new base mesh
+  // fit holds the rows of the current topology when fit_rows, and is their factorization only when
+  // fit_built; fit_waiting: a new base mesh
   // has been shown and its fit has not started yet. fit_shape: the shape weights it was built with,
   // which depend on the base points (a change of them needs a new factorization too).
   LimitFit fit;
+  bool fit_rows = false;
   bool fit_built = false;
   std::vector<double> fit_shape;
   double fit_fairness = 0;  // the fairness it was built with (fit_fairness of the network's noise)
@@ -276,8 +278,7 @@ Status check_options(const Options& options) {
                            std::to_string(options.levels));
   if (!(options.fairness >= 0 && options.fairness <= 1))
     return Status::failure("the fairness weight must be 0 to 1, not " + std::to_string(options.fairness));
-  if (options.fit_solves_per_frame < 1)
-    return Status::failure("the fit's back-substitutions per frame must be at least 1");
+  if (options.fit_work_per_frame < 1) return Status::failure("the fit's work per frame must be at least 1");
   return Status::success();
 }
 
@@ -768,11 +769,12 @@ bool same_topology(const ReconstructionCache& c, const BaseMesh& b) {
          c.key_curve_drawn == b.curve_drawn && c.key_vertex_drawn == b.vertex_drawn;
 }
 
-// Catmull-Clark topology and limit stencils of the base mesh; the fit's factorization (fire) is left to
-// build_fit, a frame later in the live frame.
+// Catmull-Clark topology and limit stencils of the base mesh; the fit's rows and factorization (fire) are
+// left to build_fit, the two frames after in the live frame.
 Status rebuild_topology(const Options& options, ReconstructionCache& c) {
   const BaseMesh& b = c.base;
   c.have_topology = false;
+  c.fit_rows = false;
   c.fit_built = false;
   catmull_clark::BaseTopology topology{b.vertex_count(), b.face_offsets, b.face_vertices, b.sharp_edges, b.border_corners};
   auto refinement = catmull_clark::build_refinement(topology, {static_cast<int>(options.levels), true});
@@ -826,12 +828,19 @@ FitWeights fit_weights(const Options& options, double noise) {
   return weights;
 }
 
-Status build_fit(const Options& options, ReconstructionCache& c) {
+// The fit's rows for the topology, if it has none yet, and then, or in the next call unless `whole`, their
+// factorization.
+Status build_fit(const Options& options, ReconstructionCache& c, bool whole) {
   const FitWeights weights = fit_weights(options, c.noise);
-  auto fit = LimitFit::build(c.refinement, c.limit, c.base, weights);
-  if (!fit) return Status::failure(fit.error());
   c.run = {};
-  c.fit = std::move(*fit);
+  if (!c.fit_rows) {
+    auto fit = LimitFit::build_rows(c.refinement, c.limit, c.base, weights);
+    if (!fit) return Status::failure(fit.error());
+    c.fit = std::move(*fit);
+    c.fit_rows = true;
+    if (!whole) return Status::success();
+  }
+  if (Status factored = c.fit.factor(c.base, weights); !factored) return factored;
   c.fit_built = true;
   c.fit_shape = shape_weights(c.base, weights);
   c.fit_fairness = weights.fairness;
@@ -888,13 +897,14 @@ void evaluate_surface(ReconstructionCache& c, std::span<const Vec3> base_points,
   surface = std::move(out);
 }
 
-// The commit frame shows the provisional surface, the next one factorizes: 5 frames are left for the solves.
-static_assert(5 * Options{}.fit_solves_per_frame >= FitWeights{}.max_iterations,
-              "the default budget settles every fit within 6 frames of its commit (reconstruct.hpp)");
+// The commit frame shows the provisional surface, the next two build the fit: 4 frames are left for the
+// solves of a base mesh of up to this many vertices to settle within 6 frames (reconstruct.hpp).
+static_assert(4 * (Options{}.fit_work_per_frame / 280) >= FitWeights{}.max_iterations);
 
 Result<SurfaceWrite> run_subdivide(const Options& options, ReconstructionCache& c, SurfaceMesh& surface) {
-  const uint32_t fit_solves = options.fit_solves_per_frame;
-  const bool whole = fit_solves == kWholeFit;
+  const bool whole = options.fit_work_per_frame == kWholeFit;
+  const uint32_t fit_solves =
+      whole ? kWholeFit : std::max<uint32_t>(1, options.fit_work_per_frame / std::max<uint32_t>(1, c.base.vertex_count()));
   if (c.pending_subdivide) {
     if (c.rebuild_topology) {
       if (auto s = rebuild_topology(options, c); !s) return Result<SurfaceWrite>::failure(s.error);
@@ -916,10 +926,13 @@ Result<SurfaceWrite> run_subdivide(const Options& options, ReconstructionCache& 
     }
   }
   if (c.fit_waiting) {
-    // A new factorization is the whole of its frame's work; with the old one the solves start at once.
+    // A new fit's rows and its factorization are each the whole of their frame's work; with the old
+    // factorization the solves start at once.
     const bool factorized = !c.fit_built;
-    if (factorized)
-      if (auto s = build_fit(options, c); !s) return Result<SurfaceWrite>::failure(s.error);
+    if (factorized) {
+      if (auto s = build_fit(options, c, whole); !s) return Result<SurfaceWrite>::failure(s.error);
+      if (!c.fit_built) return SurfaceWrite::None;
+    }
     c.run = FitRun(c.fit, c.base);
     c.fit_waiting = false;
     if (factorized && !whole) return SurfaceWrite::None;
@@ -955,7 +968,7 @@ Status reconstruct_update(const Mesh& net, const Options& options, Reconstructio
   // A call with nothing changed still re-runs the global stages, as a fresh reconstruction would.
   if (c.built) c.pending_subdivide = true;
   Options whole = options;
-  whole.fit_solves_per_frame = kWholeFit;
+  whole.fit_work_per_frame = kWholeFit;
   if (auto r = refine_update(net, whole, state); !r) return Status::failure(r.error());
   if (auto r = subdivide_update(whole, state, surface); !r) return Status::failure(r.error());
   return Status::success();

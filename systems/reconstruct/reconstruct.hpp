@@ -68,7 +68,7 @@ inline constexpr uint32_t kMaxSideDoublings = 2;
 inline constexpr double kStraightCornerTurn = 20.0;
 // Surface levels the options allow (the Catmull-Clark library itself refines further).
 inline constexpr uint32_t kMaxSurfaceLevels = 6;
-// Options::fit_solves_per_frame that runs a fit to its end in one call, as a rebuild does.
+// Options::fit_work_per_frame that runs a fit to its end in one call, as a rebuild does.
 inline constexpr uint32_t kWholeFit = UINT32_MAX;
 
 struct Options {
@@ -82,11 +82,16 @@ struct Options {
   // (fit_fairness); without, the weight itself (an explicit --fairness).
   double fairness = 1e-3;
   bool fairness_from_noise = true;
-  // FIRE, the live frame: back-substitutions of the fit per frame after a commit (the subdivide system);
-  // at least 1, kWholeFit for the whole fit in the commit frame. The frame after a commit that changed
-  // the base topology factorizes; 22 is the fewest with which a fit (at most FitWeights::max_iterations
-  // = 110 of them) then settles within 6 frames, 100 ms, of the commit.
-  uint32_t fit_solves_per_frame = 22;
+  // FIRE, the live frame: the fit's work per frame after a commit (the subdivide system), in base
+  // vertices times back-substitutions: a frame runs this over the base mesh's vertex count of them, at
+  // least one; kWholeFit for the whole fit in the commit frame. The two frames after a commit that changed
+  // the base topology build the fit's rows and then factorize it. A back-substitution and its target
+  // updates cost about in proportion to the base mesh, so a frame's share stays under about 8 ms on the
+  // 2-core VM (perf/notes/frame.md, "A fit that stops where noisy curves stop it"); a fit settles within
+  // 2 + ceil(iterations x base vertices / 8000) frames of its commit: 6 frames for the at most
+  // FitWeights::max_iterations = 110 of a base mesh of up to 280 vertices, 7 for the simulated pawn's 650
+  // and its noisy curves' 40 or so.
+  uint32_t fit_work_per_frame = 8000;
   friend bool operator==(const Options&, const Options&) = default;
 };
 
@@ -281,7 +286,7 @@ enum class SurfaceWrite : uint8_t {
 // mesh, rebuilds topology and limit stencils where needed and evaluates into `surface` the new base
 // mesh's provisional surface (fire, unless the whole fit runs in the same call: kWholeFit). The next call
 // (fire) factorizes the fit if the topology changed, and then, or at once with the old factorization,
-// the calls run at most Options::fit_solves_per_frame of the fit's back-substitutions each and write the
+// the calls run the fit's back-substitutions, as many each as Options::fit_work_per_frame allows, and write the
 // settled surface when the fit ends. On failure the state is emptied as above.
 Result<Refined> refine_update(const Mesh& net, const Options& options, ReconstructionState& state);
 Result<SurfaceWrite> subdivide_update(const Options& options, ReconstructionState& state, SurfaceMesh& surface);

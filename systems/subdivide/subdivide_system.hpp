@@ -3,11 +3,11 @@
 // stencils only if the base topology changed, evaluates the limit positions and normals of the base
 // mesh's initial points (the transfinite patches) through the stencils and writes them to the engine's
 // SurfaceLevels, not settled, for the renderer and the exporters, the quads grouped by network face
-// (SurfaceLevels' patches). The next frame factorizes the fit if the topology changed; from then on each
-// frame runs at most Options::fit_solves_per_frame back-substitutions of the fit that makes the limit
-// surface pass through the curves, and the frame the fit ends in writes the fitted surface, settled
-// (equal to a rebuild's bit for bit). A new base mesh abandons a fit still running. Work per frame is a
-// count, never a clock.
+// (SurfaceLevels' patches). The next two frames build the fit's rows and factorize it if the topology
+// changed; from then on each frame runs Options::fit_work_per_frame's share of the back-substitutions of
+// the fit that makes the limit surface pass through the curves, and the frame the fit ends in writes the
+// fitted surface, settled (equal to a rebuild's bit for bit). A new base mesh abandons a fit still
+// running. Work per frame is a count, never a clock.
 #include "engine/surface.hpp"
 #include "engine/scheduler.hpp"
 #include "systems/reconstruct/reconstruct.hpp"

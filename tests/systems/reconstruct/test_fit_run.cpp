@@ -1,7 +1,9 @@
 // FitRun, the fit spread over frames: however its back-substitutions are spread over calls, it ends on
 // LimitFit::solve's points bit for bit, runs exactly the budget per call, and needs no base mesh after it
-// starts. And a fit of noisy curves stops where they stop it.
+// starts. The frame builds a new fit in two frames and gives each frame a share of its solves that
+// shrinks as the base mesh grows. And a fit of noisy curves stops where they stop it.
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -96,4 +98,30 @@ TEST_CASE("a fit of noisy curves stops once its distance to them stops falling, 
                        << ", rms " << early.rms);
   CHECK(early.iterations * 2 <= all.iterations);
   CHECK(early.rms <= 1.02 * all.rms);
+}
+
+TEST_CASE("the frame builds a new fit's rows and factorization in two frames, then shares out its work per frame",
+          "[reconstruct][fit][frame]") {
+  const Mesh net = grid_network(4, 3, 17, height);
+  for (uint32_t work : {1u, 300u, 2000u, Options{}.fit_work_per_frame}) {
+    Options options{Method::Fire, 1, 2, Planarity::LeastSquares};
+    options.fit_work_per_frame = work;
+    ReconstructionState state;
+    SurfaceMesh surface;
+    REQUIRE(refine_update(net, options, state).ok());
+    auto commit = subdivide_update(options, state, surface);
+    REQUIRE(commit.ok());
+    CHECK(*commit == SurfaceWrite::Provisional);
+    uint32_t frames = 0;
+    for (SurfaceWrite write = SurfaceWrite::None; write != SurfaceWrite::Settled && frames < 1000; ++frames) {
+      auto r = subdivide_update(options, state, surface);
+      REQUIRE(r.ok());
+      write = *r;
+      CHECK((write == SurfaceWrite::Settled || write == SurfaceWrite::None));
+    }
+    const uint32_t vertices = state.base().vertex_count(), iterations = state.last_update().fit_iterations;
+    const uint32_t per_frame = std::max(1u, work / vertices);
+    INFO("work " << work << ", " << vertices << " base vertices, " << iterations << " back-substitutions");
+    CHECK(frames == 2 + (iterations + per_frame - 1) / per_frame);
+  }
 }

@@ -1,6 +1,6 @@
 // The live surface under a long seeded random edit sequence: the frame of every applied edit shows the
 // new faces from their initial base points, not settled; the fit then ends within 6 frames (the default
-// budget of back-substitutions per frame) on a surface equal, bit for bit, to a reconstruction from
+// work per frame, on this grid's small base meshes) on a surface equal, bit for bit, to a reconstruction from
 // scratch, writing nothing in the frames between; and the refine stage recomputes only the faces the edit
 // stamped and the faces across the edges it stamped. Some edits come before the previous fit has ended,
 // which abandons it.
