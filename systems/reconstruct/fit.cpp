@@ -597,10 +597,13 @@ Steps<FitRun::Fitted> FitRun::fit_steps(const LimitFit::Impl& m, const BaseMesh&
       double distance = 0;
       if (feet(x, g, distance) <= tolerance) break;
       distances.push_back(distance);
-      const uint32_t stall = m.settings.stall_rounds;
-      if (stall > 0 && distances.size() > stall &&
-          distances[distances.size() - 1 - stall] - distance < m.settings.stall_gain * distance)
-        break;
+      const size_t stall = m.settings.stall_rounds;
+      if (stall > 0 && distances.size() > stall) {
+        const auto window = distances.end() - long(stall);
+        const double before = *std::min_element(distances.begin(), window);
+        const double lately = *std::min_element(window, distances.end());
+        if (before - lately < m.settings.stall_gain * lately) break;
+      }
       const Eigen::VectorXd f = g - x;
       if (previous_g.size() > 0) {
         if (step_history.size() == m.settings.anderson_depth) {

@@ -89,9 +89,10 @@ struct FitWeights {
   uint32_t max_iterations = 110;   // solves in all
   double tolerance = 1e-11;
   // Noisy curves' feet never settle to `tolerance` (the largest move stays near the noise), so phase 2
-  // would spend all its solves creeping: with stall_rounds > 0 it stops once the squared distances of the
-  // fitted points to their feet fell by less than `stall_gain` of themselves over the last stall_rounds
-  // rounds (fit_weights sets it for noisy curves).
+  // would spend all its solves creeping: with stall_rounds > 0 it stops once the least squared distance of
+  // the fitted points to their feet over the last stall_rounds rounds is less than `stall_gain` of itself
+  // below the least before them (the sum rises for a round or two now and then: the mixed steps). Set by
+  // fit_weights for noisy curves.
   uint32_t stall_rounds = 0;
   double stall_gain = 5e-3;
 };

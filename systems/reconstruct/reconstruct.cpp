@@ -816,7 +816,7 @@ FitWeights fit_weights(const Options& options, double noise) {
   // they move by a millionth of the object, both far below the noise (perf/notes/frame.md, "A fit that
   // stops where noisy curves stop it").
   if (weights.targets == Sampling::Linear) {
-    weights.stall_rounds = 5;
+    weights.stall_rounds = 8;
     weights.tolerance = 1e-6;
   }
   if (!options.fairness_from_noise || !(kNoisyFairness > options.fairness)) {

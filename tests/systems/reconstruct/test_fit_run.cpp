@@ -85,7 +85,7 @@ TEST_CASE("a fit of noisy curves stops once its distance to them stops falling, 
   // The weights the reconstruction gives noisy curves, with and without the stop.
   const FitWeights creeping{.fairness = kNoisyFairness, .targets = Sampling::Linear};
   FitWeights stopping = creeping;
-  stopping.stall_rounds = 5;
+  stopping.stall_rounds = 8;
   stopping.tolerance = 1e-6;
   auto fit_with = [&](const FitWeights& weights, std::vector<Vec3>& points) {
     auto fit = LimitFit::build(*refinement, *limit, base, weights);
