@@ -63,9 +63,9 @@ struct ReconstructionCache {
   catmull_clark::Refinement refinement;
   catmull_clark::LimitStencils limit;
   // fit holds the rows of the current topology when fit_rows, and is their factorization only when
-  // fit_built; fit_waiting: a new base mesh
-  // has been shown and its fit has not started yet. fit_shape: the shape weights it was built with,
-  // which depend on the base points (a change of them needs a new factorization too).
+  // fit_built; fit_waiting: a new base mesh has been shown and its fit has not started yet. fit_shape: the
+  // shape weights it was built with, which depend on the base points (a change of them needs a new
+  // factorization too).
   LimitFit fit;
   bool fit_rows = false;
   bool fit_built = false;

@@ -19,23 +19,39 @@ namespace {
 
 double height(double x, double y) { return 0.5 * std::sin(0.6 * x) * std::cos(0.5 * y) + 0.02 * x * y; }
 
+// The base mesh of a reconstruction of the 4 x 3 grid with `samples` points per curve.
+BaseMesh grid_base(const Options& options, uint32_t samples) {
+  ReconstructionState state;
+  SurfaceMesh surface;
+  REQUIRE(reconstruct_update(grid_network(4, 3, samples, height), options, state, surface).ok());
+  return state.base();
+}
+
+// The fit's topology for a base mesh: its refinement with the last level's adjacency, and limit stencils.
+struct Subdivided {
+  catmull_clark::Refinement refinement;
+  catmull_clark::LimitStencils limit;
+};
+
+Subdivided subdivided(const BaseMesh& base, uint32_t levels) {
+  const catmull_clark::BaseTopology topology{base.vertex_count(), base.face_offsets, base.face_vertices, base.sharp_edges,
+                                             base.border_corners};
+  auto refinement = catmull_clark::build_refinement(topology, {int(levels), true});
+  REQUIRE(refinement.ok());
+  auto limit = catmull_clark::build_limit_stencils(*refinement);
+  REQUIRE(limit.ok());
+  return {std::move(*refinement), std::move(*limit)};
+}
+
 }  // namespace
 
 TEST_CASE("a fit advanced 1, 7 or all back-substitutions at a time ends on solve's points bit for bit",
           "[reconstruct][fit]") {
   // Two Coons steps: four pieces per network edge, so that phase 3 splits the spans too.
   const Options options{Method::Fire, 2, 2, Planarity::LeastSquares};
-  ReconstructionState state;
-  SurfaceMesh surface;
-  REQUIRE(reconstruct_update(grid_network(4, 3, 17, height), options, state, surface).ok());
-  const BaseMesh& base = state.base();
-  const catmull_clark::BaseTopology topology{base.vertex_count(), base.face_offsets, base.face_vertices, base.sharp_edges,
-                                         base.border_corners};
-  auto refinement = catmull_clark::build_refinement(topology, {int(options.levels), true});
-  REQUIRE(refinement.ok());
-  auto limit = catmull_clark::build_limit_stencils(*refinement);
-  REQUIRE(limit.ok());
-  auto fit = LimitFit::build(*refinement, *limit, base, FitWeights{});
+  const BaseMesh base = grid_base(options, 17);
+  const Subdivided topology = subdivided(base, options.levels);
+  auto fit = LimitFit::build(topology.refinement, topology.limit, base, FitWeights{});
   REQUIRE(fit.ok());
   std::vector<Vec3> solved;
   const LimitFit::Report whole = fit->solve(base, solved);
@@ -66,29 +82,21 @@ TEST_CASE("a fit advanced 1, 7 or all back-substitutions at a time ends on solve
 TEST_CASE("a fit of noisy curves stops once its distance to them stops falling, as close to them as one that runs every solve",
           "[reconstruct][fit]") {
   const Options options{Method::Fire, 1, 2, Planarity::LeastSquares};
-  ReconstructionState state;
-  SurfaceMesh surface;
-  REQUIRE(reconstruct_update(grid_network(4, 3, 33, height), options, state, surface).ok());
-  BaseMesh base = state.base();
+  BaseMesh base = grid_base(options, 33);
   // Seeded noise of 1 % of a face's side on every sample but the curves' ends (the network's vertices).
   std::mt19937_64 rng(11);
   std::normal_distribution<double> noise(0.0, 0.01);
   for (uint32_t c = 0; c + 1 < base.curve_offsets.size(); ++c)
     for (uint32_t k = base.curve_offsets[c] + 1; k + 1 < base.curve_offsets[c + 1]; ++k)
       for (int axis = 0; axis < 3; ++axis) base.curve_points[k][axis] += noise(rng);
-  const catmull_clark::BaseTopology topology{base.vertex_count(), base.face_offsets, base.face_vertices, base.sharp_edges,
-                                             base.border_corners};
-  auto refinement = catmull_clark::build_refinement(topology, {int(options.levels), true});
-  REQUIRE(refinement.ok());
-  auto limit = catmull_clark::build_limit_stencils(*refinement);
-  REQUIRE(limit.ok());
+  const Subdivided topology = subdivided(base, options.levels);
   // The weights the reconstruction gives noisy curves, with and without the stop.
   const FitWeights creeping{.fairness = kNoisyFairness, .targets = Sampling::Linear};
   FitWeights stopping = creeping;
   stopping.stall_rounds = 8;
   stopping.tolerance = 1e-6;
   auto fit_with = [&](const FitWeights& weights, std::vector<Vec3>& points) {
-    auto fit = LimitFit::build(*refinement, *limit, base, weights);
+    auto fit = LimitFit::build(topology.refinement, topology.limit, base, weights);
     REQUIRE(fit.ok());
     return fit->solve(base, points);
   };
