@@ -145,7 +145,14 @@ under_x() {
   cat "$stem.status" 2>/dev/null || echo "no status (xvfb-run did not run it)"
 }
 
-has() { local o="$1"; shift; printf '%s\n' "$@" | grep -qx -- "$o"; }
+# A loop, not printf into grep -q: under pipefail grep's early exit can fail printf with SIGPIPE, and a word that
+# is there reads as missing (the app's --live once did, and its session was closed at frame 5).
+has() {
+  local o="$1" word
+  shift
+  for word in "$@"; do [ "$word" = "$o" ] && return 0; done
+  return 1
+}
 value_of() {  # OPTION WORDS...: the word after OPTION
   local o="$1"; shift
   while [ $# -gt 1 ]; do [ "$1" = "$o" ] && { echo "$2"; return; }; shift; done
