@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "systems/catmull_clark/catmull_clark.hpp"
 
@@ -31,29 +32,48 @@ void corner_masks(Row& row) {
   row.tangent2[row.edge(1)] = 1.0;
 }
 
-void smooth_masks(Row& row) {
-  const uint32_t n = row.n;
+// A smooth vertex's masks depend on its valence alone: computed once per valence a build meets (most of
+// a level's vertices are regular), then copied.
+struct SmoothMasks {
+  double center = 0, edge = 0, face = 0;
+  std::vector<double> tangent_edge, tangent_face;  // tangent1's weights; tangent2 is them one slot on
+};
+
+SmoothMasks smooth_masks_of(uint32_t n) {
+  SmoothMasks masks;
   const double dn = n;
   const double face_weight = 1.0 / (dn * (dn + 5.0));
-  row.position[0] = dn / (dn + 5.0);
-  for (uint32_t i = 0; i < n; ++i) {
-    row.position[row.edge(i)] = 4.0 * face_weight;
-    row.position[row.face(i)] = face_weight;
-  }
+  masks.center = dn / (dn + 5.0);
+  masks.edge = 4.0 * face_weight;
+  masks.face = face_weight;
   const double theta = 2.0 * std::numbers::pi / dn;
   const double cos_theta = std::cos(theta);
   const double lambda =
       5.0 / 16.0 + (cos_theta + std::cos(0.5 * theta) * std::sqrt(2.0 * (9.0 + cos_theta))) / 16.0;
   const double face_scale = 1.0 / (4.0 * lambda - 1.0);
-  // tangent2 is tangent1 rotated by one slot.
   for (uint32_t i = 0; i < n; ++i) {
-    const double e = 4.0 * std::cos(i * theta);
-    const double f = face_scale * (std::cos(i * theta) + std::cos((i + 1) * theta));
+    masks.tangent_edge.push_back(4.0 * std::cos(i * theta));
+    masks.tangent_face.push_back(face_scale * (std::cos(i * theta) + std::cos((i + 1) * theta)));
+  }
+  return masks;
+}
+
+void smooth_masks(Row& row, std::vector<SmoothMasks>& by_valence) {
+  const uint32_t n = row.n;
+  if (by_valence.size() <= n) by_valence.resize(n + 1);
+  if (by_valence[n].tangent_edge.empty()) by_valence[n] = smooth_masks_of(n);
+  const SmoothMasks& masks = by_valence[n];
+  row.position[0] = masks.center;
+  for (uint32_t i = 0; i < n; ++i) {
+    row.position[row.edge(i)] = masks.edge;
+    row.position[row.face(i)] = masks.face;
+  }
+  for (uint32_t i = 0; i < n; ++i) {
     const uint32_t next = i + 1 == n ? 0 : i + 1;
-    row.tangent1[row.edge(i)] = e;
-    row.tangent1[row.face(i)] = f;
-    row.tangent2[row.edge(next)] = e;
-    row.tangent2[row.face(next)] = f;
+    row.tangent1[row.edge(i)] = masks.tangent_edge[i];
+    row.tangent1[row.face(i)] = masks.tangent_face[i];
+    row.tangent2[row.edge(next)] = masks.tangent_edge[i];
+    row.tangent2[row.face(next)] = masks.tangent_face[i];
   }
 }
 
@@ -131,6 +151,7 @@ Status build_limit_stencils(const Refinement& refinement, LimitStencils& limit) 
   limit.tangent1.resize(total);
   limit.tangent2.resize(total);
 
+  std::vector<SmoothMasks> smooth_by_valence;
   for (uint32_t v = 0; v < vertex_count; ++v) {
     const uint32_t o = limit.offsets[v];
     const uint32_t r0 = level.ring_offsets[v], n = level.ring_offsets[v + 1] - r0;
@@ -163,7 +184,7 @@ Status build_limit_stencils(const Refinement& refinement, LimitStencils& limit) 
         if (n == 2)
           corner_masks(row);
         else
-          smooth_masks(row);
+          smooth_masks(row, smooth_by_valence);
         break;
       case VertexRule::Crease: crease_masks(row, sharp[0], sharp[1]); break;
       case VertexRule::Corner: corner_masks(row); break;
