@@ -61,7 +61,10 @@ struct ReconstructionCache {
   std::vector<uint8_t> key_curve_drawn, key_vertex_drawn, key_border_corners;
   uint32_t key_vertex_count = 0;
   catmull_clark::Refinement refinement;
+  // The limit stencils of `refinement`, when have_limit: built by the frame after a commit, with the fit's
+  // rows, as the provisional surface is shown without them.
   catmull_clark::LimitStencils limit;
+  bool have_limit = false;
   // fit holds the rows of the current topology when fit_rows, and is their factorization only when
   // fit_built; fit_waiting: a new base mesh has been shown and its fit has not started yet. fit_shape: the
   // shape weights it was built with, which depend on the base points (a change of them needs a new
@@ -769,19 +772,18 @@ bool same_topology(const ReconstructionCache& c, const BaseMesh& b) {
          c.key_curve_drawn == b.curve_drawn && c.key_vertex_drawn == b.vertex_drawn;
 }
 
-// Catmull-Clark topology and limit stencils of the base mesh; the fit's rows and factorization (fire) are
-// left to build_fit, the two frames after in the live frame.
+// Catmull-Clark topology of the base mesh; its limit stencils are left to ensure_limit, the fit's rows and
+// factorization (fire) to build_fit, the two frames after in the live frame.
 Status rebuild_topology(const Options& options, ReconstructionCache& c) {
   const BaseMesh& b = c.base;
   c.have_topology = false;
+  c.have_limit = false;
   c.fit_rows = false;
   c.fit_built = false;
   catmull_clark::BaseTopology topology{b.vertex_count(), b.face_offsets, b.face_vertices, b.sharp_edges, b.border_corners};
   auto refinement = catmull_clark::build_refinement(topology, {static_cast<int>(options.levels), true});
   if (!refinement) return Status::failure("the base mesh cannot be subdivided: " + refinement.error());
   c.refinement = std::move(*refinement);
-  if (auto s = catmull_clark::build_limit_stencils(c.refinement, c.limit); !s)
-    return Status::failure("internal error: " + s.error);
   c.key_vertex_count = b.vertex_count();
   c.key_face_offsets = b.face_offsets;
   c.key_face_vertices = b.face_vertices;
@@ -791,6 +793,14 @@ Status rebuild_topology(const Options& options, ReconstructionCache& c) {
   c.key_curve_drawn = b.curve_drawn;
   c.key_vertex_drawn = b.vertex_drawn;
   c.have_topology = true;
+  return Status::success();
+}
+
+Status ensure_limit(ReconstructionCache& c) {
+  if (c.have_limit) return Status::success();
+  if (auto s = catmull_clark::build_limit_stencils(c.refinement, c.limit); !s)
+    return Status::failure("internal error: " + s.error);
+  c.have_limit = true;
   return Status::success();
 }
 
@@ -834,6 +844,7 @@ Status build_fit(const Options& options, ReconstructionCache& c, bool whole) {
   const FitWeights weights = fit_weights(options, c.noise);
   c.run = {};
   if (!c.fit_rows) {
+    if (Status s = ensure_limit(c); !s) return s;
     auto fit = LimitFit::build_rows(c.refinement, c.limit, c.base, weights);
     if (!fit) return Status::failure(fit.error());
     c.fit = std::move(*fit);
@@ -887,13 +898,37 @@ Result<Refined> run_refine(const Mesh& net, const Options& options, Reconstructi
   return Refined::Assembled;
 }
 
-void evaluate_surface(ReconstructionCache& c, std::span<const Vec3> base_points, SurfaceMesh& surface) {
+Status evaluate_surface(ReconstructionCache& c, std::span<const Vec3> base_points, SurfaceMesh& surface) {
+  if (Status s = ensure_limit(c); !s) return s;
   std::vector<Vec3> last_level;
   catmull_clark::evaluate(c.refinement, base_points, last_level, c.scratch);
   SurfaceMesh out;
   catmull_clark::evaluate_limit(c.limit, last_level, out.positions, out.normals);
   out.face_offsets = c.refinement.last().face_offsets;
   out.face_vertices = c.refinement.last().face_vertices;
+  surface = std::move(out);
+  return Status::success();
+}
+
+// The provisional surface: the last level's points themselves, a level short of the limit, with the
+// normals of their quads, so the commit frame builds no limit stencils (perf/notes/frame.md, "The commit
+// frame without limit stencils"). The settled surface replaces it a few frames later.
+void evaluate_provisional(ReconstructionCache& c, SurfaceMesh& surface) {
+  const catmull_clark::Level& last = c.refinement.last();
+  SurfaceMesh out;
+  catmull_clark::evaluate(c.refinement, c.base.positions, out.positions, c.scratch);
+  out.normals.assign(out.positions.size(), Vec3::Zero());
+  for (uint32_t f = 0; f + 1 < last.face_offsets.size(); ++f) {
+    const uint32_t* q = last.face_vertices.data() + last.face_offsets[f];
+    const Vec3 n = (out.positions[q[2]] - out.positions[q[0]]).cross(out.positions[q[3]] - out.positions[q[1]]);
+    for (int k = 0; k < 4; ++k) out.normals[q[k]] += n;
+  }
+  for (Vec3& n : out.normals) {
+    const double length = n.norm();
+    n = length > 0.0 ? Vec3(n / length) : Vec3::Zero();
+  }
+  out.face_offsets = last.face_offsets;
+  out.face_vertices = last.face_vertices;
   surface = std::move(out);
 }
 
@@ -913,15 +948,15 @@ Result<SurfaceWrite> run_subdivide(const Options& options, ReconstructionCache& 
     }
     c.pending_subdivide = false;
     if (options.method == Method::Thesis) {
-      evaluate_surface(c, c.base.positions, surface);
+      if (Status s = evaluate_surface(c, c.base.positions, surface); !s) return Result<SurfaceWrite>::failure(s.error);
       c.settled_points = c.base.positions;
       return SurfaceWrite::Settled;
     }
     // The fit starts from the base mesh's points, the transfinite patches': their surface is shown until
-    // it ends. In the frame, that is all this call does: topology and limit stencils were its work.
+    // it ends. In the frame, that is all this call does: the topology was its work.
     c.fit_waiting = true;
     if (!whole) {
-      evaluate_surface(c, c.base.positions, surface);
+      evaluate_provisional(c, surface);
       return SurfaceWrite::Provisional;
     }
   }
@@ -943,7 +978,7 @@ Result<SurfaceWrite> run_subdivide(const Options& options, ReconstructionCache& 
   // preview (phase 2 creeps, and the fit keeps phase 2's or phase 3's solution only at its end).
   c.stats.fit_iterations = c.run.report().iterations;
   c.stats.fit_rms = c.run.report().rms;
-  evaluate_surface(c, c.run.points(), surface);
+  if (Status s = evaluate_surface(c, c.run.points(), surface); !s) return Result<SurfaceWrite>::failure(s.error);
   c.settled_points = c.run.points();
   c.run = {};
   return SurfaceWrite::Settled;

@@ -85,7 +85,7 @@ struct Options {
   // FIRE, the live frame: the fit's work per frame after a commit (the subdivide system), in base
   // vertices times back-substitutions: a frame runs this over the base mesh's vertex count of them, at
   // least one; kWholeFit for the whole fit in the commit frame. The two frames after a commit that changed
-  // the base topology build the fit's rows and then factorize it. A back-substitution and its target
+  // the base topology build the limit stencils with the fit's rows and then factorize it. A back-substitution and its target
   // updates cost about in proportion to the base mesh, so a frame's share stays under about 8 ms on the
   // 2-core VM (perf/notes/frame.md, "A fit that stops where noisy curves stop it"); a fit settles within
   // 2 + ceil(iterations x base vertices / 8000) frames of its commit: 6 frames for the at most
@@ -276,17 +276,17 @@ enum class Refined : uint8_t {
 // What a subdivide_update call wrote into its `surface`.
 enum class SurfaceWrite : uint8_t {
   None,         // nothing new: `surface` is left as it was
-  Provisional,  // the new base mesh's surface from its initial points (the transfinite patches); a fit runs
+  Provisional,  // the new base mesh's last level from its initial points (the transfinite patches); a fit runs
   Settled,      // the final surface, equal to a rebuild's bit for bit
 };
 
 // reconstruct_update in the two halves the frame runs as systems. refine_update recomputes the changed
 // edges and faces and assembles the base mesh; it returns Refined::Unchanged, doing nothing, when nothing
 // changed since its last call (a new base mesh abandons a fit still running). subdivide_update then, for a new base
-// mesh, rebuilds topology and limit stencils where needed and evaluates into `surface` the new base
-// mesh's provisional surface (fire, unless the whole fit runs in the same call: kWholeFit). The next call
-// (fire) factorizes the fit if the topology changed, and then, or at once with the old factorization,
-// the calls run the fit's back-substitutions, as many each as Options::fit_work_per_frame allows, and write the
+// mesh, rebuilds topology where needed and evaluates into `surface` the new base mesh's provisional
+// surface, its last level's points with their quads' normals (fire, unless the whole fit runs in the same
+// call: kWholeFit). If the topology changed, the next call (fire) builds the limit stencils and the fit's
+// rows and the one after factorizes it; then, or at once with the old factorization, the calls run the fit's back-substitutions, as many each as Options::fit_work_per_frame allows, and write the
 // settled surface when the fit ends. On failure the state is emptied as above.
 Result<Refined> refine_update(const Mesh& net, const Options& options, ReconstructionState& state);
 Result<SurfaceWrite> subdivide_update(const Options& options, ReconstructionState& state, SurfaceMesh& surface);

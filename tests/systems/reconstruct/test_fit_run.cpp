@@ -1,7 +1,7 @@
 // FitRun, the fit spread over frames: however its back-substitutions are spread over calls, it ends on
 // LimitFit::solve's points bit for bit, runs exactly the budget per call, and needs no base mesh after it
-// starts. The frame builds a new fit in two frames and gives each frame a share of its solves that
-// shrinks as the base mesh grows. And a fit of noisy curves stops where they stop it.
+// starts. The frame shows a new base mesh without limit stencils, builds its fit in two frames and gives
+// each frame a share of its solves that shrinks as the base mesh grows. And a fit of noisy curves stops where they stop it.
 #include <catch2/catch.hpp>
 #include <algorithm>
 #include <cmath>
@@ -120,6 +120,7 @@ TEST_CASE("the frame builds a new fit's rows and factorization in two frames, th
     auto commit = subdivide_update(options, state, surface);
     REQUIRE(commit.ok());
     CHECK(*commit == SurfaceWrite::Provisional);
+    const SurfaceMesh provisional = surface;
     uint32_t frames = 0;
     for (SurfaceWrite write = SurfaceWrite::None; write != SurfaceWrite::Settled && frames < 1000; ++frames) {
       auto r = subdivide_update(options, state, surface);
@@ -131,5 +132,22 @@ TEST_CASE("the frame builds a new fit's rows and factorization in two frames, th
     const uint32_t per_frame = std::max(1u, work / vertices);
     INFO("work " << work << ", " << vertices << " base vertices, " << iterations << " back-substitutions");
     CHECK(frames == 2 + (iterations + per_frame - 1) / per_frame);
+    // The commit frame builds no limit stencils: it shows the last level's points of the initial base
+    // points, with their quads' normals, a level short of the limit and close to the settled surface.
+    const BaseMesh& base = state.base();
+    auto refined = catmull_clark::subdivide({{base.positions, base.face_offsets, base.face_vertices}, base.sharp_edges,
+                                             base.border_corners},
+                                            int(options.levels));
+    REQUIRE(refined.ok());
+    REQUIRE(provisional.face_vertices == surface.face_vertices);
+    REQUIRE(provisional.positions.size() == refined->positions.size());
+    CHECK(std::memcmp(provisional.positions.data(), refined->positions.data(),
+                      provisional.positions.size() * sizeof(Vec3)) == 0);
+    double least_cosine = 1;
+    for (size_t v = 0; v < provisional.normals.size(); ++v) {
+      CHECK(std::abs(provisional.normals[v].norm() - 1) < 1e-12);
+      least_cosine = std::min(least_cosine, provisional.normals[v].dot(refined->limit_normals[v]));
+    }
+    CHECK(least_cosine > 0.9);
   }
 }
