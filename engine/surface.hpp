@@ -22,8 +22,8 @@ struct SurfaceMesh : PolygonMesh {
 
 struct SurfaceLevels {
   uint32_t level = 0;           // subdivision level the quads belong to (0: no surface yet)
-  std::vector<Vec3> positions;  // limit position per vertex of that level
-  std::vector<Vec3> normals;    // unit limit normal per vertex
+  std::vector<Vec3> positions;  // limit position per vertex of that level (its points while not `settled`)
+  std::vector<Vec3> normals;    // unit limit normal per vertex (its quads' normals while not `settled`)
   std::vector<uint32_t> quads;  // 4 vertex indices per quad, counter-clockwise seen from the front
   // Quads by patch: patch p owns quads [patch_offsets[p], patch_offsets[p+1]) and is named by
   // patch_keys[p] (the subdivide system: its network face slot), so that a reader holding a copy (the
@@ -35,8 +35,9 @@ struct SurfaceLevels {
   uint64_t topology_version = 0;
   Frame frame = 0;              // frame of the last write
   ChangedRange changed;         // vertices whose position or normal was written in `frame`
-  // False while the surface is provisional: new faces shown from their transfinite patches, the fit
-  // that passes through the curves still converging over the next frames.
+  // False while the surface is provisional: new faces shown from their transfinite patches (the last
+  // level's points, not pushed to the limit), the fit that passes through the curves still converging
+  // over the next frames.
   bool settled = true;
 
   uint32_t vertex_count() const { return static_cast<uint32_t>(positions.size()); }
