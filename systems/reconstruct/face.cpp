@@ -156,9 +156,12 @@ struct Refiner {
   LocalMesh& mesh;
   double spacing;  // mean segment length of the network face's polylines: spokes are sampled as densely
 
+  // A spoke of the last step is a base edge that nothing samples (the fit reads drawn curves only), so its
+  // two ends are all it needs; the patch points along it were most of a big face's cost (perf/notes/frame.md,
+  // "Refine's big faces"). Spokes of earlier steps are sides the next step's Coons patches sample.
   uint32_t spoke_segments(Rule rule, uint32_t remaining, const Vec3& from, const Vec3& to) const {
     const uint32_t needed = 1u << (remaining - 1);  // enough samples for the steps still to come
-    if (rule == Rule::ThesisCoons || rule == Rule::ThesisCentroid) return needed;
+    if (rule == Rule::ThesisCoons || rule == Rule::ThesisCentroid || remaining == 1) return needed;
     const double dense = spacing > 0 ? std::round((to - from).norm() / spacing) : 1.0;
     return std::max(needed, static_cast<uint32_t>(std::clamp(dense, 1.0, 256.0)));
   }

@@ -88,6 +88,27 @@ TEST_CASE("thesis: the centre of a 4-sided face is its Coons point x(1/2, 1/2)",
   check_disk(b);
 }
 
+TEST_CASE("FIRE: the last Coons step's spokes are their two ends, an earlier step's are sampled for the next",
+          "[reconstruct][fire]") {
+  // A fine polygon (129 points a side), whose spokes would otherwise be sampled as densely as its sides.
+  const Mesh net = cornered_polygon_network(7, 129);
+  for (uint32_t steps : {1u, 2u}) {
+    const BaseMesh b = base_of(net, {Method::Fire, steps, 2, Planarity::LeastSquares});
+    INFO(steps << " Coons steps");
+    size_t longest = 0, undrawn = 0;
+    for (uint32_t c = 0; c < b.curve_count(); ++c) {
+      if (b.curve_drawn[c]) continue;
+      ++undrawn;
+      longest = std::max(longest, b.curve(c).size());
+    }
+    REQUIRE(undrawn > 0);
+    // One step: 7 spokes of 2 points. Two: the first step's spokes were sampled densely and are split in
+    // halves by the second, whose own spokes are 2 points again.
+    if (steps == 1) CHECK(longest == 2);
+    else CHECK(longest > 4);
+  }
+}
+
 TEST_CASE("FIRE: an n-sided face becomes n quads around its centre", "[reconstruct][fire]") {
   for (uint32_t n : {2u, 3u, 4u, 5u, 6u}) {
     const Mesh net = n == 2 ? polygon_network(n) : cornered_polygon_network(n);
