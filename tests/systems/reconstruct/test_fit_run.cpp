@@ -1,7 +1,8 @@
 // FitRun, the fit spread over frames: however its back-substitutions are spread over calls, it ends on
 // LimitFit::solve's points bit for bit, runs exactly the budget per call, and needs no base mesh after it
 // starts. The frame shows a new base mesh without limit stencils, builds its fit in two frames and gives
-// each frame a share of its solves that shrinks as the base mesh grows. And a fit of noisy curves stops where they stop it.
+// each frame a share of its solves that shrinks as the base mesh grows. And a fit of noisy curves stops
+// where they stop it.
 #include <catch2/catch.hpp>
 #include <algorithm>
 #include <cmath>
